@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// Rank-aware logging. core knows no MPI: the driver tells the logger which rank it is on.
+///
+/// * info(): progress and parameters; printed by the root rank only (to stdout).
+/// * warn(): printed by whichever rank calls it, prefixed with the rank when there are several
+///   (to stderr), so that a warning seen on one rank only is not lost.
+/// * error(): the final message of a failing run (stderr), always printed.
+
+#include <string>
+#include <utility>
+
+#include <fmt/format.h>
+
+namespace efdem::log {
+
+enum class Level { quiet = 0, warn = 1, info = 2, debug = 3 };
+
+/// Called once by the driver after MPI start-up (defaults: rank 0 of 1, Level::info).
+void configure(int rank, int n_ranks, Level level);
+Level level();
+int rank();
+
+void write_info(const std::string& message);
+void write_warn(const std::string& message);
+void write_error(const std::string& message);
+void write_debug(const std::string& message);
+
+template <class... Args>
+void info(fmt::format_string<Args...> f, Args&&... args) {
+    if (level() >= Level::info && rank() == 0)
+        write_info(fmt::format(f, std::forward<Args>(args)...));
+}
+template <class... Args>
+void debug(fmt::format_string<Args...> f, Args&&... args) {
+    if (level() >= Level::debug) write_debug(fmt::format(f, std::forward<Args>(args)...));
+}
+template <class... Args>
+void warn(fmt::format_string<Args...> f, Args&&... args) {
+    if (level() >= Level::warn) write_warn(fmt::format(f, std::forward<Args>(args)...));
+}
+template <class... Args>
+void error(fmt::format_string<Args...> f, Args&&... args) {
+    write_error(fmt::format(f, std::forward<Args>(args)...));
+}
+
+}  // namespace efdem::log
