@@ -1,0 +1,48 @@
+#pragma once
+/// \file
+/// Domain: the box of one realization. Periodic in x and y with lengths lx, ly; a flat floor
+/// (the gas distributor) at z = 0; optionally a reflecting lid at z = lid_height.
+///
+/// Positions are wrapped into [0, lx) x [0, ly) only when the neighbour list is rebuilt; between
+/// rebuilds a particle may sit slightly outside (by less than half the skin), as in LAMMPS.
+
+#include <cmath>
+#include <limits>
+
+#include "core/vec3.hpp"
+
+namespace efdem {
+class Params;
+}
+
+namespace efdem::dem {
+
+struct Domain {
+    double lx = 1.0;  ///< periodic length in x [d_p]
+    double ly = 1.0;  ///< periodic length in y [d_p]
+    double lid_height = std::numeric_limits<double>::infinity();  ///< z of the lid, or +inf
+
+    bool has_lid() const { return std::isfinite(lid_height); }
+    double area() const { return lx * ly; }
+
+    /// Maps a position into [0, lx) x [0, ly); z is unchanged.
+    Vec3 wrap(Vec3 p) const {
+        p.x -= lx * std::floor(p.x / lx);
+        p.y -= ly * std::floor(p.y / ly);
+        // floor() of a value just below 0 can produce exactly lx; keep the half-open interval.
+        if (p.x >= lx) p.x -= lx;
+        if (p.y >= ly) p.y -= ly;
+        return p;
+    }
+    /// The periodic image of a separation vector with |dx| <= lx/2, |dy| <= ly/2.
+    Vec3 minimum_image(Vec3 d) const {
+        d.x -= lx * std::nearbyint(d.x / lx);
+        d.y -= ly * std::nearbyint(d.y / ly);
+        return d;
+    }
+
+    /// Reads `domain.lx`, `domain.ly` (required, > 0) and `domain.lid` (optional height > 0).
+    static Domain from_params(const Params& scope);
+};
+
+}  // namespace efdem::dem

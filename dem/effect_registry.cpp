@@ -1,0 +1,34 @@
+#include "dem/effect_registry.hpp"
+
+#include "dem/effects/gravity.hpp"
+#include "dem/effects/pair_contact.hpp"
+#include "dem/effects/viscous_damping.hpp"
+#include "dem/effects/wall_contact.hpp"
+
+namespace efdem::dem {
+
+namespace {
+template <class T>
+std::unique_ptr<Effect> make(const EffectSetup& s) {
+    return std::make_unique<T>(s);
+}
+
+// THE table of effects. One row per effect: name (as written in `effects = ...`), factory,
+// one-line summary (printed by `efdem --list-effects`).
+const EffectRegistry::Entry kEffects[] = {
+    {"gravity", &make<Gravity>, "uniform body force -m g e_z"},
+    {"pair_contact", &make<PairContact>,
+     "soft-sphere particle-particle contact (hooke|hertz, restitution|gamma, history|none)"},
+    {"wall_contact", &make<WallContact>,
+     "soft-sphere contact with the floor z = 0 (and the lid, if any); same sub-models"},
+    {"viscous_damping", &make<ViscousDamping>,
+     "F = -gamma m v toward rest; for settling beds, not a physical effect of the bed"},
+};
+}  // namespace
+
+const EffectRegistry& effect_registry() {
+    static const EffectRegistry registry{kEffects};
+    return registry;
+}
+
+}  // namespace efdem::dem

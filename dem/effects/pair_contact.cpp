@@ -1,0 +1,134 @@
+#include "dem/effects/pair_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "dem/contact_history.hpp"
+#include "dem/contact_report.hpp"
+#include "dem/neighbor_list.hpp"
+
+namespace efdem::dem {
+
+PairContact::PairContact(const EffectSetup& s)
+    : PairContact(ContactSpec::from_params(s.scope, nullptr), s.species) {}
+
+PairContact::PairContact(const ContactSpec& spec, const SpeciesTable& species)
+    : table_(spec, species, ContactTable::Partner::particle), n_species_(species.size()) {}
+
+Needs PairContact::needs() const {
+    return {.neighbor_list = true,
+            .contact_history = table_.spec().tangential == TangentialModel::history};
+}
+
+template <class Normal, class Tangential>
+void PairContact::loop(ForceContext& ctx) const {
+    Particles& p = ctx.particles;
+    const std::size_t n = p.size();
+    const Vec3* x = p.x().data();
+    const Vec3* v = p.v().data();
+    const Vec3* w = p.omega().data();
+    Vec3* f = p.force().data();
+    Vec3* tq = p.torque().data();
+    const double* rad = p.radius().data();
+    const SpeciesId* sp = p.species().data();
+    const std::uint32_t* off = ctx.neighbors->offsets().data();
+    const NeighborList::Entry* ent = ctx.neighbors->entries().data();
+    const Vec3* shift = ctx.neighbors->shifts();
+    Vec3* hist = nullptr;
+    if constexpr (Tangential::kHistory) hist = ctx.history->pairs().data();
+    const ContactCoeffs* coeffs = &table_(0, 0);
+    const std::size_t ns = n_species_;
+    const double dt = ctx.dt;
+
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 xi = x[i], vi = v[i], wi = w[i];
+        const double ri = rad[i];
+        const ContactCoeffs* ci = coeffs + sp[i] * ns;
+        Vec3 fi{}, ti{};
+        for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+            const NeighborList::Entry e = ent[k];
+            const Index j = NeighborList::neighbor(e);
+            const Vec3 d = xi - x[j] - shift[NeighborList::code(e)];
+            const double rsq = norm2(d);
+            const double radsum = ri + rad[j];
+            if (rsq >= radsum * radsum) {
+                if constexpr (Tangential::kHistory) hist[k] = Vec3{};
+                continue;
+            }
+            const double r = std::sqrt(rsq);
+            const Vec3 nrm = d * (1.0 / r);
+            const ContactForce cf = contact_force<Normal, Tangential>(
+                nrm, radsum - r, vi - v[j], wi * ri + w[j] * rad[j], ci[sp[j]], dt,
+                Tangential::kHistory ? hist + k : nullptr);
+            fi += cf.total;
+            f[j] -= cf.total;
+            if constexpr (Tangential::kHistory) {
+                const Vec3 arm = cross(nrm, cf.tangential);
+                ti -= arm * ri;
+                tq[j] -= arm * rad[j];
+            }
+        }
+        f[i] += fi;
+        tq[i] += ti;
+    }
+}
+
+void PairContact::add_forces(ForceContext& ctx) {
+    const ContactSpec& s = table_.spec();
+    const bool hertz = s.normal == NormalModel::hertz;
+    const bool history = s.tangential == TangentialModel::history;
+    if (!hertz && history) loop<HookeNormal, HistoryTangential>(ctx);
+    else if (!hertz) loop<HookeNormal, NoTangential>(ctx);
+    else if (history) loop<HertzNormal, HistoryTangential>(ctx);
+    else loop<HertzNormal, NoTangential>(ctx);
+}
+
+/// Calls f(i, j, k, d, radsum) for every touching listed pair.
+template <class F>
+static void for_each_touching(const ForceContext& ctx, F&& f) {
+    const Particles& p = ctx.particles;
+    const auto x = p.x();
+    const auto rad = p.radius();
+    const auto off = ctx.neighbors->offsets();
+    const auto ent = ctx.neighbors->entries();
+    const Vec3* shift = ctx.neighbors->shifts();
+    for (std::size_t i = 0; i < p.size(); ++i)
+        for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+            const Index j = NeighborList::neighbor(ent[k]);
+            const Vec3 d = x[i] - x[j] - shift[NeighborList::code(ent[k])];
+            const double radsum = rad[i] + rad[j];
+            if (norm2(d) < radsum * radsum) f(i, j, k, d, radsum);
+        }
+}
+
+double PairContact::potential_energy(const ForceContext& ctx) const {
+    const ContactSpec& s = table_.spec();
+    const auto sp = ctx.particles.species();
+    double e = 0;
+    for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t k, const Vec3& d, double radsum) {
+        const ContactCoeffs& c = table_(sp[i], sp[j]);
+        const double delta = radsum - norm(d);
+        const bool hertz = s.normal == NormalModel::hertz;
+        e += hertz ? HertzNormal::energy(c.kn, delta, c.r_eff) : HookeNormal::energy(c.kn, delta, c.r_eff);
+        if (ctx.history) {
+            const double scale = hertz ? HertzNormal::elastic_scale(delta, c.r_eff) : 1.0;
+            e += 0.5 * scale * c.kt * norm2(ctx.history->pairs()[k]);
+        }
+    });
+    return e;
+}
+
+void PairContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const {
+    for_each_touching(ctx, [&](std::size_t, Index, std::uint32_t, const Vec3& d, double radsum) {
+        ++stats.contacts;
+        stats.max_overlap = std::max(stats.max_overlap, (radsum - norm(d)) / radsum);
+    });
+}
+
+std::string PairContact::time_scale_label() const { return shortest_contact_label(table_); }
+
+void PairContact::describe(EffectReport& r) const { describe_contact_table(table_, r); }
+
+}  // namespace efdem::dem

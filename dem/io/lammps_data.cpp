@@ -1,0 +1,183 @@
+#include "dem/io/lammps_data.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace efdem::dem {
+
+namespace {
+
+/// Line reader over gzip or plain files (zlib reads both transparently).
+class GzLines {
+public:
+    explicit GzLines(const std::filesystem::path& path) : path_(path.string()) {
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec))
+            throw InputError({path_, 0}, "LAMMPS data file not found (bed.file)");
+        file_ = gzopen(path_.c_str(), "rb");
+        if (!file_) throw InputError({path_, 0}, "cannot be opened for reading");
+    }
+    ~GzLines() {
+        if (file_) gzclose(file_);
+    }
+    GzLines(const GzLines&) = delete;
+    GzLines& operator=(const GzLines&) = delete;
+
+    bool next(std::string& line) {
+        line.clear();
+        char buf[4096];
+        while (gzgets(file_, buf, sizeof buf)) {
+            line += buf;
+            if (!line.empty() && line.back() == '\n') break;
+        }
+        int err = 0;
+        gzerror(file_, &err);
+        if (err != Z_OK && err != Z_STREAM_END)
+            throw InputError({path_, line_ + 1}, "is corrupt or truncated (gzip error)");
+        if (line.empty()) return false;
+        ++line_;
+        if (line.back() == '\n') line.pop_back();
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        return true;
+    }
+    int line_number() const { return line_; }
+    const std::string& path() const { return path_; }
+
+private:
+    std::string path_;
+    gzFile file_ = nullptr;
+    int line_ = 0;
+};
+
+std::string strip(const std::string& s) {
+    std::string t = s.substr(0, s.find('#'));
+    const auto b = t.find_first_not_of(" \t");
+    if (b == std::string::npos) return "";
+    const auto e = t.find_last_not_of(" \t");
+    return t.substr(b, e - b + 1);
+}
+
+std::vector<double> numbers(const std::string& line, std::size_t want, const GzLines& in,
+                            const char* what) {
+    std::istringstream ss(line);
+    std::vector<double> out;
+    std::string tok;
+    while (ss >> tok) {
+        try {
+            std::size_t used = 0;
+            out.push_back(std::stod(tok, &used));
+            if (used != tok.size()) throw std::invalid_argument(tok);
+        } catch (const std::exception&) {
+            throw InputError({in.path(), in.line_number()},
+                             fmt::format("'{}' in a {} line is not a number", tok, what));
+        }
+        if (!std::isfinite(out.back()))
+            throw InputError({in.path(), in.line_number()}, fmt::format("non-finite value in a {} line", what));
+    }
+    if (out.size() < want)
+        throw InputError({in.path(), in.line_number()},
+                         fmt::format("a {} line needs at least {} numbers, has {}", what, want, out.size()));
+    return out;
+}
+
+}  // namespace
+
+Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable& species,
+                           const Domain& domain) {
+    GzLines in(file);
+    std::string line;
+    in.next(line);  // the first line is a title
+    long n_atoms = -1;
+    double box[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    bool have_box[3] = {false, false, false};
+    struct Atom {
+        Tag id;
+        SpeciesId type;
+        Vec3 x, v, w;
+    };
+    std::vector<Atom> atoms;
+    std::unordered_map<Tag, std::size_t> index_of;
+    std::string section;
+    while (in.next(line)) {
+        const std::string s = strip(line);
+        if (s.empty()) continue;
+        const bool is_number = std::isdigit(static_cast<unsigned char>(s[0])) || s[0] == '-' || s[0] == '+' || s[0] == '.';
+        if (!is_number) {  // a section keyword
+            section = s.substr(0, s.find_first_of(" \t"));
+            if (section == "Atoms" && line.find("sphere") == std::string::npos && line.find('#') != std::string::npos)
+                throw InputError({in.path(), in.line_number()},
+                                 "the Atoms section is not of atom_style sphere");
+            continue;
+        }
+        if (section.empty()) {  // header
+            if (s.find("atoms") != std::string::npos) n_atoms = std::stol(s);
+            for (int a = 0; a < 3; ++a) {
+                const char* lo = a == 0 ? "xlo" : a == 1 ? "ylo" : "zlo";
+                if (s.find(lo) != std::string::npos) {
+                    const auto v = numbers(s.substr(0, s.find(lo)), 2, in, "box");
+                    box[a][0] = v[0];
+                    box[a][1] = v[1];
+                    have_box[a] = true;
+                }
+            }
+        } else if (section == "Atoms") {
+            const auto v = numbers(s, 7, in, "Atoms");
+            const auto type = static_cast<long>(v[1]);
+            if (type < 1 || type > static_cast<long>(species.size()))
+                throw InputError({in.path(), in.line_number()},
+                                 fmt::format("atom type {} has no species: species.names lists {} species", type, species.size()));
+            const auto sp = static_cast<SpeciesId>(type - 1);
+            const double d = v[2], rho = v[3];
+            if (std::abs(d - species[sp].diameter) > 1e-9 * species[sp].diameter ||
+                std::abs(rho - species[sp].density) > 1e-9 * species[sp].density)
+                throw InputError({in.path(), in.line_number()},
+                                 fmt::format("atom {} of type {} has diameter {} and density {}, but species '{}' has "
+                                             "diameter {} and density {}", static_cast<Tag>(v[0]), type, d, rho,
+                                             species[sp].name, species[sp].diameter, species[sp].density));
+            const auto id = static_cast<Tag>(v[0]);
+            if (index_of.count(id))
+                throw InputError({in.path(), in.line_number()}, fmt::format("atom id {} appears twice", id));
+            index_of.emplace(id, atoms.size());
+            atoms.push_back({id, sp, {v[4], v[5], v[6]}, {}, {}});
+        } else if (section == "Velocities") {
+            const auto v = numbers(s, 7, in, "Velocities");
+            const auto it = index_of.find(static_cast<Tag>(v[0]));
+            if (it == index_of.end())
+                throw InputError({in.path(), in.line_number()}, "velocity of an atom id not in the Atoms section");
+            atoms[it->second].v = {v[1], v[2], v[3]};
+            atoms[it->second].w = {v[4], v[5], v[6]};
+        }
+    }
+    if (n_atoms < 0) throw InputError({in.path(), 0}, "the header does not give the number of atoms");
+    if (static_cast<long>(atoms.size()) != n_atoms)
+        throw InputError({in.path(), 0}, fmt::format("the header announces {} atoms but the Atoms section "
+                                                     "has {} (truncated file?)", n_atoms, atoms.size()));
+    for (int a = 0; a < 2; ++a) {
+        const double want = a == 0 ? domain.lx : domain.ly;
+        if (!have_box[a] || std::abs(box[a][0]) > 1e-12 || std::abs(box[a][1] - want) > 1e-9 * want)
+            throw InputError({in.path(), 0},
+                             fmt::format("the box in {} is [{}, {}], but domain.{} = {} (the box must start at 0)",
+                                         a == 0 ? "x" : "y", box[a][0], box[a][1], a == 0 ? "lx" : "ly", want));
+    }
+    // A deterministic particle order: by id.
+    std::sort(atoms.begin(), atoms.end(), [](const Atom& a, const Atom& b) { return a.id < b.id; });
+    Particles p;
+    p.reserve(atoms.size());
+    for (const auto& a : atoms) {
+        p.add(a.id, domain.wrap(a.x), a.v, a.type, species);
+        p.omega()[p.size() - 1] = a.w;
+    }
+    return p;
+}
+
+}  // namespace efdem::dem

@@ -1,0 +1,98 @@
+#include "dem/scene.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/log.hpp"
+#include "dem/bed_builder.hpp"
+#include "dem/effect_registry.hpp"
+
+namespace efdem::dem {
+
+DemScene DemScene::from_params(const Params& root) {
+    DemScene s;
+    s.dt = root.get<double>("dt", Bounds::positive());
+    s.effect_names = root.get<std::vector<std::string>>("effects");
+    s.domain = Domain::from_params(root.scope("domain"));
+    s.species = SpeciesTable::from_params(root.scope("species"));
+    s.skin = root.scope("neighbor").get_or<double>("skin", 0.1, Bounds::positive());
+    const double cutoff = s.species.max_diameter() + s.skin;
+    if (s.domain.lx < 2 * cutoff)
+        root.scope("domain").fail("lx", fmt::format("is narrower than twice the neighbour cutoff "
+                                                    "(largest diameter + skin = {:g})", cutoff),
+                                  fmt::format(">= {:g}", 2 * cutoff));
+    if (s.domain.ly < 2 * cutoff)
+        root.scope("domain").fail("ly", fmt::format("is narrower than twice the neighbour cutoff "
+                                                    "(largest diameter + skin = {:g})", cutoff),
+                                  fmt::format(">= {:g}", 2 * cutoff));
+    return s;
+}
+
+std::vector<std::unique_ptr<Effect>> make_effects(const DemScene& scene, const Params& root) {
+    const EffectRegistry& registry = effect_registry();
+    std::vector<std::unique_ptr<Effect>> out;
+    for (std::size_t k = 0; k < scene.effect_names.size(); ++k) {
+        const std::string& name = scene.effect_names[k];
+        for (std::size_t j = 0; j < k; ++j)
+            if (scene.effect_names[j] == name)
+                root.fail("effects", "lists '" + name + "' twice", "each effect at most once");
+        const auto* entry = registry.find(name);
+        if (!entry)
+            root.fail("effects", "names an unknown effect '" + name + "'",
+                      "known effects: " + registry.names_joined());
+        const EffectSetup setup{root.scope(name), root, scene.species, scene.domain,
+                                scene.effect_names};
+        out.push_back(entry->make(setup));
+    }
+    return out;
+}
+
+std::string check_time_step(const DemScene& scene, const Params& root,
+                            const std::vector<std::unique_ptr<Effect>>& effects) {
+    const Effect* limiting = nullptr;
+    for (const auto& e : effects)
+        if (!limiting || e->time_scale() < limiting->time_scale()) limiting = e.get();
+    if (!limiting || !std::isfinite(limiting->time_scale())) return {};
+    const double tc = limiting->time_scale();
+    const std::string who = fmt::format("{} {} contacts", limiting->name(), limiting->time_scale_label());
+    if (scene.dt > kRefuseDtFraction * tc)
+        root.fail("dt",
+                  fmt::format("exceeds t_c/5 = {:.4g} for the {} (contact time t_c = {:.4g}); "
+                              "the contacts would not be resolved",
+                              kRefuseDtFraction * tc, who, tc),
+                  fmt::format("dt <= {:.4g}; recommended dt <= t_c/20 = {:.4g}", kRefuseDtFraction * tc,
+                              kWarnDtFraction * tc));
+    if (scene.dt > kWarnDtFraction * tc)
+        return fmt::format("dt = {:g} is t_c/{:.1f} for the {} (t_c = {:.4g}); contacts are resolved "
+                           "with fewer than 20 steps, so restitution and overlaps lose accuracy "
+                           "(recommended dt <= {:.4g})",
+                           scene.dt, tc / scene.dt, who, tc, kWarnDtFraction * tc);
+    return {};
+}
+
+std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::string>& effect_names) {
+    const auto dot = entry.key.find('.');
+    if (dot == std::string::npos) return {};
+    const std::string scope = entry.key.substr(0, dot);
+    if (!effect_registry().find(scope)) return {};
+    for (const auto& n : effect_names)
+        if (n == scope) return {};
+    return fmt::format("is '{}' listed in 'effects'?", scope);
+}
+
+System build_system(const Params& root, const RealizationSpec& spec) {
+    DemScene scene = DemScene::from_params(root);
+    auto effects = make_effects(scene, root);
+    const std::string warning = check_time_step(scene, root, effects);
+    if (!warning.empty() && spec.realization == 0) log::warn("{}", warning);
+    const BedSpec bed = BedSpec::from_params(root.scope("bed"), scene);
+    Particles particles = build_bed(bed, scene, root, spec);
+    SystemOptions options;
+    options.dt = scene.dt;
+    options.skin = scene.skin;
+    options.realization = spec.realization;
+    return System(scene.species, scene.domain, std::move(particles), std::move(effects), options);
+}
+
+}  // namespace efdem::dem

@@ -1,0 +1,112 @@
+// The LAMMPS write_data reader on the reference bed (tests/data/packed_bed_12500.data.gz) and on
+// broken files.
+#include <catch2/catch.hpp>
+
+#include <zlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "dem/io/lammps_data.hpp"
+#include "tests/support/dem_fixtures.hpp"
+
+using namespace efdem;
+using namespace efdem::dem;
+
+namespace {
+const std::filesystem::path kBed = std::filesystem::path(EFDEM_TEST_DATA_DIR) / "packed_bed_12500.data.gz";
+
+std::filesystem::path write_text(const std::string& name, const std::string& text) {
+    const auto path = std::filesystem::temp_directory_path() / name;
+    std::ofstream(path) << text;
+    return path;
+}
+
+std::string read_gz(const std::filesystem::path& path) {
+    gzFile f = gzopen(path.string().c_str(), "rb");
+    std::string out;
+    char buf[1 << 16];
+    int n;
+    while ((n = gzread(f, buf, sizeof buf)) > 0) out.append(buf, static_cast<std::size_t>(n));
+    gzclose(f);
+    return out;
+}
+}  // namespace
+
+TEST_CASE("the reference bed loads: 12,500 spheres, 6,250 of each species, the recorded heights",
+          "[unit][io]") {
+    const Particles p = read_lammps_data(kBed, test::binary_species(), Domain{15, 15, 150});
+    REQUIRE(p.size() == 12500);
+    double mean_z[2] = {0, 0};
+    long count[2] = {0, 0};
+    double top = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        mean_z[p.species()[i]] += p.x()[i].z;
+        ++count[p.species()[i]];
+        top = std::max(top, p.x()[i].z);
+        REQUIRE(p.x()[i].x >= 0);
+        REQUIRE(p.x()[i].x < 15);
+    }
+    CHECK(count[0] == 6250);
+    CHECK(count[1] == 6250);
+    // lammps_reference.md: mean height 23.869 (light), 23.875 (heavy), top particle at 48.04.
+    CHECK(mean_z[0] / 6250 == Approx(23.869).margin(5e-4));
+    CHECK(mean_z[1] / 6250 == Approx(23.875).margin(5e-4));
+    CHECK(top == Approx(48.04).margin(0.01));
+    CHECK(p.tag()[0] == 1);  // sorted by id
+}
+
+TEST_CASE("broken LAMMPS data files are input errors naming the file and the line", "[unit][io]") {
+    const auto species = test::binary_species();
+    const std::string header =
+        "title\n\n3 atoms\n2 atom types\n\n0 4 xlo xhi\n0 4 ylo yhi\n0 10 zlo zhi\n\nAtoms # sphere\n\n";
+    auto error_of = [&](const std::filesystem::path& path, const Domain& d) -> InputError {
+        try {
+            read_lammps_data(path, species, d);
+        } catch (const InputError& e) {
+            return e;
+        }
+        FAIL("expected an InputError");
+        throw std::logic_error("unreachable");
+    };
+    const Domain d{4, 4};
+    SECTION("missing file") {
+        CHECK(error_of("/nonexistent/bed.data", d).problem().find("not found") != std::string::npos);
+    }
+    SECTION("truncated: fewer atoms than announced") {
+        const auto f = write_text("efdem_trunc.data", header + "1 1 1 1 0.5 0.5 0.5\n2 2 1 2 1.5 0.5 0.5\n");
+        CHECK(error_of(f, d).problem().find("announces 3 atoms") != std::string::npos);
+    }
+    SECTION("a non-number") {
+        const auto f = write_text("efdem_nan.data", header + "1 1 1 1 0.5 0.5 x\n");
+        const auto e = error_of(f, d);
+        CHECK(e.where().line == 12);
+        CHECK(e.problem().find("'x'") != std::string::npos);
+    }
+    SECTION("a type with no species") {
+        const auto f = write_text("efdem_type.data", header + "1 3 1 1 0.5 0.5 0.5\n");
+        CHECK(error_of(f, d).problem().find("atom type 3 has no species") != std::string::npos);
+    }
+    SECTION("density that does not match the scene's species") {
+        const auto f = write_text("efdem_rho.data", header + "1 2 1 3 0.5 0.5 0.5\n");
+        CHECK(error_of(f, d).problem().find("species 'heavy'") != std::string::npos);
+    }
+    SECTION("box that does not match the domain") {
+        const auto f = write_text("efdem_box.data", header + "1 1 1 1 0.5 0.5 0.5\n2 1 1 1 1.5 0.5 0.5\n3 1 1 1 2.5 0.5 0.5\n");
+        const auto e = error_of(f, Domain{5, 4});
+        INFO(e.what());
+        CHECK(e.problem().find("domain.lx = 5") != std::string::npos);
+    }
+    SECTION("a gzip stream cut in the middle") {
+        const std::string whole = read_gz(kBed);
+        const auto path = std::filesystem::temp_directory_path() / "efdem_cut.data.gz";
+        gzFile g = gzopen(path.string().c_str(), "wb");
+        gzwrite(g, whole.data(), static_cast<unsigned>(whole.size()));
+        gzclose(g);
+        const auto size = std::filesystem::file_size(path);
+        std::filesystem::resize_file(path, size / 2);
+        const auto e = error_of(path, Domain{15, 15, 150});
+        CHECK(e.where().file == path.string());
+    }
+}

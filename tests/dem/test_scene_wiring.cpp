@@ -1,0 +1,147 @@
+// Scene -> effects wiring: "simulate only the effects a scene calls for". A scene builds only
+// what its effects need; unknown effects, too-large time steps and keys for unlisted effects are
+// input errors with clear messages.
+#include <catch2/catch.hpp>
+
+#include "dem/effect_registry.hpp"
+#include "dem/scene.hpp"
+#include "tests/support/dem_fixtures.hpp"
+
+using namespace efdem;
+using namespace efdem::dem;
+
+namespace {
+const char* kBase =
+    "dt = 1e-4\n"
+    "domain.lx = 4\n"
+    "domain.ly = 4\n"
+    "species.names = light heavy\n"
+    "species.density = 1 2\n"
+    "species.diameter = 1 1\n"
+    "bed.count = 20 20\n"
+    "bed.settle = false\n"
+    "pair_contact.kn = 2e5\n"
+    "pair_contact.restitution = 0.9\n"
+    "pair_contact.mu = 0.1\n";
+
+System build(ParamTable& t) { return build_system(t.root(), {1, 0}); }
+
+template <class F>
+InputError input_error(F&& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e;
+    }
+    FAIL("expected an InputError");
+    throw std::logic_error("unreachable");
+}
+}  // namespace
+
+TEST_CASE("a frictionless scene allocates no contact history; no contact effect, no list",
+          "[unit][effects]") {
+    SECTION("tangential = none: neighbour list but no history") {
+        auto t = test::scene_table(std::string(kBase) +
+                                   "effects = gravity pair_contact wall_contact\n"
+                                   "pair_contact.tangential = none\n");
+        System s = build(t);
+        CHECK(s.neighbor_list() != nullptr);
+        CHECK(s.contact_history() == nullptr);
+        CHECK_FALSE(s.needs().contact_history);
+        CHECK(s.slab_fields() == nullptr);  // no effect reads slab fields
+    }
+    SECTION("tangential = history: history allocated") {
+        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        System s = build(t);
+        CHECK(s.contact_history() != nullptr);
+    }
+    SECTION("gravity alone: no neighbour list, no history") {
+        auto t = test::scene_table(
+            "dt = 1e-4\ndomain.lx = 4\ndomain.ly = 4\nspecies.names = a\nspecies.density = 1\n"
+            "species.diameter = 1\nbed.count = 5\nbed.settle = false\neffects = gravity\n");
+        System s = build(t);
+        CHECK(s.neighbor_list() == nullptr);
+        CHECK(s.contact_history() == nullptr);
+        CHECK(s.effects().size() == 1);
+    }
+}
+
+TEST_CASE("effects are applied in the listed order and each is built once", "[unit][effects]") {
+    auto t = test::scene_table(std::string(kBase) + "effects = wall_contact gravity pair_contact\n");
+    System s = build(t);
+    REQUIRE(s.effects().size() == 3);
+    CHECK(s.effects()[0]->name() == "wall_contact");
+    CHECK(s.effects()[1]->name() == "gravity");
+    CHECK(s.effects()[2]->name() == "pair_contact");
+}
+
+TEST_CASE("an unknown effect is an input error that lists the known effects", "[unit][effects]") {
+    auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contatc\n");
+    const auto e = input_error([&] { build(t); });
+    CHECK(e.key() == "effects");
+    CHECK(e.problem() == "names an unknown effect 'pair_contatc'");
+    CHECK(e.allowed() == "known effects: " + effect_registry().names_joined());
+    CHECK(e.where().line > 0);
+}
+
+TEST_CASE("keys of an effect that is not listed are reported with a hint", "[unit][effects]") {
+    auto t = test::scene_table(std::string(kBase) + "effects = gravity\nwall_contact.kn = 1e5\n");
+    System s = build(t);
+    const auto e = input_error([&] {
+        t.check_all_used([&](const ParamEntry& entry) {
+            return unused_key_hint(entry, {"gravity"});
+        });
+    });
+    // pair_contact.* comes first in the file.
+    CHECK(e.key() == "pair_contact.kn");
+    CHECK(e.problem().find("is 'pair_contact' listed in 'effects'?") != std::string::npos);
+}
+
+TEST_CASE("dt > t_c/5 is refused with the computed limit; t_c/20 < dt warns", "[unit][effects]") {
+    // Shortest contact: light-light, t_c = 3.596e-3 (physics.md §5.2): limit 7.19e-4.
+    SECTION("refused") {
+        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        t.add_override("dt=8e-4");
+        const auto e = input_error([&] { build(t); });
+        INFO(e.what());
+        CHECK(e.key() == "dt");
+        CHECK(e.problem().find("exceeds t_c/5 = 0.0007193") != std::string::npos);
+        CHECK(e.problem().find("light-light") != std::string::npos);
+        CHECK(e.allowed().find("dt <= 0.0007193") != std::string::npos);
+    }
+    SECTION("warning band") {
+        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        t.add_override("dt=3e-4");
+        const DemScene scene = DemScene::from_params(t.root());
+        const auto effects = make_effects(scene, t.root());
+        const std::string w = check_time_step(scene, t.root(), effects);
+        CHECK(w.find("t_c/12.0") != std::string::npos);
+    }
+    SECTION("stiff contacts scale the limit") {
+        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        t.add_override("pair_contact.kn=2e7");  // t_c shrinks by 10: 3.596e-4
+        const auto e = input_error([&] { build(t); });
+        INFO(e.what());
+        CHECK(e.problem().find("exceeds t_c/5 = 7.193e-05") != std::string::npos);
+    }
+}
+
+TEST_CASE("wall_contact falls back to pair_contact's keys, and can override them",
+          "[unit][effects]") {
+    auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n"
+                                                    "wall_contact.restitution = 0.5\n");
+    System s = build(t);
+    const auto* wall = dynamic_cast<const WallContact*>(s.find_effect("wall_contact"));
+    REQUIRE(wall != nullptr);
+    CHECK(wall->table().spec().kn == 2e5);
+    CHECK(wall->table().spec().restitution == 0.5);
+    CHECK(wall->table().spec().mu == 0.1);
+    CHECK_NOTHROW(t.check_all_used());
+}
+
+TEST_CASE("hertz with LAMMPS' single gamma_n is refused", "[unit][effects]") {
+    auto t = test::scene_table(std::string(kBase) + "effects = pair_contact\npair_contact.normal = hertz\n"
+                                                    "pair_contact.damping = gamma\n");
+    const auto e = input_error([&] { build(t); });
+    CHECK(e.key() == "pair_contact.damping");
+}

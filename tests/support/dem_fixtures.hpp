@@ -1,0 +1,70 @@
+#pragma once
+// Small builders for DEM tests: systems made programmatically (exact initial states) and from
+// scene text (the real input path).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/param_table.hpp"
+#include "dem/contact_model.hpp"
+#include "dem/effects/gravity.hpp"
+#include "dem/effects/pair_contact.hpp"
+#include "dem/effects/wall_contact.hpp"
+#include "dem/scene.hpp"
+#include "dem/system.hpp"
+
+namespace efdem::test {
+
+/// The paper's binary species: light (density 1) and heavy (density 2), both of diameter 1.
+inline dem::SpeciesTable binary_species() {
+    return dem::SpeciesTable({{"light", 1.0, 1.0}, {"heavy", 2.0, 1.0}});
+}
+
+/// The paper's contact model (physics.md §5): hooke, kn = 2e5, e = 0.9, kt = 2/7 kn, mu = 0.1.
+inline dem::ContactSpec paper_contact(dem::DampingModel damping = dem::DampingModel::restitution,
+                                      dem::TangentialModel tangential = dem::TangentialModel::history) {
+    dem::ContactSpec s;
+    s.normal = dem::NormalModel::hooke;
+    s.kn = 2e5;
+    s.damping = damping;
+    s.restitution = 0.9;
+    s.gamma_n = 58.5928;  // LAMMPS reference bed: e = 0.9 for a light-light pair
+    s.tangential = tangential;
+    s.kt = 2.0 / 7.0 * s.kn;
+    s.tangential_damping = 0.5;
+    s.mu = 0.1;
+    return s;
+}
+
+struct EffectList {
+    std::vector<std::unique_ptr<dem::Effect>> effects;
+    EffectList& pair(const dem::ContactSpec& s, const dem::SpeciesTable& sp) {
+        effects.push_back(std::make_unique<dem::PairContact>(s, sp));
+        return *this;
+    }
+    EffectList& gravity(double g = 1.0) {
+        effects.push_back(std::make_unique<dem::Gravity>(g));
+        return *this;
+    }
+    EffectList& wall(const dem::ContactSpec& s, const dem::SpeciesTable& sp) {
+        effects.push_back(std::make_unique<dem::WallContact>(s, sp));
+        return *this;
+    }
+};
+
+inline dem::System make_system(const dem::SpeciesTable& species, const dem::Domain& domain,
+                               dem::Particles particles, EffectList effects, double dt,
+                               double skin = 0.1) {
+    dem::SystemOptions o;
+    o.dt = dt;
+    o.skin = skin;
+    o.health_check_every = 0;
+    return dem::System(species, domain, std::move(particles), std::move(effects.effects), o);
+}
+
+/// A scene table from text (file name "test.cfg").
+inline ParamTable scene_table(const std::string& text) {
+    return ParamTable::from_text(text, "test.cfg", EFDEM_SOURCE_DIR);
+}
+
+}  // namespace efdem::test
