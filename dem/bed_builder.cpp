@@ -170,7 +170,7 @@ Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& roo
     Particles p;
     if (bed.source == BedSpec::Source::lattice) {
         p = lattice_bed(bed, scene, spec);
-        if (bed.settle) p = settle_bed(std::move(p), bed, scene, root, spec);
+        if (bed.settle && !spec.skip_settling) p = settle_bed(std::move(p), bed, scene, root, spec);
     } else {
         p = read_lammps_data(bed.file, scene.species, scene.domain);
     }

@@ -48,8 +48,9 @@ std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::stri
 
 /// Everything needed to build one realization.
 struct RealizationSpec {
-    std::uint64_t seed = 1;   ///< master seed
-    long realization = 0;     ///< global realization index
+    std::uint64_t seed = 1;       ///< master seed
+    long realization = 0;         ///< global realization index
+    bool skip_settling = false;   ///< read every key but do not run the settling (efdem --check)
 };
 
 /// Builds one realization: effects, initial bed (dem/bed_builder.hpp), System. InputError for

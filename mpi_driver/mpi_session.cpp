@@ -1,0 +1,49 @@
+#include "mpi_driver/mpi_session.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace efdem::mpi_driver {
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+    MPI_Init(argc, argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    // Errors inside MPI calls are reported by the call's return code path of MPI_Abort.
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_ARE_FATAL);
+}
+
+MpiSession::~MpiSession() {
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (!finalized) MPI_Finalize();
+}
+
+std::string MpiSession::launcher_mismatch() const {
+    if (size_ != 1) return {};
+    // Variables that launchers of several MPI implementations and Slurm set per process.
+    for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS",
+                            "SLURM_NTASKS"}) {
+        const char* value = std::getenv(var);
+        if (value && std::atoi(value) > 1)
+            return fmt::format(
+                "efdem was started as one of {} processes ({}={}) but its MPI library sees only "
+                "this one: the launcher (mpirun/srun) belongs to a different MPI than the one "
+                "efdem was built with ({}). Use that MPI's mpirun, or rebuild efdem.",
+                value, var, value, MPI_VERSION == 3 ? "MPI-3" : "MPI");
+    }
+    return {};
+}
+
+void MpiSession::abort(const std::string& message, int exit_code) const {
+    std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", rank_, size_, message.c_str());
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, exit_code);
+    std::exit(exit_code);  // not reached
+}
+
+}  // namespace efdem::mpi_driver

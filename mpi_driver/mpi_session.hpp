@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// MpiSession: MPI start-up and shut-down as an object (RAII, like Kokkos::ScopeGuard), and the
+/// two ways a run ends early.
+///
+/// * input errors are collective: every rank parsed the same text and fails the same way, so all
+///   ranks return kExitInputError together (the root prints the message once);
+/// * a failure seen by one rank while running (RuntimeFailure) is printed with the rank and
+///   realization named, then MPI_Abort ends every rank: no rank waits forever in a collective.
+
+#include <mpi.h>
+
+#include <string>
+
+namespace efdem::mpi_driver {
+
+class MpiSession {
+public:
+    MpiSession(int* argc, char*** argv);
+    ~MpiSession();
+    MpiSession(const MpiSession&) = delete;
+    MpiSession& operator=(const MpiSession&) = delete;
+
+    MPI_Comm comm() const { return MPI_COMM_WORLD; }
+    int rank() const { return rank_; }
+    int size() const { return size_; }
+    bool is_root() const { return rank_ == 0; }
+
+    /// If a process launcher (mpirun, srun) started several processes but this MPI library
+    /// sees only one, the launcher belongs to another MPI: returns a message saying so.
+    std::string launcher_mismatch() const;
+
+    /// Prints `message` (naming this rank) and aborts every rank with `exit_code`.
+    [[noreturn]] void abort(const std::string& message, int exit_code) const;
+
+private:
+    int rank_ = 0;
+    int size_ = 1;
+};
+
+}  // namespace efdem::mpi_driver
