@@ -93,17 +93,19 @@ PeriodEstimate estimate_period(std::span<const double> t, std::span<const double
     auto spacing = [](const std::vector<double>& c) {
         return (c.back() - c.front()) / static_cast<double>(c.size() - 1);
     };
+    // Each pass needs two periods for a meaningful harmonic fit. If a pass finds fewer
+    // crossings, the extra one came from the biased trend: keep the pass's answer (too few
+    // periods) rather than the biased estimate.
     const auto n_coefficients = static_cast<std::size_t>(2 + 4 * settings.harmonics);
     for (int pass = 0;
          pass < settings.refinements && est.crossings.size() >= 3 && t.size() > 2 * n_coefficients;
          ++pass) {
         const double period = spacing(est.crossings);
-        auto refined = upward_crossings(
+        est.crossings = upward_crossings(
             t, signal, harmonic_trend(t, signal, period, settings.harmonics), settings.hysteresis);
-        if (refined.size() < 3) break;
-        const bool converged = std::abs(spacing(refined) - period) <= 1e-14 * period;
-        est.crossings = std::move(refined);
-        if (converged) break;
+        if (est.crossings.size() >= 2 &&
+            std::abs(spacing(est.crossings) - period) <= 1e-14 * period)
+            break;
     }
 
     est.n_periods = est.crossings.empty() ? 0 : static_cast<int>(est.crossings.size()) - 1;

@@ -95,3 +95,26 @@ TEST_CASE("fewer than two periods is reported", "[unit][coarse]") {
         CHECK(std::isnan(est.period));
     }
 }
+
+TEST_CASE("a crossing that only the biased trend line creates is not counted", "[unit][coarse]") {
+    // Window [67.9, 94.9] of sin(2 pi t/10 + 3.144155) + trend: true upward crossings at 75.0
+    // and 85.0, the next at 95.0, just after the end (the signal ends at -0.06, rising). The
+    // least-squares line tilts the residual enough to fake a crossing at 94.63 (T = 9.82); the
+    // refined trend removes it, so the honest answer is one period (and the burst is
+    // lengthened), not a 2 % wrong period.
+    Signal sig;
+    for (int i = 0; i <= 270; ++i) {
+        const double t = 67.9 + 0.1 * i;
+        sig.t.push_back(t);
+        sig.s.push_back(3.0 + 0.05 * t + std::sin(2 * kPi * t / 10.0 + 3.144155));
+    }
+    PeriodSettings plain;
+    plain.refinements = 0;
+    CHECK(estimate_period(sig.t, sig.s, plain).n_periods == 2);  // the trap is real
+    const PeriodEstimate est = estimate_period(sig.t, sig.s);
+    CHECK(est.status == PeriodStatus::too_few_periods);
+    CHECK(est.n_periods == 1);
+    // One refinement pass from a 2 % wrong period leaves a trend error of second order,
+    // (0.02)^2 ~ 4e-4, in this single spacing.
+    CHECK(est.period == Approx(10.0).epsilon(1e-3));
+}

@@ -1,0 +1,62 @@
+#pragma once
+/// \file
+/// The micro model as the projective integrator sees it: a coarse time-stepper that can run a
+/// burst, restricting as it goes, and lift a coarse vector back to the micro level
+/// (physics.md §10 steps i-v; EquationFreeGit's burst/restrict/lift seams). The integrator
+/// never sees particles: an ensemble of DEM realizations and a toy ODE look the same.
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace efdem::coarse {
+
+/// The restricted samples of one burst, in time order.
+struct BurstSamples {
+    /// Sample times [sqrt(d_p/g)], strictly increasing.
+    std::vector<double> t;
+    /// Restricted (ensemble-mean) coarse vector at each time, all of one size (e.g. the light
+    /// ICDF on the p-grid [d_p]).
+    std::vector<Eigen::VectorXd> x;
+    /// A scalar that shows the travelling-wave phase at each time (e.g. the centre-of-mass
+    /// height [d_p]). Needed by the DT = k T integrator; may stay empty otherwise.
+    std::vector<double> phase_signal;
+
+    std::size_t size() const { return t.size(); }
+};
+
+/**
+ * \brief A coarse time-stepper: the micro model behind run / lift / time.
+ *
+ * In an MPI ensemble every call is collective (every rank calls it with the same arguments);
+ * the implementation restricts each realization and reduces to the ensemble mean.
+ */
+class CoarseStepper {
+  public:
+    virtual ~CoarseStepper() = default;
+
+    /// Micro clock [sqrt(d_p/g)].
+    virtual double time() const = 0;
+
+    /**
+     * \brief Runs the micro model for `duration` [sqrt(d_p/g)] and appends to `out` one
+     *        restricted sample at the end of each of the stepper's own sampling intervals.
+     *
+     * The stepper alone decides the sampling interval. The last sample must be taken at the
+     * end of the run, i.e. at time() on return: the integrator projects from it. No sample is
+     * taken at the start of the run (right after a lift the state is not yet healed).
+     */
+    virtual void run(double duration, BurstSamples& out) = 0;
+
+    /**
+     * \brief Lifts every realization to the coarse vector `target` and sets the micro clock to
+     *        `new_time` [sqrt(d_p/g)].
+     *
+     * `target` has already been through the integrator's repair hook (monotone, inside the
+     * feasible range, if the caller installed one).
+     */
+    virtual void lift(const Eigen::VectorXd& target, double new_time) = 0;
+};
+
+}  // namespace efdem::coarse
