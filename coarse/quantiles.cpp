@@ -31,14 +31,9 @@ NodeRank node_rank(const ProbabilityGrid& grid, int i, std::int64_t n) {
 /// Q(p_i) from a sequence in which at least the order statistics node_rank() names are in
 /// their sorted places (a sorted vector, or one prepared by select_order_statistics()).
 Eigen::VectorXd evaluate_nodes(std::span<const double> z, const ProbabilityGrid& grid) {
-    const auto n = static_cast<std::int64_t>(z.size());
-    Eigen::VectorXd q(grid.size());
-    for (int i = 0; i < grid.size(); ++i) {
-        const NodeRank r = node_rank(grid, i, n);
-        const auto k = static_cast<std::size_t>(r.lower);
-        q[i] = r.fraction == 0.0 ? z[k] : z[k] + r.fraction * (z[k + 1] - z[k]);
-    }
-    return q;
+    return quantiles_from_order_statistics(
+        static_cast<std::int64_t>(z.size()), grid,
+        [&](std::int64_t k) { return z[static_cast<std::size_t>(k)]; });
 }
 
 /// Puts the order statistics with the (sorted, unique) ranks `ranks` into their sorted places
@@ -58,6 +53,20 @@ void select_order_statistics(std::vector<double>& v, std::span<const std::int64_
 }
 
 }  // namespace
+
+Eigen::VectorXd quantiles_from_order_statistics(
+    std::int64_t n, const ProbabilityGrid& grid,
+    const std::function<double(std::int64_t)>& order_statistic) {
+    EFDEM_EXPECTS(n >= 1);
+    Eigen::VectorXd q(grid.size());
+    for (int i = 0; i < grid.size(); ++i) {
+        const NodeRank r = node_rank(grid, i, n);
+        const double lower = order_statistic(r.lower);
+        q[i] =
+            r.fraction == 0.0 ? lower : lower + r.fraction * (order_statistic(r.lower + 1) - lower);
+    }
+    return q;
+}
 
 double quantile_sorted(std::span<const double> sorted, double p) {
     EFDEM_EXPECTS(!sorted.empty());

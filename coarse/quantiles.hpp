@@ -8,6 +8,7 @@
 /// Heights are in particle diameters d_p; p is dimensionless.
 
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include <Eigen/Core>
@@ -36,6 +37,19 @@ Eigen::VectorXd quantiles_sorted(std::span<const double> sorted, const Probabili
  * heights exactly. \pre heights non-empty and finite.
  */
 Eigen::VectorXd quantiles(std::span<const double> heights, const ProbabilityGrid& grid);
+
+/**
+ * \brief (Q(p_0), ..., Q(p_{m-1})) of n points given only access to their order statistics:
+ *        `order_statistic(k)` returns the k-th smallest (0-based) and is called only for the
+ *        at most 2 m ranks the nodes need.
+ *
+ * For callers that can find an order statistic faster than by selecting over all n points
+ * (colour lifting knows which interval of heights holds each rank). Same values, bit for bit,
+ * as quantiles_sorted(). \pre n >= 1.
+ */
+Eigen::VectorXd quantiles_from_order_statistics(
+    std::int64_t n, const ProbabilityGrid& grid,
+    const std::function<double(std::int64_t)>& order_statistic);
 
 /**
  * \brief Number of the n sample points that lie strictly below Q(p_i), for distinct points:
