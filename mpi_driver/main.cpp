@@ -1,16 +1,35 @@
 // efdem: wiring only. Parse the command line, read the scene collectively, build this rank's
 // realizations, then hand over to the driver of the chosen mode.
+#include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
+#include <memory>
+#include <optional>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "coarse/compact_observable.hpp"
+#include "coarse/ensemble_observable.hpp"
+#include "coarse/probability_grid.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/version.hpp"
 #include "dem/effect_registry.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/check_report.hpp"
+#include "mpi_driver/csv_recorder.hpp"
+#include "mpi_driver/dem_realization.hpp"
+#include "mpi_driver/driver.hpp"
+#include "mpi_driver/ensemble_layout.hpp"
+#include "mpi_driver/ensemble_stepper.hpp"
+#if EFDEM_HAVE_HDF5
+#include "mpi_driver/hdf5_recorder.hpp"
+#endif
 #include "mpi_driver/mpi_broadcast.hpp"
 #include "mpi_driver/mpi_session.hpp"
+#include "mpi_driver/recorder_list.hpp"
 #include "mpi_driver/run_options.hpp"
 #include "mpi_driver/run_settings.hpp"
 #include "mpi_driver/scene_input.hpp"
@@ -19,6 +38,87 @@ using namespace efdem;
 using namespace efdem::mpi_driver;
 
 namespace {
+RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
+                         const dem::System& any) {
+    RunProvenance p;
+    p.scene_file = table.file();
+    p.scene_text = table.text();
+    p.overrides = fmt::format("{}", fmt::join(table.overrides(), " "));
+    for (const auto& r : table.resolved()) p.parameters += fmt::format("{} = {}   [{}]\n", r.key, r.value, r.origin);
+    p.mode = s.mode == RunSettings::Mode::cpi ? "cpi" : "direct";
+    p.ranks = mpi.size();
+    p.realizations_per_rank = s.realizations_per_rank;
+    p.realizations = mpi.size() * s.realizations_per_rank;
+    p.seed = s.seed;
+    p.p_grid = coarse::ProbabilityGrid(s.observe.quantiles).values();
+    p.observed_species = any.species()[s.observe.species].name;
+    return p;
+}
+
+/// Runs the scene: the root drives (direct or cpi loop) and records; the other ranks serve.
+int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
+        std::vector<dem::System> systems, InjectedFailure injected) {
+    const RunProvenance prov = provenance(mpi, table, s, systems.front());
+    const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
+    const bool cpi = s.mode == RunSettings::Mode::cpi;
+    coarse::IcdfObservable icdf(s.observe.quantiles);
+    std::unique_ptr<coarse::EnsembleObservable> compact;
+    if (cpi && s.cpi.observable == CpiSettings::Observable::compact)
+        compact = std::make_unique<coarse::CompactObservable>(coarse::ProbabilityGrid(s.observe.quantiles));
+    coarse::EnsembleObservable& observable = compact ? *compact : icdf;
+
+    std::unique_ptr<RecorderList> recorders;
+    std::vector<std::unique_ptr<Realization>> local;
+    try {
+        if (mpi.is_root()) {
+            std::vector<std::unique_ptr<RunRecorder>> owned;
+#if EFDEM_HAVE_HDF5
+            owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory / (s.output.prefix + ".h5"), prov,
+                                                           observable.dimension()));
+#endif
+            owned.push_back(std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov));
+            recorders = std::make_unique<RecorderList>(std::move(owned));
+        }
+        RealizationOutput out{s.output.directory, s.output.prefix,
+                              std::lround(s.output.vtk_interval / s.observe.interval),
+                              std::lround(s.output.thermo_interval / s.observe.interval)};
+        for (auto& sys : systems)
+            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species, s.observe.other, out));
+    } catch (const std::exception& e) {
+        mpi.abort(e.what(), kExitRuntimeFailure);
+    }
+    log::info("efdem {}: {} run of {} on {} ranks x {} = {} realizations ({} particles each), output {}/{}.*",
+              version(), prov.mode, table.file(), mpi.size(), s.realizations_per_rank, prov.realizations,
+              local.front()->particles(), s.output.directory.string(), s.output.prefix);
+
+    StepperSettings ss;
+    ss.sample_interval = s.observe.interval;
+    ss.steps_per_sample = s.observe.steps_per_sample;
+    ss.quantiles = s.observe.quantiles;
+    ss.seed = s.seed;
+    ss.failure = injected;
+    const double t0 = local.front()->time();
+    Progress progress(t0, t0 + s.duration, 2.0);
+    const ColourLifter lifter;
+    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, recorders.get(),
+                            mpi.is_root() ? &progress : nullptr);
+    if (!mpi.is_root()) {
+        stepper.serve();
+        return kExitOk;
+    }
+    RunSummary summary;
+    try {
+        summary = cpi ? run_cpi(stepper, s, icdf, recorders.get(), progress) : run_direct(stepper, s, progress);
+        recorders->finish(summary);
+    } catch (const std::exception& e) {
+        mpi.abort(e.what(), kExitRuntimeFailure);
+    }
+    log::info("{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall, {:.3e} particle-steps",
+              summary.end_status, summary.simulated_time, summary.dem_time,
+              format_duration(summary.wall_seconds), summary.particle_steps);
+    return kExitOk;
+}
+
 void print_effects() {
     std::printf("effects a scene can list (effects = name name ...):\n");
     for (const auto& e : dem::effect_registry().entries())
@@ -66,24 +166,33 @@ int main(int argc, char** argv) {
     std::optional<ParamTable> table;
     std::optional<RunSettings> settings;
     std::vector<dem::System> systems;
+    InjectedFailure injected;
     try {
         table.emplace(read_scene(mpi, options.scene, options.overrides));
         Params root = table->root();
-        settings = RunSettings::from_params(root);
+        const dem::DemScene scene = dem::DemScene::from_params(root);
+        settings = RunSettings::from_params(root, scene);
+        const Params debug = root.scope("debug");
+        injected.realization = debug.get_or<long>("fail_realization", -1);
+        injected.time = debug.get_or<double>("fail_time", 0.0);
         const int k = check ? 1 : settings->realizations_per_rank;
-        const std::vector<std::string> effect_names = root.get<std::vector<std::string>>("effects");
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;
             systems.push_back(dem::build_system(root, {settings->seed, realization, check}));
         }
         table->check_all_used(
-            [&](const ParamEntry& e) { return dem::unused_key_hint(e, effect_names); });
+            [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
+        if (!check) std::filesystem::create_directories(settings->output.directory);
     } catch (const InputError& e) {
         code = kExitInputError;
         message = e.what();
     } catch (const RuntimeFailure& e) {
         code = kExitRuntimeFailure;
         message = e.what();
+    } catch (const std::filesystem::filesystem_error& e) {
+        code = kExitInputError;
+        message = fmt::format("output.directory = '{}' cannot be created: {}",
+                              settings->output.directory.string(), e.code().message());
     } catch (const std::exception& e) {
         code = kExitRuntimeFailure;
         message = std::string("unexpected failure during set-up: ") + e.what();
@@ -98,7 +207,5 @@ int main(int argc, char** argv) {
             std::printf("%s", check_report(*table, *settings, systems.front(), mpi.size()).c_str());
         return kExitOk;
     }
-    if (mpi.is_root())
-        log::error("modes 'direct' and 'cpi' are not available in this build yet; use --check");
-    return kExitInputError;
+    return run(mpi, *table, *settings, std::move(systems), injected);
 }

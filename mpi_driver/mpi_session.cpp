@@ -9,12 +9,23 @@
 
 namespace efdem::mpi_driver {
 
+MpiComm::MpiComm(MPI_Comm comm) : comm_(comm) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &size_);
+}
+
+void MpiComm::abort(const std::string& message, int exit_code) const {
+    std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", rank_, size_, message.c_str());
+    std::fflush(stderr);
+    MPI_Abort(comm_, exit_code);
+    std::exit(exit_code);  // not reached
+}
+
 MpiSession::MpiSession(int* argc, char*** argv) {
     MPI_Init(argc, argv);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-    MPI_Comm_size(MPI_COMM_WORLD, &size_);
-    // Errors inside MPI calls are reported by the call's return code path of MPI_Abort.
+    // A failing MPI call ends the job (the default for MPI_COMM_WORLD, made explicit).
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_ARE_FATAL);
+    world_.emplace(MPI_COMM_WORLD);
 }
 
 MpiSession::~MpiSession() {
@@ -24,7 +35,7 @@ MpiSession::~MpiSession() {
 }
 
 std::string MpiSession::launcher_mismatch() const {
-    if (size_ != 1) return {};
+    if (size() != 1) return {};
     // Variables that launchers of several MPI implementations and Slurm set per process.
     for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS",
                             "SLURM_NTASKS"}) {
@@ -39,11 +50,5 @@ std::string MpiSession::launcher_mismatch() const {
     return {};
 }
 
-void MpiSession::abort(const std::string& message, int exit_code) const {
-    std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", rank_, size_, message.c_str());
-    std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, exit_code);
-    std::exit(exit_code);  // not reached
-}
 
 }  // namespace efdem::mpi_driver

@@ -10,9 +10,27 @@
 
 #include <mpi.h>
 
+#include <optional>
 #include <string>
 
 namespace efdem::mpi_driver {
+
+/// A communicator with its rank and size, and the way a rank-local failure ends the job.
+class MpiComm {
+public:
+    explicit MpiComm(MPI_Comm comm);
+    MPI_Comm comm() const { return comm_; }
+    int rank() const { return rank_; }
+    int size() const { return size_; }
+    bool is_root() const { return rank_ == 0; }
+    /// Prints `message` (naming this rank) and aborts every rank with `exit_code`.
+    [[noreturn]] void abort(const std::string& message, int exit_code) const;
+
+private:
+    MPI_Comm comm_;
+    int rank_ = 0;
+    int size_ = 1;
+};
 
 class MpiSession {
 public:
@@ -22,20 +40,22 @@ public:
     MpiSession& operator=(const MpiSession&) = delete;
 
     MPI_Comm comm() const { return MPI_COMM_WORLD; }
-    int rank() const { return rank_; }
-    int size() const { return size_; }
-    bool is_root() const { return rank_ == 0; }
+    int rank() const { return world_->rank(); }
+    int size() const { return world_->size(); }
+    bool is_root() const { return world_->is_root(); }
+    /// MPI_COMM_WORLD with its rank and size.
+    const MpiComm& world() const { return *world_; }
 
     /// If a process launcher (mpirun, srun) started several processes but this MPI library
     /// sees only one, the launcher belongs to another MPI: returns a message saying so.
     std::string launcher_mismatch() const;
 
-    /// Prints `message` (naming this rank) and aborts every rank with `exit_code`.
-    [[noreturn]] void abort(const std::string& message, int exit_code) const;
+    [[noreturn]] void abort(const std::string& message, int exit_code) const {
+        world_->abort(message, exit_code);
+    }
 
 private:
-    int rank_ = 0;
-    int size_ = 1;
+    std::optional<MpiComm> world_;
 };
 
 }  // namespace efdem::mpi_driver

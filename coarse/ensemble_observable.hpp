@@ -1,0 +1,57 @@
+#pragma once
+/// \file
+/// EnsembleObservable: how the root turns one ensemble sample into the coarse vector X that the
+/// projective integrator sees, and how it turns a projected X back into each realization's
+/// lifting target (the ICDF of the observed species that colour lifting must meet).
+///
+/// Inputs are per-realization ICDFs on the p-grid (R x m matrices, row r = realization r):
+/// `icdf` of the observed species (Q_L) and, when needs_top_half(), `top` of the N/2 highest
+/// particles (Q_top, physics.md §8). Heights in d_p. Generic: no DEM, no MPI.
+
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+namespace efdem::coarse {
+
+class EnsembleObservable {
+public:
+    virtual ~EnsembleObservable() = default;
+    virtual std::string_view name() const = 0;
+    virtual Eigen::Index dimension() const = 0;
+    virtual bool needs_top_half() const = 0;
+    /// X of one sample. May carry state (e.g. a warm start); call once per sample, in time order.
+    /// Returns a vector of NaN when X cannot be formed (the integrator then rejects the burst);
+    /// status() says why.
+    virtual Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) = 0;
+    /// The observed-species ICDF target for one realization, from the projected X and that
+    /// realization's own top-half ICDF (ignored when !needs_top_half()).
+    virtual Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const = 0;
+    /// 0 when the last restrict_ensemble() succeeded; a message otherwise.
+    virtual int status() const { return 0; }
+    virtual std::string status_message() const { return {}; }
+};
+
+/// X = the ensemble-mean ICDF of the observed species (m nodes); every realization is lifted to
+/// X itself (physics.md §9).
+class IcdfObservable final : public EnsembleObservable {
+public:
+    explicit IcdfObservable(Eigen::Index m) : m_(m) {}
+    std::string_view name() const override { return "icdf"; }
+    Eigen::Index dimension() const override { return m_; }
+    bool needs_top_half() const override { return false; }
+    Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) override;
+    Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const override;
+
+private:
+    Eigen::Index m_;
+};
+
+/// Column means of an R x m matrix, summed in realization order (so the result does not depend
+/// on how the rows were produced). \pre R >= 1.
+Eigen::VectorXd ensemble_mean(const Eigen::MatrixXd& rows);
+/// Unbiased column variances (divisor R - 1; zeros when R = 1).
+Eigen::VectorXd ensemble_variance(const Eigen::MatrixXd& rows, const Eigen::VectorXd& mean);
+
+}  // namespace efdem::coarse

@@ -1,0 +1,133 @@
+#include "mpi_driver/driver.hpp"
+
+#include <cmath>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "coarse/monotone_repair.hpp"
+#include "coarse/period_projective_euler.hpp"
+#include "coarse/projective_forward_euler.hpp"
+#include "core/log.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+constexpr double kTimeTolerance = 1e-9;
+
+/// Consecutive outer steps without a jump after which a cpi run stops (the run would silently
+/// have become a direct run).
+constexpr int kMaxStepsWithoutProgress = 3;
+
+std::unique_ptr<coarse::ProjectiveIntegrator> make_integrator(const RunSettings& s, coarse::RepairHook hook) {
+    const CpiSettings& c = s.cpi;
+    if (c.projection == CpiSettings::Projection::fixed) {
+        coarse::ProjectiveEulerSettings e;
+        e.healing = c.healing;
+        e.window = c.window;
+        e.dt = c.dt;
+        e.stability_policy = c.stability;
+        return std::make_unique<coarse::ProjectiveForwardEuler>(e, std::move(hook));
+    }
+    coarse::PeriodProjectiveEulerSettings e;
+    e.healing = c.healing;
+    e.window = c.window;
+    e.periods_per_step = c.periods;
+    e.max_extension = c.max_extension;
+    // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
+    e.extension_step = std::max(1.0, std::round(5.0 / s.observe.interval)) * s.observe.interval;
+    e.stability_policy = c.stability;
+    return std::make_unique<coarse::PeriodProjectiveEuler>(e, std::move(hook));
+}
+
+std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const LiftRecord& lift) {
+    long changed = 0;
+    for (long c : lift.changed) changed += c;
+    std::string s = fmt::format("coarse step {}: burst {:.4g}..{:.4g}", n, r.t_start, r.t_end);
+    if (std::isfinite(r.period)) s += fmt::format(", period T = {:.4g}", r.period);
+    s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
+    if (r.lifted) s += fmt::format(", {} labels changed", changed);
+    if (r.repair.changed()) s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
+    if (!r.message.empty()) s += " [" + r.message + "]";
+    return s;
+}
+}  // namespace
+
+RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress) {
+    const double t_end = stepper.time() + s.duration;
+    long remaining = std::lround(s.duration / s.observe.interval);
+    // Chunks of about 10 time units keep the burst buffer small; sampling is unaffected.
+    const long chunk = std::max(1L, std::lround(10.0 / s.observe.interval));
+    coarse::BurstSamples scratch;
+    while (remaining > 0) {
+        const long n = std::min(chunk, remaining);
+        scratch = {};
+        stepper.run(static_cast<double>(n) * s.observe.interval, scratch);
+        remaining -= n;
+    }
+    stepper.finish();
+    progress.update(stepper.time(), stepper.particle_steps(), "done", true);
+    RunSummary sum;
+    sum.simulated_time = s.duration;
+    sum.dem_time = stepper.micro_time();
+    sum.wall_seconds = progress.elapsed_seconds();
+    sum.particle_steps = stepper.particle_steps();
+    sum.end_status = std::abs(stepper.time() - t_end) < 1e-6 * std::max(1.0, t_end) ? "completed" : "incomplete";
+    return sum;
+}
+
+RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::EnsembleObservable& fallback,
+                   RunRecorder* recorder, Progress& progress) {
+    const double t_start = stepper.time();
+    const double t_end = t_start + s.duration;
+    const bool compact = s.cpi.observable == CpiSettings::Observable::compact;
+    // ICDF targets are made non-decreasing and clipped into the heights the particles occupy
+    // before lifting (physics.md §9 step 1); each repair is recorded with its step.
+    coarse::RepairHook icdf_repair = [&stepper](Eigen::VectorXd& x) {
+        const auto [lo, hi] = stepper.height_range();
+        return coarse::repair_monotone(x, lo, hi);
+    };
+    auto integrator = make_integrator(s, compact ? coarse::RepairHook{} : icdf_repair);
+    bool fell_back = false;
+    RunSummary sum;
+    sum.end_status = "completed";
+    int without_progress = 0;
+    while (stepper.time() < t_end - kTimeTolerance * std::max(1.0, t_end)) {
+        const coarse::ProjectiveStepRecord rec = integrator->step(stepper);
+        ++sum.coarse_steps;
+        const LiftRecord lift = rec.lifted ? stepper.last_lift() : LiftRecord{};
+        if (recorder) recorder->coarse_step(rec, lift);
+        log::info("{}", describe_step(sum.coarse_steps, rec, lift));
+        progress.update(stepper.time(), stepper.particle_steps(), "", true);
+        if (rec.advanced()) {
+            without_progress = 0;
+            continue;
+        }
+        if (compact && !fell_back && rec.status == coarse::StepStatus::invalid_burst) {
+            // The compact fit failed (y = 0 at full demixing, or no convergence): continue with
+            // the full ICDF, which is always defined.
+            log::warn("the compact (A,B,C,D) observable failed ({}); continuing with the full ICDF "
+                      "as the coarse variable", rec.message);
+            stepper.set_observable(fallback);
+            integrator = make_integrator(s, icdf_repair);
+            fell_back = true;
+            continue;
+        }
+        if (rec.status == coarse::StepStatus::stopped_unstable ||
+            ++without_progress >= kMaxStepsWithoutProgress) {
+            sum.end_status = fmt::format("stopped at t = {:.6g}: {} ({})", stepper.time(),
+                                         coarse::to_string(rec.status), rec.message);
+            log::warn("cpi run {}", sum.end_status);
+            break;
+        }
+    }
+    stepper.finish();
+    sum.simulated_time = stepper.time() - t_start;
+    sum.dem_time = stepper.micro_time();
+    sum.wall_seconds = progress.elapsed_seconds();
+    sum.particle_steps = stepper.particle_steps();
+    if (fell_back && sum.end_status == "completed") sum.end_status = "completed (compact observable fell back to icdf)";
+    return sum;
+}
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,173 @@
+#include "mpi_driver/ensemble_stepper.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/contracts.hpp"
+#include "core/error.hpp"
+
+namespace efdem::mpi_driver {
+
+EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, std::vector<std::unique_ptr<Realization>> local,
+                                 const StepperSettings& settings, coarse::EnsembleObservable& observable,
+                                 const Lifter& lifter, RunRecorder* recorder, Progress* progress)
+    : layout_(layout), local_(std::move(local)), settings_(settings), observable_(&observable),
+      lifter_(lifter), recorder_(recorder), progress_(progress), grid_(settings.quantiles) {
+    EFDEM_EXPECTS(static_cast<int>(local_.size()) == layout.per_rank());
+    if (layout_.is_root())
+        for (int r = 0; r < layout_.size(); ++r)
+            lifting_.emplace_back(settings.seed, static_cast<std::uint64_t>(r), "lifting");
+    long n = 0;
+    for (const auto& r : local_) n += r->particles();
+    total_particles_ = static_cast<double>(layout_.sum(n));
+}
+
+double EnsembleStepper::time() const { return local_.front()->time(); }
+
+void EnsembleStepper::fail(const std::string& message, long realization) const {
+    layout_.mpi().abort(fmt::format("realization {}: {}", realization, message), kExitRuntimeFailure);
+}
+
+void EnsembleStepper::broadcast_command(Command& c, double& value) const {
+    double buf[2] = {static_cast<double>(static_cast<int>(c)), value};
+    MPI_Bcast(buf, 2, MPI_DOUBLE, 0, layout_.mpi().comm());
+    c = static_cast<Command>(static_cast<int>(buf[0]));
+    value = buf[1];
+}
+
+void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
+    Command c = Command::run;
+    double d = duration;
+    broadcast_command(c, d);
+    do_run(std::lround(duration / settings_.sample_interval), &out);
+}
+
+void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
+    Command c = Command::lift;
+    double t = new_time;
+    broadcast_command(c, t);
+    do_lift(new_time, &target);
+}
+
+void EnsembleStepper::finish() {
+    Command c = Command::finish;
+    double unused = 0;
+    broadcast_command(c, unused);
+}
+
+void EnsembleStepper::serve() {
+    while (true) {
+        Command c = Command::finish;
+        double value = 0;
+        broadcast_command(c, value);
+        switch (c) {
+            case Command::run: do_run(std::lround(value / settings_.sample_interval), nullptr); break;
+            case Command::lift: do_lift(value, nullptr); break;
+            case Command::finish: return;
+        }
+    }
+}
+
+void EnsembleStepper::do_run(long samples, coarse::BurstSamples* out) {
+    const InjectedFailure& inject = settings_.failure;
+    for (long s = 0; s < samples; ++s) {
+        for (auto& r : local_) {
+            try {
+                r->advance(settings_.steps_per_sample);
+                if (r->index() == inject.realization && r->time() >= inject.time)
+                    throw RuntimeFailure("injected failure (debug.fail_realization)", r->index());
+            } catch (const std::exception& e) {
+                fail(e.what(), r->index());
+            }
+        }
+        micro_time_ += static_cast<double>(settings_.steps_per_sample) * local_.front()->dt();
+        particle_steps_ += static_cast<double>(settings_.steps_per_sample) * total_particles_;
+        take_sample(out);
+        ++samples_taken_;
+        for (auto& r : local_) {
+            try {
+                r->after_sample(samples_taken_);
+            } catch (const std::exception& e) {
+                fail(e.what(), r->index());
+            }
+        }
+    }
+}
+
+void EnsembleStepper::take_sample(coarse::BurstSamples* out) {
+    const bool top = observable_->needs_top_half();
+    std::vector<Eigen::VectorXd> icdf, top_icdf, scalars;
+    for (const auto& r : local_) {
+        Observation o = r->observe(grid_, top);
+        icdf.push_back(std::move(o.icdf));
+        if (top) top_icdf.push_back(std::move(o.top));
+        scalars.push_back(Eigen::Vector3d(o.com, o.z_min, o.z_max));
+    }
+    const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
+    const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+    const Eigen::MatrixXd all_scalars = layout_.gather_rows(scalars);
+    if (!layout_.is_root()) return;
+
+    SampleRecord& rec = last_sample_;
+    rec.time = time();
+    rec.realizations = all_icdf;
+    rec.mean = coarse::ensemble_mean(all_icdf);
+    rec.variance = coarse::ensemble_variance(all_icdf, rec.mean);
+    rec.com = all_scalars.col(0);
+    height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
+    const Eigen::VectorXd x = observable_->restrict_ensemble(all_icdf, all_top);
+    rec.compact = top ? x : Eigen::VectorXd();
+    rec.compact_status = observable_->status();
+    if (out) {
+        out->t.push_back(rec.time);
+        out->x.push_back(x);
+        out->phase_signal.push_back(coarse::ensemble_mean(all_scalars)[0]);
+    }
+    if (recorder_) recorder_->sample(rec);
+    if (progress_) progress_->update(rec.time, particle_steps_, "");
+}
+
+void EnsembleStepper::do_lift(double new_time, const Eigen::VectorXd* target) {
+    const bool top = observable_->needs_top_half();
+    std::vector<std::vector<double>> reals;
+    std::vector<std::vector<std::uint8_t>> bytes;
+    std::vector<Eigen::VectorXd> top_icdf;
+    std::vector<std::size_t> out_reals, out_bytes;
+    for (const auto& r : local_) {
+        LiftPayload in = r->lift_input();
+        reals.push_back(std::move(in.reals));
+        bytes.push_back(std::move(in.bytes));
+        if (top) top_icdf.push_back(r->observe(grid_, true).top);
+        const auto [nr, nb] = r->lift_output_sizes();
+        out_reals.push_back(nr);
+        out_bytes.push_back(nb);
+    }
+    const auto all_reals = layout_.gather_arrays(reals);
+    const auto all_bytes = layout_.gather_arrays(bytes);
+    const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+
+    std::vector<std::vector<double>> lifted_reals;
+    std::vector<std::vector<std::uint8_t>> lifted_bytes;
+    if (layout_.is_root()) {
+        last_lift_ = LiftRecord{};
+        for (int r = 0; r < layout_.size(); ++r) {
+            const Eigen::VectorXd goal =
+                observable_->lift_target(*target, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
+            LiftOutcome res = lifter_.lift(goal, {all_reals[r], all_bytes[r]}, grid_, lifting_[r]);
+            last_lift_.changed.push_back(res.changed);
+            last_lift_.max_deviation.push_back(res.max_deviation);
+            last_lift_.messages.push_back(res.message);
+            lifted_reals.push_back(std::move(res.payload.reals));
+            lifted_bytes.push_back(std::move(res.payload.bytes));
+        }
+    }
+    const auto my_reals = layout_.scatter_arrays(lifted_reals, out_reals);
+    const auto my_bytes = layout_.scatter_arrays(lifted_bytes, out_bytes);
+    for (std::size_t j = 0; j < local_.size(); ++j) {
+        local_[j]->apply_lift({my_reals[j], my_bytes[j]});
+        local_[j]->set_time(new_time);
+    }
+}
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,82 @@
+#pragma once
+/// \file
+/// A small RAII layer over the HDF5 C API for the run output written by the root rank: groups,
+/// attributes, fixed datasets and appendable series (an unlimited first dimension that grows by
+/// one row per append). Every HDF5 failure becomes a RuntimeFailure naming the file and object.
+
+#include <hdf5.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace efdem::mpi_driver {
+
+class H5File;
+
+/// A dataset of shape (rows, row_shape...) that grows by one row per append; doubles, 64-bit
+/// integers or variable-length strings.
+class H5Series {
+public:
+    enum class Type { real, integer, text };
+    H5Series(H5File& file, const std::string& name, std::vector<hsize_t> row_shape, Type type);
+    ~H5Series();
+    H5Series(H5Series&& other) noexcept;
+    H5Series& operator=(H5Series&&) = delete;
+    H5Series(const H5Series&) = delete;
+    H5Series& operator=(const H5Series&) = delete;
+
+    void append(std::span<const double> row);
+    void append(std::span<const std::int64_t> row);
+    void append(double value) { append(std::span<const double>(&value, 1)); }
+    void append_integer(std::int64_t value) { append(std::span<const std::int64_t>(&value, 1)); }
+    void append_text(const std::string& text);
+    hsize_t rows() const { return rows_; }
+
+private:
+    void extend_and_write(const void* data, hid_t memtype);
+    H5File* file_;
+    std::string name_;
+    std::vector<hsize_t> row_shape_;
+    hsize_t row_size_ = 1;
+    hid_t dset_ = -1;
+    hid_t type_ = -1;
+    hsize_t rows_ = 0;
+};
+
+class H5File {
+public:
+    /// Creates (truncates) `path`.
+    static H5File create(const std::filesystem::path& path);
+    ~H5File();
+    H5File(H5File&& other) noexcept;
+    H5File& operator=(H5File&&) = delete;
+    H5File(const H5File&) = delete;
+    H5File& operator=(const H5File&) = delete;
+
+    void create_group(const std::string& path);
+    /// Attributes on an existing object ("/" for the file).
+    void attribute(const std::string& object, const std::string& name, const std::string& value);
+    void attribute(const std::string& object, const std::string& name, double value);
+    void attribute(const std::string& object, const std::string& name, std::int64_t value);
+    /// A fixed dataset of doubles with the given shape (row-major).
+    void write(const std::string& name, std::span<const double> data, std::vector<hsize_t> shape);
+    /// A scalar variable-length string dataset.
+    void write_text(const std::string& name, const std::string& text);
+    void flush();
+
+    hid_t id() const { return file_; }
+    const std::string& path() const { return path_; }
+    /// Throws RuntimeFailure naming the file and `what` when status < 0.
+    void check(herr_t status, const std::string& what) const;
+    hid_t check_id(hid_t id, const std::string& what) const;
+
+private:
+    H5File(hid_t file, std::string path) : file_(file), path_(std::move(path)) {}
+    hid_t file_ = -1;
+    std::string path_;
+};
+
+}  // namespace efdem::mpi_driver
