@@ -30,6 +30,9 @@ struct Needs {
     bool neighbor_list = false;
     bool contact_history = false;
     bool slab_fields = false;
+    /// Slab thickness dz [d_p] of the slab fields, when slab_fields is set. Every effect that
+    /// needs slab fields must ask for the same dz (a contract: one set of slabs per System).
+    double slab_thickness = 0.0;
 };
 
 /// What an effect may read and write while adding forces (one step of one realization).
@@ -39,7 +42,8 @@ struct ForceContext {
     const SpeciesTable& species;
     const NeighborList* neighbors;  ///< null unless some effect needs it
     ContactHistory* history;        ///< null unless some effect needs it
-    const SlabFields* slabs;        ///< null unless some effect needs it
+    const SlabFields* slabs;        ///< null unless some effect needs it; else up to date with
+                                    ///< the positions and velocities the forces are evaluated at
     double dt;
     double time;
 };

@@ -1,5 +1,6 @@
 #include "dem/effect_registry.hpp"
 
+#include "dem/effects/gas_drag.hpp"
 #include "dem/effects/gravity.hpp"
 #include "dem/effects/pair_contact.hpp"
 #include "dem/effects/viscous_damping.hpp"
@@ -21,6 +22,8 @@ const EffectRegistry::Entry kEffects[] = {
      "soft-sphere particle-particle contact (hooke|hertz, restitution|gamma, history|none)"},
     {"wall_contact", &make<WallContact>,
      "soft-sphere contact with the floor z = 0 (and the lid, if any); same sub-models"},
+    {"gas_drag", &make<GasDrag>,
+     "1D locally averaged gas (paper Eq. 1-2): drag + pressure gradient on slab fields"},
     {"viscous_damping", &make<ViscousDamping>,
      "F = -gamma m v toward rest; for settling beds, not a physical effect of the bed"},
 };

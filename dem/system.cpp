@@ -24,11 +24,16 @@ System::System(SpeciesTable species, Domain domain, Particles particles,
         const Needs n = e->needs();
         needs_.neighbor_list |= n.neighbor_list;
         needs_.contact_history |= n.contact_history;
-        needs_.slab_fields |= n.slab_fields;
+        if (n.slab_fields) {
+            EFDEM_EXPECTS(!needs_.slab_fields || needs_.slab_thickness == n.slab_thickness);
+            needs_.slab_fields = true;
+            needs_.slab_thickness = n.slab_thickness;
+        }
     }
     // Build only what some effect asked for.
     if (needs_.neighbor_list) neighbors_.emplace(species_.max_diameter(), options_.skin);
     if (needs_.contact_history) history_.emplace(particles_.size());
+    if (needs_.slab_fields) slabs_.emplace(needs_.slab_thickness, species_.max_diameter());
     if (neighbors_) {
         neighbors_->build(particles_, domain_, permutation_);
         if (history_) history_->attach(*neighbors_);
@@ -39,8 +44,6 @@ System::System(SpeciesTable species, Domain domain, Particles particles,
 System::~System() = default;
 System::System(System&&) noexcept = default;
 System& System::operator=(System&&) noexcept = default;
-
-const SlabFields* System::slab_fields() const { return nullptr; }
 
 const Effect* System::find_effect(std::string_view name) const {
     for (const auto& e : effects_)
@@ -60,6 +63,8 @@ ForceContext System::context() const {
 }
 
 void System::compute_forces() {
+    // The fields see the positions and (half-step) velocities the forces are evaluated at.
+    if (slabs_) slabs_->update(particles_, domain_);
     particles_.zero_forces();
     ForceContext ctx = context();
     for (auto& e : effects_) e->add_forces(ctx);

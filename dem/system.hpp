@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// System: one DEM realization. Owns its particles, species, domain, effects, integrator and
-/// whatever the effects need (neighbour list, contact history), and nothing else.
+/// whatever the effects need (neighbour list, contact history, slab fields), and nothing else.
 ///
 /// \code
 /// System sys(species, domain, std::move(particles), std::move(effects), {.dt = 1e-4});
@@ -21,6 +21,7 @@
 #include "dem/integrator.hpp"
 #include "dem/neighbor_list.hpp"
 #include "dem/particles.hpp"
+#include "dem/slab_fields.hpp"
 #include "dem/species.hpp"
 
 namespace efdem::dem {
@@ -61,7 +62,8 @@ public:
     const NeighborList* neighbor_list() const { return neighbors_ ? &*neighbors_ : nullptr; }
     const ContactHistory* contact_history() const { return history_ ? &*history_ : nullptr; }
     ContactHistory* contact_history() { return history_ ? &*history_ : nullptr; }
-    const SlabFields* slab_fields() const;
+    /// The slab fields phi(z), u_s(z) of the current state, or null when no effect needs them.
+    const SlabFields* slab_fields() const { return slabs_ ? &*slabs_ : nullptr; }
     const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
     const Effect* find_effect(std::string_view name) const;
     /// The union of what the effects need.
@@ -112,6 +114,7 @@ private:
     Needs needs_;
     std::optional<NeighborList> neighbors_;
     std::optional<ContactHistory> history_;
+    std::optional<SlabFields> slabs_;
     std::vector<Index> permutation_;
     double time_ = 0;
     long step_ = 0;

@@ -7,6 +7,7 @@
 
 #include "core/param_table.hpp"
 #include "dem/contact_model.hpp"
+#include "dem/effects/gas_drag.hpp"
 #include "dem/effects/gravity.hpp"
 #include "dem/effects/pair_contact.hpp"
 #include "dem/effects/wall_contact.hpp"
@@ -46,6 +47,10 @@ struct EffectList {
         effects.push_back(std::make_unique<dem::Gravity>(g));
         return *this;
     }
+    EffectList& gas(const dem::GasDragSpec& s, const dem::SpeciesTable& sp) {
+        effects.push_back(std::make_unique<dem::GasDrag>(s, sp));
+        return *this;
+    }
     EffectList& wall(const dem::ContactSpec& s, const dem::SpeciesTable& sp) {
         effects.push_back(std::make_unique<dem::WallContact>(s, sp));
         return *this;
@@ -60,6 +65,15 @@ inline dem::System make_system(const dem::SpeciesTable& species, const dem::Doma
     o.skin = skin;
     o.health_check_every = 0;
     return dem::System(species, domain, std::move(particles), std::move(effects.effects), o);
+}
+
+/// The paper's gas (physics.md §3.3): wen_yu_low_re, A = 0.114939, cap 0.70, dz = 1.
+inline dem::GasDragSpec paper_gas(double superficial_velocity, double slab_thickness = 1.0) {
+    dem::GasDragSpec s;
+    s.superficial_velocity = superficial_velocity;
+    s.slab_thickness = slab_thickness;
+    s.A = dem::GasProperties{}.drag_number();
+    return s;
 }
 
 /// A scene table from text (file name "test.cfg").

@@ -1,0 +1,35 @@
+#pragma once
+/// \file
+/// BedTimeSeries: a CSV time series of the bed diagnostics (dem/bed_diagnostics.hpp), one row
+/// per call, for plots of Delta P(t), H(t), the species' centre-of-mass heights and for the
+/// travelling-wave period (coarse::estimate_period on z_com).
+///
+/// Format: `#` comment lines first (what the file is, units of every column), then one header
+/// row of column names, then comma-separated rows; e.g. pandas.read_csv(f, comment='#').
+/// Columns: step, time [sqrt(d_p/g)], pressure_drop [rho_s g d_p], weight_per_area
+/// [rho_s g d_p], bed_height (99 % of the particle volume) [d_p], z_com (all) [d_p],
+/// z_com_<species> [d_p] for every species, ke_per_particle [rho_s g d_p^4].
+
+#include <cstdio>
+#include <filesystem>
+
+#include "dem/system.hpp"
+
+namespace efdem::dem {
+
+class BedTimeSeries {
+public:
+    /// Opens (truncates) `file` and writes the header, naming `system`'s species; RuntimeFailure
+    /// if it cannot.
+    BedTimeSeries(const std::filesystem::path& file, const System& system);
+    ~BedTimeSeries();
+    BedTimeSeries(const BedTimeSeries&) = delete;
+    BedTimeSeries& operator=(const BedTimeSeries&) = delete;
+    /// Appends one row for the current state of `system` (flushed, so a crash loses nothing).
+    void write(const System& system);
+
+private:
+    std::FILE* file_ = nullptr;
+};
+
+}  // namespace efdem::dem

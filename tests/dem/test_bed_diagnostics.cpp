@@ -1,0 +1,98 @@
+// Bed diagnostics on configurations whose answers are known exactly, and the CSV time series.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "dem/bed_diagnostics.hpp"
+#include "dem/io/bed_time_series.hpp"
+#include "tests/support/dem_fixtures.hpp"
+
+using namespace efdem;
+using namespace efdem::dem;
+
+namespace {
+/// `layers` layers of 4 x 4 touching spheres in a 4 x 4 box, centres at z = k + 1/2: slab
+/// [k, k+1] holds exactly one layer. Species alternate by layer (light at the bottom).
+Particles lattice(int layers) {
+    const auto species = test::binary_species();
+    Particles p;
+    Tag tag = 1;
+    for (int k = 0; k < layers; ++k)
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                p.add(tag++, {a + 0.5, b + 0.5, k + 0.5}, {}, static_cast<SpeciesId>(k % 2), species);
+    return p;
+}
+}  // namespace
+
+TEST_CASE("bed height, centre-of-mass heights and phi(z) of a simple-cubic stack", "[unit][diagnostics]") {
+    const Particles p = lattice(10);
+    // Half of the volume lies below z = 5; 95 % below the middle of the top layer, z = 9.5.
+    CHECK(bed_height(p, 0.5) == Approx(5.0).margin(1e-8));
+    CHECK(bed_height(p, 0.95) == Approx(9.5).margin(1e-8));
+    const double h99 = bed_height(p);  // 99 %: 90 % of the top layer's spheres
+    CHECK(h99 > 9.5);
+    CHECK(h99 < 10.0);
+    CHECK(sphere_volume_below(h99, 9.5, 0.5) == Approx(0.9 * std::numbers::pi / 6).epsilon(1e-8));
+    // Light layers at 0.5, 2.5, ..., 8.5 (mean 4.5), heavy at 1.5, ..., 9.5 (mean 5.5); heavy
+    // weigh twice as much: all particles (4.5 + 2 x 5.5)/3.
+    CHECK(center_of_mass_height(p, 0) == Approx(4.5));
+    CHECK(center_of_mass_height(p, 1) == Approx(5.5));
+    CHECK(center_of_mass_height(p) == Approx((4.5 + 11.0) / 3));
+    CHECK(center_of_mass_height(p, 5) == 0.0);
+    CHECK(weight_per_area(p, Domain{4, 4}) == Approx(80 * std::numbers::pi / 6 * 3 / 16));
+    const auto phi = solid_fraction_profile(p, Domain{4, 4}, 1.0);
+    REQUIRE(phi.size() == 10);
+    for (double f : phi) CHECK(f == Approx(std::numbers::pi / 6).epsilon(1e-14));
+    // One sphere ejected far above barely moves the 99 % height (it holds 1/161 of the volume).
+    Particles q = lattice(10);
+    q.add(999, {1, 1, 500}, {}, 0, test::binary_species());
+    CHECK(bed_height(q) < 10.0);
+    CHECK(bed_height(Particles{}) == 0.0);
+}
+
+TEST_CASE("the bed time series writes a commented header, column names and one row per call",
+          "[unit][diagnostics][io]") {
+    const auto file = std::filesystem::temp_directory_path() / "efdem_bed_series_test.csv";
+    const auto species = test::binary_species();
+    test::EffectList fx;
+    fx.gravity().gas(test::paper_gas(0.41), species);
+    System s = test::make_system(species, {4, 4}, lattice(3), std::move(fx), 1e-3);
+    {
+        BedTimeSeries series(file, s);
+        series.write(s);
+        s.run(10);
+        series.write(s);
+    }
+    std::ifstream in(file);
+    std::string line, header;
+    int comments = 0, rows = 0;
+    std::vector<std::string> last;
+    while (std::getline(in, line)) {
+        if (line.rfind("#", 0) == 0) {
+            ++comments;
+            continue;
+        }
+        if (header.empty()) {
+            header = line;
+            continue;
+        }
+        ++rows;
+        last.clear();
+        std::stringstream ss(line);
+        for (std::string cell; std::getline(ss, cell, ',');) last.push_back(cell);
+    }
+    CHECK(comments >= 3);
+    CHECK(header == "step,time,pressure_drop,weight_per_area,bed_height,z_com,z_com_light,"
+                    "z_com_heavy,ke_per_particle");
+    CHECK(rows == 2);
+    REQUIRE(last.size() == 9);
+    CHECK(last[0] == "10");
+    CHECK(std::stod(last[1]) == Approx(0.01));
+    CHECK(std::stod(last[2]) == Approx(pressure_drop(s)).epsilon(1e-9));
+    CHECK(std::stod(last[2]) > 0);  // gas flows up through the bed
+    CHECK_THROWS_AS(BedTimeSeries("/nonexistent_dir/x.csv", s), RuntimeFailure);
+}
