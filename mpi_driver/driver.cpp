@@ -92,6 +92,13 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     RunSummary sum;
     sum.end_status = "completed";
     int without_progress = 0;
+    if (s.cpi.warmup > 0) {
+        // The initial bed (packed, at rest) is far from the slow manifold: run it directly
+        // until the fast transients (fluidization) are gone before the first projection.
+        coarse::BurstSamples warmup;
+        stepper.run(std::min(s.cpi.warmup, s.duration), warmup);
+        log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step", s.cpi.warmup);
+    }
     while (stepper.time() < t_end - kTimeTolerance * std::max(1.0, t_end)) {
         const coarse::ProjectiveStepRecord rec = integrator->step(stepper);
         ++sum.coarse_steps;

@@ -45,6 +45,8 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.cpi.projection = cpi.get_or_choice("projection", "fixed", {"fixed", "periods"}) == "periods"
                            ? CpiSettings::Projection::periods
                            : CpiSettings::Projection::fixed;
+    s.cpi.warmup = cpi.get_or<double>("warmup", 0.0, Bounds::non_negative());
+    whole_multiple(cpi, "warmup", s.cpi.warmup, s.observe.interval, "observe.interval");
     s.cpi.healing = cpi.get_or<double>("healing", 10.0, Bounds::non_negative());
     whole_multiple(cpi, "healing", s.cpi.healing, s.observe.interval, "observe.interval");
     s.cpi.window = cpi.get_or<double>("window", 10.0, Bounds::positive());

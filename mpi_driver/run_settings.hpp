@@ -15,6 +15,8 @@
 /// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19      |
 /// | cpi.observable                 | `icdf` (the ICDF nodes) or `compact` ((A,B,C,D))    | icdf    |
 /// | cpi.projection                 | `fixed` (DT = cpi.dt) or `periods` (DT = k T)       | fixed   |
+/// | cpi.warmup                     | direct simulation before the first coarse step (the | 0       |
+/// |                                | packed start is not on the slow manifold)           |         |
 /// | cpi.healing                    | start of each burst left out of the slope           | 10      |
 /// | cpi.window                     | estimation window after healing                     | 10      |
 /// | cpi.dt                         | projective step DT (projection = fixed)             | 80      |
@@ -48,6 +50,7 @@ struct ObserveSettings {
 struct CpiSettings {
     enum class Observable { icdf, compact } observable = Observable::icdf;
     enum class Projection { fixed, periods } projection = Projection::fixed;
+    double warmup = 0.0;
     double healing = 10.0;
     double window = 10.0;
     double dt = 80.0;
