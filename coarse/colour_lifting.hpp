@@ -81,10 +81,11 @@ struct LiftResult {
  * Cost: O(N log m) time and O(N) memory, no sort of the heights: a branch-free binary search
  * among the m cuts per particle, then sequential passes for the counts, the switch candidates
  * and the light buckets; the achieved ICDF takes bucket-local minima/maxima (O(N)).
- * Measured (g++ 12 -O3, one core of a shared 2-core machine, demixing target, ~25 % of labels
- * switched): 0.2 ms for N = 1e4, 3 ms for N = 1e5, i.e. ~3 s for 1024 realizations of 1e5
- * particles on one rank per coarse step (~0.3 s at the paper's N = 12,500), against DEM bursts
- * of 2-3e5 time steps per realization. Reproduce: efdem_unit_tests "[.benchmark]".
+ * Measured CPU time (g++ 12 -O3, demixing target, ~25 % of labels switched): 0.21 ms for
+ * N = 1e4 and 2.4 ms for N = 1e5 (ratio 11), i.e. ~2.5 s per coarse step for 1024
+ * realizations of 1e5 particles on one rank (~0.3 s at the paper's N = 12,500), against DEM
+ * bursts of 2-3e5 time steps per realization. Wall time doubled on a loaded shared core.
+ * Reproduce: efdem_unit_tests "[.benchmark]".
  *
  * \pre heights.size() == colours.size(); colours in {kHeavy, kLight};
  *      target_icdf.size() == grid.size().
