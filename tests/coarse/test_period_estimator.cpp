@@ -33,7 +33,7 @@ Signal sine_trend(efdem::RandomStream& rng, double period, double trend, double 
 TEST_CASE("period of sine + trend: the refinement removes the detrending bias", "[unit][coarse]") {
     efdem::RandomStream rng(9, 0, "test-period");
     double worst_plain = 0.0;
-    for (int trial = 0; trial < 300; ++trial) {
+    for (int trial = 0; trial < 150; ++trial) {
         const double period = rng.uniform(5.0, 14.0);
         const auto sig = sine_trend(rng, period, rng.uniform(-0.2, 0.2), rng.uniform(0, 2 * kPi),
                                     rng.uniform(0.0, 100.0), rng.uniform(3.0, 6.0) * period, 0.0);
@@ -61,7 +61,7 @@ TEST_CASE("period of a noisy sine + trend is within the crossing-jitter bound", 
     // |T_est - T| <= 2 (dt + h)/n.
     efdem::RandomStream rng(10, 0, "test-period");
     const double eps = 0.1, h = 0.1;
-    for (int trial = 0; trial < 300; ++trial) {
+    for (int trial = 0; trial < 150; ++trial) {
         const double period = rng.uniform(5.0, 14.0);
         const auto sig = sine_trend(rng, period, rng.uniform(-0.2, 0.2), rng.uniform(0, 2 * kPi),
                                     rng.uniform(0.0, 100.0), rng.uniform(3.0, 8.0) * period, eps);
