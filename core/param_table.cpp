@@ -531,7 +531,7 @@ std::filesystem::path Params::get_path(std::string_view key) const {
     // command line resolve against the working directory, as a shell user expects.
     const bool from_scene = location(key).line > 0;
     if (p.is_relative() && from_scene && !table_->base_dir().empty()) p = table_->base_dir() / p;
-    return p;
+    return p.lexically_normal();
 }
 
 std::filesystem::path Params::get_or_path(std::string_view key,

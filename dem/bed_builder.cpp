@@ -66,13 +66,13 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
                                         top, scene.domain.lid_height),
                    "fewer particles, a wider box or a higher domain.lid");
         b.settle = p.get_or<bool>("settle", true);
-        if (b.settle) {
-            const Params s = p.scope("settle");
-            b.settle_damping = s.get_or<double>("damping", 1.0, Bounds::non_negative());
-            b.settle_damped_time = s.get_or<double>("damped_time", 7.2, Bounds::non_negative());
-            b.settle_ke_threshold = s.get_or<double>("ke_threshold", 1e-6, Bounds::positive());
-            b.settle_max_time = s.get_or<double>("max_time", 100.0, Bounds::positive());
-        }
+        // The settling protocol's keys are read (and checked) even with settle = false, so that
+        // a scene can be run unsettled with one override, without editing out its settle block.
+        const Params s = p.scope("settle");
+        b.settle_damping = s.get_or<double>("damping", 1.0, Bounds::non_negative());
+        b.settle_damped_time = s.get_or<double>("damped_time", 7.2, Bounds::non_negative());
+        b.settle_ke_threshold = s.get_or<double>("ke_threshold", 1e-6, Bounds::positive());
+        b.settle_max_time = s.get_or<double>("max_time", 100.0, Bounds::positive());
     } else {
         b.source = Source::lammps_data;
         b.file = p.get_path("file");

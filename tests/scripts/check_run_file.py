@@ -1,0 +1,72 @@
+#!/usr/bin/python3
+"""Read back an efdem run file and check its structure and basic physics:
+shapes consistent, times increasing, every ICDF (mean and per realization) non-decreasing in p
+and inside the bed, variances non-negative, provenance present, cpi records consistent.
+
+    /usr/bin/python3 check_run_file.py RUN.h5 [--mode cpi|direct] [--realizations R]
+"""
+import argparse
+import sys
+
+import h5py
+import numpy as np
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser()
+    ap.add_argument("run")
+    ap.add_argument("--mode")
+    ap.add_argument("--realizations", type=int)
+    ap.add_argument("--min-samples", type=int, default=2)
+    a = ap.parse_args(argv)
+    errors = []
+
+    def check(cond, msg):
+        if not cond:
+            errors.append(msg)
+
+    with h5py.File(a.run, "r") as f:
+        R = int(f.attrs["realizations"])
+        p = f["p"][:]
+        m = len(p)
+        t = f["samples/time"][:]
+        mean = f["samples/mean"][:]
+        var = f["samples/variance"][:]
+        icdf = f["samples/icdf"][:]
+        n = len(t)
+        for key in ("efdem_version", "git_hash", "date", "mode", "seed", "end_status"):
+            check(key in f.attrs, f"attribute {key} missing")
+        check(len(f["scene"][()]) > 0, "scene text missing")
+        if a.mode:
+            check(f.attrs["mode"] == a.mode, f"mode {f.attrs['mode']} != {a.mode}")
+        if a.realizations:
+            check(R == a.realizations, f"realizations {R} != {a.realizations}")
+        check(n >= a.min_samples, f"only {n} samples")
+        check(np.all(np.diff(p) > 0) and p[0] > 0 and p[-1] < 1, "p-grid not increasing inside (0, 1)")
+        check(mean.shape == (n, m) and var.shape == (n, m), f"mean/variance shapes {mean.shape}, {var.shape}")
+        check(icdf.shape == (n, R, m), f"icdf shape {icdf.shape} != {(n, R, m)}")
+        check(np.all(np.diff(t) > 0), "sample times not strictly increasing")
+        check(np.all(np.isfinite(icdf)), "non-finite ICDF values")
+        check(np.all(np.diff(icdf, axis=2) >= 0), "a realization's ICDF decreases in p")
+        check(np.all(np.diff(mean, axis=1) >= 0), "a mean ICDF decreases in p")
+        check(np.all(var >= 0), "negative variance")
+        check(np.all(icdf > 0), "a particle centre below the floor")
+        check(np.allclose(mean, icdf.mean(axis=1), rtol=1e-12, atol=1e-12), "mean is not the mean of the realizations")
+        if f.attrs["mode"] == "cpi":
+            c = f["cpi"]
+            k = len(c["t_start"])
+            check(k >= 1, "no coarse steps recorded")
+            check(int(f.attrs["coarse_steps"]) == k, "coarse_steps attribute does not match the records")
+            for name in ("burst_length", "dt", "t_end", "slope", "x_projected", "lift_changed"):
+                check(len(c[name]) == k, f"/cpi/{name} has {len(c[name])} rows, expected {k}")
+            check(np.all(c["lift_changed"][:] >= 0), "negative label counts")
+            check(np.all(np.diff(c["t_start"][:]) > 0), "coarse steps not in time order")
+    if errors:
+        print(f"check_run_file: {a.run}: " + "; ".join(errors))
+        return 1
+    print(f"check_run_file: {a.run}: ok ({n} samples, R = {R}, m = {m})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
