@@ -54,13 +54,12 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     if (window_samples < 3)
         cpi.fail("window", fmt::format("holds {} samples; a slope needs at least 3", window_samples),
                  fmt::format(">= 3 x observe.interval = {:g}", 3 * s.observe.interval));
-    if (s.cpi.projection == CpiSettings::Projection::fixed) {
-        s.cpi.dt = cpi.get_or<double>("dt", 80.0, Bounds::non_negative());
-    } else {
-        s.cpi.periods = cpi.get_or<int>("periods", 2, Bounds::closed(0, 1000));
-        s.cpi.max_extension = cpi.get_or<double>("max_extension", 30.0, Bounds::non_negative());
-        whole_multiple(cpi, "max_extension", s.cpi.max_extension, s.observe.interval, "observe.interval");
-    }
+    // Both projections' keys are read, so switching cpi.projection on the command line works
+    // on a scene written for the other one.
+    s.cpi.dt = cpi.get_or<double>("dt", 80.0, Bounds::non_negative());
+    s.cpi.periods = cpi.get_or<int>("periods", 2, Bounds::closed(0, 1000));
+    s.cpi.max_extension = cpi.get_or<double>("max_extension", 30.0, Bounds::non_negative());
+    whole_multiple(cpi, "max_extension", s.cpi.max_extension, s.observe.interval, "observe.interval");
     const std::string policy = cpi.get_or_choice("stability", "warn", {"warn", "halve", "stop"});
     s.cpi.stability = policy == "halve"  ? coarse::StabilityPolicy::halve_step
                       : policy == "stop" ? coarse::StabilityPolicy::stop
