@@ -72,6 +72,7 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
     sum.dem_time = stepper.micro_time();
     sum.wall_seconds = progress.elapsed_seconds();
     sum.particle_steps = stepper.particle_steps();
+    sum.restrict_seconds = stepper.overhead().restrict_seconds;
     sum.end_status = std::abs(stepper.time() - t_end) < 1e-6 * std::max(1.0, t_end) ? "completed" : "incomplete";
     return sum;
 }
@@ -88,6 +89,11 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
         return coarse::repair_monotone(x, lo, hi);
     };
     auto integrator = make_integrator(s, compact ? coarse::RepairHook{} : icdf_repair);
+    if (s.cpi.projection == CpiSettings::Projection::periods && stepper.realizations() > 1)
+        log::warn("cpi.projection = periods measures the wave period from the ensemble-mean centre of "
+                  "mass; with {} realizations the wave phases average out and the period may not be "
+                  "measurable. DT = k T is the single-realization method of the paper (Fig. 2b); for "
+                  "an ensemble use cpi.projection = fixed", stepper.realizations());
     bool fell_back = false;
     RunSummary sum;
     sum.end_status = "completed";
@@ -133,6 +139,8 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     sum.dem_time = stepper.micro_time();
     sum.wall_seconds = progress.elapsed_seconds();
     sum.particle_steps = stepper.particle_steps();
+    sum.restrict_seconds = stepper.overhead().restrict_seconds;
+    sum.lift_seconds = stepper.overhead().lift_seconds;
     if (fell_back && sum.end_status == "completed") sum.end_status = "completed (compact observable fell back to icdf)";
     return sum;
 }

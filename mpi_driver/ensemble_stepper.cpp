@@ -96,6 +96,7 @@ void EnsembleStepper::do_run(long samples, coarse::BurstSamples* out) {
 }
 
 void EnsembleStepper::take_sample(coarse::BurstSamples* out) {
+    const double start = MPI_Wtime();
     const bool top = observable_->needs_top_half();
     std::vector<Eigen::VectorXd> icdf, top_icdf, scalars;
     for (const auto& r : local_) {
@@ -107,7 +108,11 @@ void EnsembleStepper::take_sample(coarse::BurstSamples* out) {
     const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
     const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
     const Eigen::MatrixXd all_scalars = layout_.gather_rows(scalars);
-    if (!layout_.is_root()) return;
+    if (!layout_.is_root()) {
+        overhead_.restrict_seconds += MPI_Wtime() - start;
+        ++overhead_.samples;
+        return;
+    }
 
     SampleRecord& rec = last_sample_;
     rec.time = time();
@@ -125,10 +130,13 @@ void EnsembleStepper::take_sample(coarse::BurstSamples* out) {
         out->phase_signal.push_back(coarse::ensemble_mean(all_scalars)[0]);
     }
     if (recorder_) recorder_->sample(rec);
+    overhead_.restrict_seconds += MPI_Wtime() - start;
+    ++overhead_.samples;
     if (progress_) progress_->update(rec.time, particle_steps_, "");
 }
 
 void EnsembleStepper::do_lift(double new_time, const Eigen::VectorXd* target) {
+    const double start = MPI_Wtime();
     const bool top = observable_->needs_top_half();
     std::vector<std::vector<double>> reals;
     std::vector<std::vector<std::uint8_t>> bytes;
@@ -168,6 +176,8 @@ void EnsembleStepper::do_lift(double new_time, const Eigen::VectorXd* target) {
         local_[j]->apply_lift({my_reals[j], my_bytes[j]});
         local_[j]->set_time(new_time);
     }
+    overhead_.lift_seconds += MPI_Wtime() - start;
+    ++overhead_.lifts;
 }
 
 }  // namespace efdem::mpi_driver

@@ -55,6 +55,7 @@ public:
                     const Lifter& lifter, RunRecorder* recorder, Progress* progress);
 
     double time() const override;
+    int realizations() const { return layout_.size(); }
     void run(double duration, coarse::BurstSamples& out) override;
     void lift(const Eigen::VectorXd& target, double new_time) override;
 
@@ -74,6 +75,17 @@ public:
     /// the feasible range of a lifting target.
     std::pair<double, double> height_range() const { return height_range_; }
     void set_observable(coarse::EnsembleObservable& observable) { observable_ = &observable; }
+
+    /// Wall time spent in the ensemble-level work of the coarse loop (not in the DEM), summed
+    /// so far [s]: restriction (observe, gather, average, record) and lifting (gather heights
+    /// and colours, compute every lift on the root, scatter, apply).
+    struct Overhead {
+        double restrict_seconds = 0;
+        double lift_seconds = 0;
+        long samples = 0;
+        long lifts = 0;
+    };
+    const Overhead& overhead() const { return overhead_; }
     std::vector<std::unique_ptr<Realization>>& local() { return local_; }
 
 private:
@@ -100,6 +112,7 @@ private:
     std::pair<double, double> height_range_{0.0, 0.0};
     LiftRecord last_lift_;
     SampleRecord last_sample_;
+    Overhead overhead_;
 };
 
 }  // namespace efdem::mpi_driver

@@ -119,6 +119,8 @@ void Hdf5Recorder::finish(const RunSummary& s) {
     file_.attribute("/", "wall_seconds", s.wall_seconds);
     file_.attribute("/", "particle_steps", s.particle_steps);
     file_.attribute("/", "coarse_steps", std::int64_t{s.coarse_steps});
+    file_.attribute("/", "restrict_seconds", s.restrict_seconds);
+    file_.attribute("/", "lift_seconds", s.lift_seconds);
     file_.flush();
 }
 

@@ -7,7 +7,8 @@
 ///   /                     attributes: format_version, efdem_version, git_hash, build, date,
 ///                         mode, ranks, realizations, realizations_per_rank, seed,
 ///                         observed_species, scene_file, overrides; at the end: end_status,
-///                         simulated_time, dem_time, wall_seconds, particle_steps, coarse_steps
+///                         simulated_time, dem_time, wall_seconds, particle_steps, coarse_steps,
+///                         restrict_seconds, lift_seconds (root wall time in the coarse layer)
 ///   /scene                the scene text as read;  /parameters  every parameter with its origin
 ///   /p                    the p-grid (m)
 ///   /samples/time (n), mean (n x m), variance (n x m), icdf (n x R x m), com (n x R)

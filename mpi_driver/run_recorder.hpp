@@ -40,6 +40,8 @@ struct RunSummary {
     double particle_steps = 0;   ///< summed over all realizations
     long coarse_steps = 0;
     std::string end_status;      ///< "completed", or why the run stopped
+    double restrict_seconds = 0; ///< root wall time in restriction (observe, gather, average, record)
+    double lift_seconds = 0;     ///< root wall time in lifting (gather, compute, scatter, apply)
 };
 
 class RunRecorder {
