@@ -1,5 +1,6 @@
 #include "dem/bed_builder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -60,6 +61,10 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
             p.fail("jitter", "lets neighbouring lattice spheres overlap",
                    fmt::format("< (spacing - diameter)/2 = {:g}", 0.5 * (b.spacing - scene.species.max_diameter())));
         b.velocity_rms = p.get_or<double>("velocity_rms", 0.2, Bounds::non_negative());
+        const std::string layering = p.get_or_choice("layering", "mixed", {"mixed", "light_on_top", "heavy_on_top"});
+        b.layering = layering == "light_on_top"   ? Layering::light_on_top
+                     : layering == "heavy_on_top" ? Layering::heavy_on_top
+                                                  : Layering::mixed;
         const double top = lattice_top(b, scene);
         if (scene.domain.has_lid() && top >= scene.domain.lid_height)
             p.fail("count", fmt::format("needs a lattice {:.4g} high, above the lid at domain.lid = {:g}",
@@ -88,12 +93,21 @@ Particles lattice_bed(const BedSpec& bed, const DemScene& scene, const Realizati
     const double ax = g.ax, ay = g.ay, az = g.az, z0 = g.z0;
     RandomStream packing(spec.seed, static_cast<std::uint64_t>(spec.realization), "packing");
     RandomStream velocities(spec.seed, static_cast<std::uint64_t>(spec.realization), "velocities");
-    // Exact species counts by a random permutation of the labels.
+    // Exact species counts: a random permutation of the labels (mixed), or stratified by density
+    // (sites are filled from the bottom up, so the first labels end up lowest).
+    std::vector<SpeciesId> order(bed.count.size());
+    for (std::size_t s = 0; s < order.size(); ++s) order[s] = static_cast<SpeciesId>(s);
+    if (bed.layering != BedSpec::Layering::mixed) {
+        const bool heavy_first = bed.layering == BedSpec::Layering::light_on_top;
+        std::stable_sort(order.begin(), order.end(), [&](SpeciesId a, SpeciesId b) {
+            return heavy_first ? scene.species[a].density > scene.species[b].density
+                               : scene.species[a].density < scene.species[b].density;
+        });
+    }
     std::vector<SpeciesId> labels;
     labels.reserve(static_cast<std::size_t>(n));
-    for (std::size_t s = 0; s < bed.count.size(); ++s)
-        labels.insert(labels.end(), static_cast<std::size_t>(bed.count[s]), static_cast<SpeciesId>(s));
-    packing.shuffle(labels.begin(), labels.end());
+    for (SpeciesId s : order) labels.insert(labels.end(), static_cast<std::size_t>(bed.count[s]), s);
+    if (bed.layering == BedSpec::Layering::mixed) packing.shuffle(labels.begin(), labels.end());
     const double sigma = bed.velocity_rms / std::sqrt(3.0);
     Particles p;
     p.reserve(static_cast<std::size_t>(n));

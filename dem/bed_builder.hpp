@@ -20,6 +20,9 @@
 /// | settle.ke_threshold    | stop when translational KE per particle < this x m_min g d_p | 1e-6 |
 /// | settle.max_time        | give up (with a warning) after this much settling     | 100       |
 /// | file                   | LAMMPS data file (.gz allowed), for lammps_data       | required  |
+/// | layering               | `mixed` (species by random permutation), or           | mixed     |
+/// |                        | `light_on_top` / `heavy_on_top` (stratified by        |           |
+/// |                        | density: a fully demixed start, e.g. for mixing runs) |           |
 /// | permute_species        | reassign species by random permutation (exact counts) | false     |
 ///
 /// Streams: `packing` (jitter, species permutation), `velocities` (initial velocities).
@@ -47,6 +50,7 @@ struct BedSpec {
     double settle_ke_threshold = 1e-6;
     double settle_max_time = 100.0;
     std::filesystem::path file;
+    enum class Layering { mixed, light_on_top, heavy_on_top } layering = Layering::mixed;
     bool permute_species = false;
 
     static BedSpec from_params(const Params& scope, const DemScene& scene);

@@ -43,7 +43,7 @@ std::unique_ptr<coarse::ProjectiveIntegrator> make_integrator(const RunSettings&
 std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const LiftRecord& lift) {
     long changed = 0;
     for (long c : lift.changed) changed += c;
-    std::string s = fmt::format("coarse step {}: burst {:.4g}..{:.4g}", n, r.t_start, r.t_end);
+    std::string s = fmt::format("coarse step {}: burst {:.4g}..{:.4g}", n, r.t_start, r.t_start + r.burst_length);
     if (std::isfinite(r.period)) s += fmt::format(", period T = {:.4g}", r.period);
     s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
     if (r.lifted) s += fmt::format(", {} labels changed", changed);

@@ -29,47 +29,38 @@ void EnsembleStepper::fail(const std::string& message, long realization) const {
     layout_.mpi().abort(fmt::format("realization {}: {}", realization, message), kExitRuntimeFailure);
 }
 
-void EnsembleStepper::broadcast_command(Command& c, double& value) const {
-    double buf[2] = {static_cast<double>(static_cast<int>(c)), value};
-    MPI_Bcast(buf, 2, MPI_DOUBLE, 0, layout_.mpi().comm());
-    c = static_cast<Command>(static_cast<int>(buf[0]));
-    value = buf[1];
+EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
+    double buf[3] = {static_cast<double>(static_cast<int>(m.command)), m.value, m.top_half ? 1.0 : 0.0};
+    MPI_Bcast(buf, 3, MPI_DOUBLE, 0, layout_.mpi().comm());
+    return {static_cast<Command>(static_cast<int>(buf[0])), buf[1], buf[2] != 0.0};
 }
 
 void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
-    Command c = Command::run;
-    double d = duration;
-    broadcast_command(c, d);
-    do_run(std::lround(duration / settings_.sample_interval), &out);
+    const bool top = observable_->needs_top_half();
+    broadcast({Command::run, duration, top});
+    do_run(std::lround(duration / settings_.sample_interval), top, &out);
 }
 
 void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
-    Command c = Command::lift;
-    double t = new_time;
-    broadcast_command(c, t);
-    do_lift(new_time, &target);
+    const bool top = observable_->needs_top_half();
+    broadcast({Command::lift, new_time, top});
+    do_lift(new_time, top, &target);
 }
 
-void EnsembleStepper::finish() {
-    Command c = Command::finish;
-    double unused = 0;
-    broadcast_command(c, unused);
-}
+void EnsembleStepper::finish() { broadcast({Command::finish, 0.0, false}); }
 
 void EnsembleStepper::serve() {
     while (true) {
-        Command c = Command::finish;
-        double value = 0;
-        broadcast_command(c, value);
-        switch (c) {
-            case Command::run: do_run(std::lround(value / settings_.sample_interval), nullptr); break;
-            case Command::lift: do_lift(value, nullptr); break;
+        const Message m = broadcast({Command::finish, 0.0, false});
+        switch (m.command) {
+            case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
+            case Command::lift: do_lift(m.value, m.top_half, nullptr); break;
             case Command::finish: return;
         }
     }
 }
 
-void EnsembleStepper::do_run(long samples, coarse::BurstSamples* out) {
+void EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {
     const InjectedFailure& inject = settings_.failure;
     for (long s = 0; s < samples; ++s) {
         for (auto& r : local_) {
@@ -83,7 +74,7 @@ void EnsembleStepper::do_run(long samples, coarse::BurstSamples* out) {
         }
         micro_time_ += static_cast<double>(settings_.steps_per_sample) * local_.front()->dt();
         particle_steps_ += static_cast<double>(settings_.steps_per_sample) * total_particles_;
-        take_sample(out);
+        take_sample(top_half, out);
         ++samples_taken_;
         for (auto& r : local_) {
             try {
@@ -95,9 +86,8 @@ void EnsembleStepper::do_run(long samples, coarse::BurstSamples* out) {
     }
 }
 
-void EnsembleStepper::take_sample(coarse::BurstSamples* out) {
+void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     const double start = MPI_Wtime();
-    const bool top = observable_->needs_top_half();
     std::vector<Eigen::VectorXd> icdf, top_icdf, scalars;
     for (const auto& r : local_) {
         Observation o = r->observe(grid_, top);
@@ -135,9 +125,8 @@ void EnsembleStepper::take_sample(coarse::BurstSamples* out) {
     if (progress_) progress_->update(rec.time, particle_steps_, "");
 }
 
-void EnsembleStepper::do_lift(double new_time, const Eigen::VectorXd* target) {
+void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target) {
     const double start = MPI_Wtime();
-    const bool top = observable_->needs_top_half();
     std::vector<std::vector<double>> reals;
     std::vector<std::vector<std::uint8_t>> bytes;
     std::vector<Eigen::VectorXd> top_icdf;

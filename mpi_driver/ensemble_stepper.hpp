@@ -90,10 +90,18 @@ public:
 
 private:
     enum class Command : int { run = 1, lift = 2, finish = 3 };
-    void broadcast_command(Command& c, double& value) const;
-    void do_run(long samples, coarse::BurstSamples* out);
-    void do_lift(double new_time, const Eigen::VectorXd* target);
-    void take_sample(coarse::BurstSamples* out);
+    /// The root's command, its argument, and whether the top-half ICDF is gathered (the
+    /// observable lives on the root only and may change during a run: the workers must join
+    /// exactly the collectives the root joins).
+    struct Message {
+        Command command;
+        double value;
+        bool top_half;
+    };
+    Message broadcast(Message m) const;
+    void do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target);
+    void take_sample(bool top_half, coarse::BurstSamples* out);
     [[noreturn]] void fail(const std::string& message, long realization) const;
 
     const EnsembleLayout& layout_;
