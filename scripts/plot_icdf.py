@@ -64,7 +64,7 @@ def main(argv=None):
 
     runs = [load(p) for p in args.runs]
     fig, ax = plt.subplots(figsize=(8, 5.5), dpi=120)
-    styles = [dict(color=None, lw=1.2, alpha=0.9), dict(lw=2.6, alpha=0.85), dict(lw=1.8, ls="--")]
+    styles = [dict(lw=1.2, alpha=0.9), dict(lw=2.6, alpha=0.85), dict(lw=1.8, ls="--", alpha=0.9)]
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, run in enumerate(runs):
         style = styles[k % len(styles)]

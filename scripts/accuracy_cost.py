@@ -1,0 +1,305 @@
+#!/usr/bin/python3
+"""What accuracy costs in time: a brute-force (direct) ensemble as the reference, then CPI runs
+sweeping the projective step, healing and window, ensemble size, observable, DEM time step and
+slab thickness. For each run: wall time, particle-steps, effective speed-up and error against
+the direct ensemble, in d_p and in units of the ensemble's standard error. Writes plots (PNG),
+a Markdown table and a CSV into the output folder.
+
+    /usr/bin/python3 scripts/accuracy_cost.py --efdem build/mpi_driver/efdem --out runs/accuracy [--quick]
+
+Runs are resumable: a run whose .h5 file is complete is not repeated. --quick uses a tiny bed
+and a handful of runs (under 15 minutes on 2 cores); the full study takes a few hours.
+"""
+import argparse
+import csv
+import math
+import os
+import subprocess
+import sys
+import time
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import accuracy_metrics as am  # noqa: E402
+
+# The reduced bed of the study (the paper's model, 1,000 spheres in 7.5 x 7.5: 1/12 of the
+# particles), and the tiny bed of --quick (256 spheres, no settling).
+BED = """effects = gravity pair_contact wall_contact gas_drag
+dt = 1e-4
+seed = 1
+domain.lx = 7.5
+domain.ly = 7.5
+domain.lid = 150
+species.names = light heavy
+species.density = 1 2
+species.diameter = 1 1
+pair_contact.kn = 2e5
+pair_contact.restitution = 0.9
+pair_contact.mu = 0.1
+gas_drag.superficial_velocity = {us}
+bed.count = 500 500
+bed.settle.ke_threshold = 1e-5
+observe.interval = 0.5
+run.duration = {duration}
+cpi.warmup = 10
+cpi.healing = 10
+cpi.window = 10
+cpi.dt = 40
+"""
+TINY = """effects = gravity pair_contact wall_contact gas_drag
+dt = 1e-4
+seed = 1
+domain.lx = 4.28
+domain.ly = 4.28
+domain.lid = 60
+species.names = light heavy
+species.density = 1 2
+species.diameter = 1 1
+pair_contact.kn = 2e5
+pair_contact.restitution = 0.9
+pair_contact.mu = 0.1
+gas_drag.superficial_velocity = {us}
+bed.count = 128 128
+bed.settle.ke_threshold = 1e-5
+observe.interval = 0.25
+run.duration = {duration}
+cpi.warmup = 5
+cpi.healing = 3
+cpi.window = 3
+cpi.dt = 12
+"""
+
+
+def study_runs(quick):
+    """(name, U_s, mode, R, overrides) of every run, reference first for each U_s."""
+    if quick:
+        runs = [("ref_0.19", 0.19, "direct", 4, {})]
+        for dt in (0, 6, 12, 24):
+            runs.append((f"DT{dt}", 0.19, "cpi", 4, {"cpi.dt": dt}))
+        runs.append(("R1_DT12", 0.19, "cpi", 1, {"cpi.dt": 12}))
+        runs.append(("R2_DT12", 0.19, "cpi", 2, {"cpi.dt": 12}))
+        runs.append(("compact_DT12", 0.19, "cpi", 4, {"cpi.dt": 12, "cpi.observable": "compact"}))
+        return runs
+    burst = 20
+    runs = [("ref_0.19", 0.19, "direct", 16, {}), ("ref_0.41", 0.41, "direct", 16, {})]
+    for k in (0, 1, 2, 4, 8):
+        runs.append((f"DT{k * burst}", 0.19, "cpi", 8, {"cpi.dt": k * burst}))
+    for healing, window in ((5, 15), (15, 5), (10, 20)):
+        runs.append((f"H{healing}W{window}_DT80", 0.19, "cpi", 8,
+                     {"cpi.healing": healing, "cpi.window": window, "cpi.dt": 80}))
+    for r in (1, 2, 4, 16):
+        runs.append((f"R{r}_DT80", 0.19, "cpi", r, {"cpi.dt": 80}))
+    runs.append(("compact_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "cpi.observable": "compact"}))
+    for frac in (10, 20, 50):
+        runs.append((f"dt_tc{frac}_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "dt": round(3.596e-3 / frac, 7)}))
+    for dz in (2, 3):
+        runs.append((f"slab{dz}_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "gas_drag.slab_thickness": dz}))
+    for k in (1, 2, 4):
+        runs.append((f"U041_DT{k * burst}", 0.41, "cpi", 8, {"cpi.dt": k * burst}))
+    return runs
+
+
+def run_efdem(args, scene, name, mode, R, overrides):
+    h5 = os.path.join(args.out, name + ".h5")
+    if os.path.exists(h5):
+        try:
+            with h5py.File(h5, "r") as f:
+                if "end_status" in f.attrs:
+                    return h5
+        except OSError:
+            pass
+    np_ = min(R, args.np)
+    per_rank = R // np_
+    cmd = ["mpirun", "-np", str(np_), "--oversubscribe", args.efdem, scene, f"mode={mode}",
+           f"ensemble.realizations_per_rank={per_rank}", f"output.directory={args.out}",
+           f"output.prefix={name}"] + [f"{k}={v}" for k, v in overrides.items()]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    t0 = time.time()
+    with open(os.path.join(args.out, name + ".log"), "w") as log:
+        code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+    print(f"  {name}: {'ok' if code == 0 else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
+    if code != 0:
+        raise SystemExit(f"accuracy_cost: run {name} failed; see {args.out}/{name}.log")
+    return h5
+
+
+def load(h5):
+    with h5py.File(h5, "r") as f:
+        d = {k: f.attrs[k] for k in ("realizations", "wall_seconds", "particle_steps", "simulated_time", "dem_time")}
+        d["t"] = f["samples/time"][:]
+        d["mean"] = f["samples/mean"][:]
+        d["var"] = f["samples/variance"][:]
+        d["p"] = f["p"][:]
+        d["scene"] = f["scene"][()].decode() if isinstance(f["scene"][()], bytes) else f["scene"][()]
+        d["params"] = f["parameters"][()]
+        if "cpi" in f:
+            d["steps"] = len(f["cpi/t_start"])
+            d["repairs"] = int(np.sum(f["cpi/repair_max_adjustment"][:] > 0))
+        return d
+
+
+def param(d, key, default=None):
+    text = d["params"].decode() if isinstance(d["params"], bytes) else d["params"]
+    for line in text.splitlines():
+        if line.startswith(key + " = "):
+            return line.split(" = ", 1)[1].split("   [")[0].strip()
+    return default
+
+
+def analyse(run, ref):
+    keep, ref_mean = am.align(ref["t"], ref["mean"], run["t"])
+    _, ref_var = am.align(ref["t"], ref["var"], run["t"])
+    mean = run["mean"][keep]
+    err = am.rms_error(mean, ref_mean)
+    R = int(run["realizations"])
+    nerr = am.normalized_error(mean, ref_mean, ref_var, int(ref["realizations"]), ref_var, R)
+    se = am.standard_error(ref_var, R)
+    sp = am.speedup(run["simulated_time"], run["wall_seconds"], R, ref["simulated_time"], ref["wall_seconds"],
+                    int(ref["realizations"]))
+    dt_proj = float(param(run, "cpi.dt", 0))
+    window = float(param(run, "cpi.window", 0))
+    interval = float(param(run, "observe.interval", 0.5))
+    sigma = math.sqrt(float(np.mean(ref_var)) / R)
+    pred = am.predicted_projection_noise(dt_proj, window, int(round(window / interval)) + 1, sigma)
+    return dict(error=err, normalized=nerr, noise_floor=se, speedup=sp, predicted=pred, dt=dt_proj,
+                ideal=run["simulated_time"] / max(run["dem_time"], 1e-12), R=R)
+
+
+def plots(args, rows, refs, loaded):
+    out = args.out
+    # 1. error vs wall time, Pareto front labelled
+    fig, ax = plt.subplots(figsize=(8, 5.5), dpi=120)
+    pts = [(r["wall"], r["error"]) for r in rows]
+    front = set(am.pareto_front(pts))
+    for i, r in enumerate(rows):
+        ax.scatter(r["wall"], r["error"], c="C3" if i in front else "C0", s=30, zorder=3)
+        ax.annotate(r["name"], (r["wall"], r["error"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+    fr = sorted(front, key=lambda i: pts[i][0])
+    ax.plot([pts[i][0] for i in fr], [pts[i][1] for i in fr], "C3-", lw=1, label="Pareto front")
+    for us, ref in refs.items():
+        ax.axvline(ref["wall_seconds"], color="grey", ls=":", lw=1)
+        ax.annotate(f"direct R={int(ref['realizations'])} (U_s={us})", (ref["wall_seconds"], ax.get_ylim()[1]),
+                    fontsize=6, rotation=90, va="top")
+    ax.set_xlabel("wall time of the run [s] (2 cores)")
+    ax.set_ylabel("RMS error of the mean ICDF vs direct [$d_p$]")
+    ax.set_title("Accuracy against cost")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "error_vs_wall_time.png"))
+    plt.close(fig)
+    # 2. speed-up vs DT, colour = error
+    dt_rows = [r for r in rows if r["name"].startswith(("DT", "U041"))]
+    if dt_rows:
+        fig, ax = plt.subplots(figsize=(7, 5), dpi=120)
+        sc = ax.scatter([r["dt"] for r in dt_rows], [r["speedup"] for r in dt_rows],
+                        c=[r["error"] for r in dt_rows], cmap="viridis", s=60)
+        for r in dt_rows:
+            ax.annotate(r["name"], (r["dt"], r["speedup"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        fig.colorbar(sc, ax=ax, label="RMS error [$d_p$]")
+        ax.set_xlabel(r"projective step DT [$\sqrt{d_p/g}$]")
+        ax.set_ylabel("effective speed-up vs direct (equal R)")
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "speedup_vs_dt.png"))
+        plt.close(fig)
+    # 3. error vs R with the 1/sqrt(R) noise floor
+    r_rows = [r for r in rows if r["name"].startswith("R") or r["name"] in ("DT80", "DT12")]
+    if r_rows:
+        fig, ax = plt.subplots(figsize=(7, 5), dpi=120)
+        Rs = np.array([r["R"] for r in r_rows])
+        ax.loglog(Rs, [r["error"] for r in r_rows], "o", label="measured RMS error")
+        ax.loglog(Rs, [r["noise_floor"] for r in r_rows], "s", mfc="none", label="standard error of a mean of R")
+        grid = np.logspace(0, np.log10(max(Rs.max(), 2)), 50)
+        ax.loglog(grid, r_rows[0]["noise_floor"] * math.sqrt(r_rows[0]["R"]) / np.sqrt(grid), "k:", label=r"$\propto 1/\sqrt{R}$")
+        ax.set_xlabel("realizations R")
+        ax.set_ylabel("RMS error [$d_p$]")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "error_vs_realizations.png"))
+        plt.close(fig)
+    # 4. predicted noise amplification vs measured error
+    pr = [r for r in rows if math.isfinite(r["predicted"]) and r["dt"] > 0]
+    if pr:
+        fig, ax = plt.subplots(figsize=(6, 5), dpi=120)
+        ax.scatter([r["predicted"] for r in pr], [r["error"] for r in pr])
+        for r in pr:
+            ax.annotate(r["name"], (r["predicted"], r["error"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        lim = max(max(r["predicted"] for r in pr), max(r["error"] for r in pr)) * 1.1
+        ax.plot([0, lim], [0, lim], "k:", lw=1, label="measured = predicted")
+        ax.set_xlabel(r"predicted projection noise $DT/W\,\sqrt{12/n}\,\sigma/\sqrt{R}$ [$d_p$]")
+        ax.set_ylabel("measured RMS error [$d_p$]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "predicted_vs_measured.png"))
+        plt.close(fig)
+    # 5. ICDF trajectories: the reference and two CPI runs, with bands
+    import plot_icdf
+    # The reference and the paper-like step (DT = 4 x burst), or the largest DT of a quick study.
+    main_run = next((r["name"] for r in rows if r["name"] in ("DT80", "DT12")), rows[0]["name"])
+    pick = [os.path.join(out, n + ".h5") for n in ("ref_0.19", main_run)]
+    plot_icdf.main([p for p in pick if os.path.exists(p)] + ["-o", os.path.join(out, "icdf_cpi_vs_direct.png"),
+                   "--title", "CPI against the direct ensemble (U_s = 0.19)"])
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--efdem", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--np", type=int, default=2, help="MPI ranks per run")
+    args = ap.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    args.out = os.path.abspath(args.out)
+    duration = 40 if args.quick else 300
+    template = TINY if args.quick else BED
+    scenes = {}
+    for us in (0.19, 0.41):
+        path = os.path.join(args.out, f"scene_{us}.cfg")
+        with open(path, "w") as f:
+            f.write(template.format(us=us, duration=duration))
+        scenes[us] = path
+    t0 = time.time()
+    print(f"accuracy_cost: {'quick' if args.quick else 'full'} study into {args.out}", flush=True)
+    runs = study_runs(args.quick)
+    files = {name: run_efdem(args, scenes[us], name, mode, R, ov) for name, us, mode, R, ov in runs}
+    loaded = {name: load(h5) for name, h5 in files.items()}
+    refs = {us: loaded[f"ref_{us}"] for us in (0.19, 0.41) if f"ref_{us}" in loaded}
+    rows = []
+    for name, us, mode, R, ov in runs:
+        if mode != "cpi":
+            continue
+        run = loaded[name]
+        a = analyse(run, refs[us])
+        rows.append(dict(name=name, us=us, wall=float(run["wall_seconds"]), particle_steps=float(run["particle_steps"]),
+                         steps=run.get("steps", 0), repairs=run.get("repairs", 0), **a))
+    plots(args, rows, refs, loaded)
+    with open(os.path.join(args.out, "accuracy_cost.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    with open(os.path.join(args.out, "table.md"), "w") as f:
+        f.write("| run | U_s | R | DT | wall [s] | particle-steps | speed-up (ideal) | error [d_p] | error / s.e. | "
+                "predicted [d_p] | coarse steps | repairs |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for us, ref in refs.items():
+            f.write(f"| direct (reference) | {us} | {int(ref['realizations'])} | - | {ref['wall_seconds']:.0f} | "
+                    f"{ref['particle_steps']:.3g} | 1 | - | - | - | - | - |\n")
+        for r in rows:
+            f.write(f"| {r['name']} | {r['us']} | {r['R']} | {r['dt']:g} | {r['wall']:.0f} | {r['particle_steps']:.3g} | "
+                    f"{r['speedup']:.2f} ({r['ideal']:.2f}) | {r['error']:.3f} | {r['normalized']:.2f} | "
+                    f"{r['predicted']:.3f} | {r['steps']} | {r['repairs']} |\n")
+    print(open(os.path.join(args.out, "table.md")).read())
+    print(f"accuracy_cost: done in {time.time() - t0:.0f} s; plots, table.md and accuracy_cost.csv in {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

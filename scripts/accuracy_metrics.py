@@ -1,0 +1,68 @@
+"""Error and cost metrics of a CPI run against a direct (brute-force) ensemble (issue 9).
+
+Pure functions on arrays, unit-tested on synthetic data in tests/scripts/test_accuracy_metrics.py.
+Heights in d_p, times in sqrt(d_p/g), wall times in seconds.
+"""
+import math
+
+import numpy as np
+
+
+def align(t_ref, values_ref, t):
+    """values_ref (n_ref x m, sampled at t_ref) linearly interpolated to the times t (n x m).
+    Times outside [t_ref[0], t_ref[-1]] are dropped: returns (mask of kept t, values)."""
+    t_ref = np.asarray(t_ref, float)
+    t = np.asarray(t, float)
+    keep = (t >= t_ref[0] - 1e-9) & (t <= t_ref[-1] + 1e-9)
+    v = np.empty((int(keep.sum()), values_ref.shape[1]))
+    for j in range(values_ref.shape[1]):
+        v[:, j] = np.interp(t[keep], t_ref, values_ref[:, j])
+    return keep, v
+
+
+def rms_error(mean, mean_ref):
+    """RMS over all samples and p-nodes of mean - mean_ref [d_p]."""
+    d = np.asarray(mean, float) - np.asarray(mean_ref, float)
+    return float(np.sqrt(np.mean(d * d)))
+
+
+def standard_error(variance, realizations):
+    """RMS over samples and nodes of the standard error of an ensemble mean, sqrt(var/R) [d_p]."""
+    return float(np.sqrt(np.mean(np.asarray(variance, float) / realizations)))
+
+
+def normalized_error(mean, mean_ref, var_ref, r_ref, var_cpi=None, r_cpi=None):
+    """RMS error divided by the standard error expected of the difference of two independent
+    ensemble means, sqrt(var_ref/R_ref + var_cpi/R_cpi) (the reference's alone when the CPI
+    variance is not given). About 1 when CPI is right within noise."""
+    noise = np.asarray(var_ref, float) / r_ref
+    if var_cpi is not None:
+        noise = noise + np.asarray(var_cpi, float) / r_cpi
+    return rms_error(mean, mean_ref) / float(np.sqrt(np.mean(noise)))
+
+
+def speedup(sim_time, wall, realizations, ref_sim_time, ref_wall, ref_realizations):
+    """Effective speed-up: simulated realization-time per wall second of the run, against that
+    of the direct ensemble (both on the same ranks), i.e. against a direct ensemble of equal R."""
+    rate = sim_time * realizations / wall
+    ref_rate = ref_sim_time * ref_realizations / ref_wall
+    return rate / ref_rate
+
+
+def predicted_projection_noise(dt_projective, window, samples_in_window, sigma):
+    """The noise a projective step adds: DT/W sqrt(12/n) sigma (physics.md §10), sigma the
+    standard deviation of one sample of the (ensemble-mean) coarse variable [d_p]."""
+    if window <= 0 or samples_in_window < 2:
+        return math.nan
+    return dt_projective / window * math.sqrt(12.0 / samples_in_window) * sigma
+
+
+def pareto_front(points):
+    """Indices of the (cost, error) points not dominated by another (lower cost and error)."""
+    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
+    front, best = [], math.inf
+    for i in order:
+        if points[i][1] < best:
+            front.append(i)
+            best = points[i][1]
+    return front

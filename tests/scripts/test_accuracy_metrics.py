@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""Unit tests of scripts/accuracy_metrics.py on synthetic data (issue 9)."""
+import math
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+import accuracy_metrics as am  # noqa: E402
+
+
+class Metrics(unittest.TestCase):
+    def test_align_interpolates_and_drops_outside(self):
+        t_ref = np.array([0.0, 1.0, 2.0])
+        v = np.array([[0.0, 10.0], [1.0, 20.0], [2.0, 30.0]])
+        keep, a = am.align(t_ref, v, [0.5, 1.0, 3.0])
+        self.assertEqual(list(keep), [True, True, False])
+        np.testing.assert_allclose(a, [[0.5, 15.0], [1.0, 20.0]])
+
+    def test_rms_error_exact(self):
+        # A constant offset c on every node and sample has RMS error |c|.
+        ref = np.random.default_rng(1).normal(size=(40, 19))
+        self.assertAlmostEqual(am.rms_error(ref + 0.3, ref), 0.3, places=14)
+        self.assertEqual(am.rms_error(ref, ref), 0.0)
+
+    def test_normalized_error_of_pure_noise_is_about_one(self):
+        # Two independent ensembles of R realizations of the same truth: the difference of their
+        # means has variance 2 var/R, so the normalized error is ~1 (within 10 % for 19 x 400
+        # nodes and samples: the relative s.e. of an RMS over 7600 values is ~1 %).
+        rng = np.random.default_rng(7)
+        R, var = 8, 0.25
+        truth = np.linspace(0, 10, 19)[None, :] + np.zeros((400, 1))
+        a = truth + rng.normal(scale=math.sqrt(var / R), size=truth.shape)
+        b = truth + rng.normal(scale=math.sqrt(var / R), size=truth.shape)
+        v = np.full(truth.shape, var)
+        e = am.normalized_error(a, b, v, R, v, R)
+        self.assertAlmostEqual(e, 1.0, delta=0.1)
+        # A bias of 3 standard errors shows as ~sqrt(1 + 9) = 3.2.
+        e_biased = am.normalized_error(a + 3 * math.sqrt(2 * var / R), b, v, R, v, R)
+        self.assertAlmostEqual(e_biased, math.sqrt(10.0), delta=0.3)
+
+    def test_standard_error(self):
+        self.assertAlmostEqual(am.standard_error(np.full((3, 4), 4.0), 16), 0.5)
+
+    def test_speedup_accounting(self):
+        # Direct: 4 realizations x 100 time units in 400 s. CPI: same R, 100 time units in 80 s
+        # -> 5x. CPI with 2 realizations in 40 s covers half the realization-time: 5x too.
+        self.assertAlmostEqual(am.speedup(100, 80, 4, 100, 400, 4), 5.0)
+        self.assertAlmostEqual(am.speedup(100, 40, 2, 100, 400, 4), 5.0)
+        self.assertAlmostEqual(am.speedup(100, 400, 4, 100, 400, 4), 1.0)
+
+    def test_predicted_projection_noise(self):
+        # DT = W: the projection error is sqrt(12/n) sigma; n = 12 gives sigma itself.
+        self.assertAlmostEqual(am.predicted_projection_noise(10, 10, 12, 0.2), 0.2)
+        self.assertAlmostEqual(am.predicted_projection_noise(80, 10, 12, 0.2), 1.6)
+        self.assertTrue(math.isnan(am.predicted_projection_noise(10, 0, 12, 0.2)))
+
+    def test_pareto_front(self):
+        pts = [(1, 5), (2, 3), (3, 4), (4, 1), (5, 1)]
+        self.assertEqual(am.pareto_front(pts), [0, 1, 3])
+
+
+if __name__ == "__main__":
+    unittest.main()
