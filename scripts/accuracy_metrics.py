@@ -57,6 +57,29 @@ def predicted_projection_noise(dt_projective, window, samples_in_window, sigma):
     return dt_projective / window * math.sqrt(12.0 / samples_in_window) * sigma
 
 
+def temporal_noise(t, values, window):
+    """RMS residual of `values` (n x m) about least-squares lines fitted over consecutive
+    windows of length `window` [d_p]: the sample-to-sample noise a slope estimate sees. (The
+    spread between realizations is not it: a bed-to-bed offset that stays put does not disturb
+    a slope.)"""
+    t = np.asarray(t, float)
+    values = np.asarray(values, float)
+    res = []
+    start = t[0]
+    while start + window <= t[-1] + 1e-9:
+        sel = (t >= start - 1e-9) & (t <= start + window + 1e-9)
+        if sel.sum() >= 3:
+            tt = t[sel]
+            for j in range(values.shape[1]):
+                c = np.polyfit(tt, values[sel, j], 1)
+                res.append(values[sel, j] - np.polyval(c, tt))
+        start += window
+    if not res:
+        return math.nan
+    r = np.concatenate(res)
+    return float(np.sqrt(np.mean(r * r)))
+
+
 def pareto_front(points):
     """Indices of the (cost, error) points not dominated by another (lower cost and error)."""
     order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))

@@ -57,6 +57,17 @@ class Metrics(unittest.TestCase):
         self.assertAlmostEqual(am.predicted_projection_noise(80, 10, 12, 0.2), 1.6)
         self.assertTrue(math.isnan(am.predicted_projection_noise(10, 0, 12, 0.2)))
 
+    def test_temporal_noise(self):
+        # A linear trend plus white noise of s.d. 0.1: residuals about the local lines have an
+        # RMS of 0.1 sqrt((n-2)/n) (two fitted parameters per window of n = 21 samples): 0.095,
+        # within 5 % for 20 x 19 x 21 residuals. A pure trend has no temporal noise.
+        rng = np.random.default_rng(3)
+        t = np.arange(0, 200.01, 0.5)
+        trend = 0.05 * t[:, None] + np.linspace(0, 5, 19)[None, :]
+        self.assertAlmostEqual(am.temporal_noise(t, trend, 10.0), 0.0, places=10)
+        noisy = trend + rng.normal(scale=0.1, size=trend.shape)
+        self.assertAlmostEqual(am.temporal_noise(t, noisy, 10.0), 0.1 * math.sqrt(19 / 21), delta=0.005)
+
     def test_pareto_front(self):
         pts = [(1, 5), (2, 3), (3, 4), (4, 1), (5, 1)]
         self.assertEqual(am.pareto_front(pts), [0, 1, 3])
