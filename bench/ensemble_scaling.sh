@@ -18,7 +18,6 @@ cmake --build "$build" -j 2 --target efdem efdem_root_cost_benchmark > /dev/null
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-cat > "$work/bed.cfg" <<EOC
 effects = gravity pair_contact wall_contact gas_drag
 dt = 1e-4
 domain.lx = 15
@@ -40,7 +39,7 @@ EOC
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(lscpu | sed -n 's/^Model name: *//p') ($(nproc) cores)"
 echo "## (a) ensemble throughput, one 12,500-particle realization per rank, 1e4 steps each"
 for np in 1 2; do
-  mpirun -np $np --oversubscribe "$build/mpi_driver/efdem" "$work/bed.cfg" output.directory="$work" \
+  mpirun -np $np --oversubscribe "$build/mpi_driver/efdem" "$src/bench/scenes/reference_bed.cfg" output.directory="$work" \
     output.prefix=p$np > "$work/p$np.log" 2>&1
 done
 /usr/bin/python3 - "$work" <<'PY' | tee "$work/throughput"

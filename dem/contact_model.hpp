@@ -93,6 +93,19 @@ private:
     std::vector<PairTypeInfo> info_;
 };
 
+/// Calls f(Normal{}, Tangential{}) with the kernel types of the spec's sub-models: the one
+/// place where the run-time choice becomes compile-time types (one dispatch per loop, never per
+/// pair). \code with_contact_kernels(spec, [&](auto n, auto t) { loop<decltype(n), decltype(t)>(); }); \endcode
+template <class F>
+void with_contact_kernels(const ContactSpec& spec, F&& f) {
+    const bool hertz = spec.normal == NormalModel::hertz;
+    const bool history = spec.tangential == TangentialModel::history;
+    if (!hertz && history) f(HookeNormal{}, HistoryTangential{});
+    else if (!hertz) f(HookeNormal{}, NoTangential{});
+    else if (history) f(HertzNormal{}, HistoryTangential{});
+    else f(HertzNormal{}, NoTangential{});
+}
+
 /// Hooke: damping ratio zeta for restitution e, zeta = -ln e / sqrt(pi^2 + ln^2 e) (§5.2).
 double hooke_damping_ratio(double e);
 /// Hertz with Tsuji damping: the alpha with eta_n = alpha sqrt(m_eff kn) that gives

@@ -59,6 +59,22 @@ public:
     std::span<const SpeciesId> species() const { return species_; }
     std::span<const Tag> tag() const { return tag_; }
 
+    /// Raw pointers to what a contact or force kernel reads and writes, taken once per loop.
+    struct KernelView {
+        std::size_t n;
+        const Vec3* x;
+        const Vec3* v;
+        const Vec3* omega;
+        Vec3* force;
+        Vec3* torque;
+        const double* radius;
+        const SpeciesId* species;
+    };
+    KernelView kernel_view() {
+        return {size(),      x_.data(),      v_.data(),      omega_.data(),
+                f_.data(),   torque_.data(), radius_.data(), species_.data()};
+    }
+
     /// Bytes held by the arrays (for memory-per-particle reports).
     std::size_t bytes() const;
 

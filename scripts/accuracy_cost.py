@@ -28,52 +28,17 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import accuracy_metrics as am  # noqa: E402
 
-# The reduced bed of the study (the paper's model, 1,000 spheres in 7.5 x 7.5: 1/12 of the
-# particles), and the tiny bed of --quick (256 spheres, no settling).
-BED = """effects = gravity pair_contact wall_contact gas_drag
-dt = 1e-4
-seed = 1
-domain.lx = 7.5
-domain.ly = 7.5
-domain.lid = 150
-species.names = light heavy
-species.density = 1 2
-species.diameter = 1 1
-pair_contact.kn = 2e5
-pair_contact.restitution = 0.9
-pair_contact.mu = 0.1
-gas_drag.superficial_velocity = {us}
-bed.count = 500 500
-bed.settle.ke_threshold = 1e-5
-observe.interval = 0.5
-run.duration = {duration}
-cpi.warmup = 10
-cpi.healing = 10
-cpi.window = 10
-cpi.dt = 40
-"""
-TINY = """effects = gravity pair_contact wall_contact gas_drag
-dt = 1e-4
-seed = 1
-domain.lx = 4.28
-domain.ly = 4.28
-domain.lid = 60
-species.names = light heavy
-species.density = 1 2
-species.diameter = 1 1
-pair_contact.kn = 2e5
-pair_contact.restitution = 0.9
-pair_contact.mu = 0.1
-gas_drag.superficial_velocity = {us}
-bed.count = 128 128
-bed.settle.ke_threshold = 1e-5
-observe.interval = 0.25
-run.duration = {duration}
-cpi.warmup = 5
-cpi.healing = 3
-cpi.window = 3
-cpi.dt = 12
-"""
+# The scenes of the study are checked in; the study only overrides keys. Full study: the demo bed
+# (the paper's model, 1,000 spheres in 7.5 x 7.5: 1/12 of the particles). --quick: the tiny bed
+# of the driver tests (256 spheres in 4.28 x 4.28), settled.
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = {
+    False: (os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg"),
+            {"run.duration": 300, "cpi.warmup": 10, "cpi.healing": 10, "cpi.window": 10, "cpi.dt": 40}),
+    True: (os.path.join(HERE, "..", "tests", "scripts", "tiny_scene.cfg"),
+           {"bed.settle": "true", "bed.settle.ke_threshold": 1e-5, "run.duration": 40, "cpi.warmup": 5,
+            "cpi.healing": 3, "cpi.window": 3, "cpi.dt": 12}),
+}
 
 
 def study_runs(quick):
@@ -105,7 +70,7 @@ def study_runs(quick):
     return runs
 
 
-def run_efdem(args, scene, name, mode, R, overrides):
+def run_efdem(args, us, name, mode, R, overrides):
     h5 = os.path.join(args.out, name + ".h5")
     if os.path.exists(h5):
         try:
@@ -116,6 +81,8 @@ def run_efdem(args, scene, name, mode, R, overrides):
             pass
     np_ = min(R, args.np)
     per_rank = R // np_
+    scene, base = SCENES[args.quick]
+    overrides = {**base, "gas_drag.superficial_velocity": us, **overrides}
     cmd = ["mpirun", "-np", str(np_), "--oversubscribe", args.efdem, scene, f"mode={mode}",
            f"ensemble.realizations_per_rank={per_rank}", f"output.directory={args.out}",
            f"output.prefix={name}"] + [f"{k}={v}" for k, v in overrides.items()]
@@ -262,18 +229,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     args.out = os.path.abspath(args.out)
-    duration = 40 if args.quick else 300
-    template = TINY if args.quick else BED
-    scenes = {}
-    for us in (0.19, 0.41):
-        path = os.path.join(args.out, f"scene_{us}.cfg")
-        with open(path, "w") as f:
-            f.write(template.format(us=us, duration=duration))
-        scenes[us] = path
     t0 = time.time()
     print(f"accuracy_cost: {'quick' if args.quick else 'full'} study into {args.out}", flush=True)
     runs = study_runs(args.quick)
-    files = {name: run_efdem(args, scenes[us], name, mode, R, ov) for name, us, mode, R, ov in runs}
+    files = {name: run_efdem(args, us, name, mode, R, ov) for name, us, mode, R, ov in runs}
     loaded = {name: load(h5) for name, h5 in files.items()}
     refs = {us: loaded[f"ref_{us}"] for us in (0.19, 0.41) if f"ref_{us}" in loaded}
     rows = []

@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "dem/contact_history.hpp"
-#include "dem/contact_report.hpp"
 #include "dem/neighbor_list.hpp"
 
 namespace efdem::dem {
@@ -15,24 +14,16 @@ PairContact::PairContact(const EffectSetup& s)
     : PairContact(ContactSpec::from_params(s.scope, nullptr), s.species) {}
 
 PairContact::PairContact(const ContactSpec& spec, const SpeciesTable& species)
-    : table_(spec, species, ContactTable::Partner::particle), n_species_(species.size()) {}
+    : ContactEffect(spec, species, ContactTable::Partner::particle), n_species_(species.size()) {}
 
 Needs PairContact::needs() const {
     return {.neighbor_list = true,
-            .contact_history = table_.spec().tangential == TangentialModel::history};
+            .contact_history = has_history()};
 }
 
 template <class Normal, class Tangential>
 void PairContact::loop(ForceContext& ctx) const {
-    Particles& p = ctx.particles;
-    const std::size_t n = p.size();
-    const Vec3* x = p.x().data();
-    const Vec3* v = p.v().data();
-    const Vec3* w = p.omega().data();
-    Vec3* f = p.force().data();
-    Vec3* tq = p.torque().data();
-    const double* rad = p.radius().data();
-    const SpeciesId* sp = p.species().data();
+    const auto [n, x, v, w, f, tq, rad, sp] = ctx.particles.kernel_view();
     const std::uint32_t* off = ctx.neighbors->offsets().data();
     const NeighborList::Entry* ent = ctx.neighbors->entries().data();
     const Vec3* shift = ctx.neighbors->shifts();
@@ -76,13 +67,9 @@ void PairContact::loop(ForceContext& ctx) const {
 }
 
 void PairContact::add_forces(ForceContext& ctx) {
-    const ContactSpec& s = table_.spec();
-    const bool hertz = s.normal == NormalModel::hertz;
-    const bool history = s.tangential == TangentialModel::history;
-    if (!hertz && history) loop<HookeNormal, HistoryTangential>(ctx);
-    else if (!hertz) loop<HookeNormal, NoTangential>(ctx);
-    else if (history) loop<HertzNormal, HistoryTangential>(ctx);
-    else loop<HertzNormal, NoTangential>(ctx);
+    with_contact_kernels(table_.spec(), [&](auto normal, auto tangential) {
+        loop<decltype(normal), decltype(tangential)>(ctx);
+    });
 }
 
 /// Calls f(i, j, k, d, radsum) for every touching listed pair.
@@ -127,8 +114,6 @@ void PairContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const 
     });
 }
 
-std::string PairContact::time_scale_label() const { return shortest_contact_label(table_); }
 
-void PairContact::describe(EffectReport& r) const { describe_contact_table(table_, r); }
 
 }  // namespace efdem::dem

@@ -3,8 +3,7 @@
 /// PairContact: soft-sphere particle-particle contact with sub-models chosen by keyword
 /// (dem/contact_model.hpp); the kernel is dem/contact_laws.hpp. Doc: docs/effects/pair_contact.md.
 
-#include "dem/contact_model.hpp"
-#include "dem/effect.hpp"
+#include "dem/contact_effect.hpp"
 
 namespace efdem::dem {
 
@@ -14,7 +13,7 @@ namespace efdem::dem {
  * The sub-model combination (hooke|hertz) x (none|history) is dispatched once per step to a
  * loop instantiated for that combination: no virtual call or branch on the model per pair.
  */
-class PairContact final : public Effect {
+class PairContact final : public ContactEffect {
 public:
     explicit PairContact(const EffectSetup& setup);
     PairContact(const ContactSpec& spec, const SpeciesTable& species);
@@ -22,18 +21,13 @@ public:
     std::string_view name() const override { return "pair_contact"; }
     Needs needs() const override;
     void add_forces(ForceContext& ctx) override;
-    double time_scale() const override { return table_.min_contact_time(); }
-    std::string time_scale_label() const override;
     double potential_energy(const ForceContext& ctx) const override;
     void add_thermo(const ForceContext& ctx, ThermoStats& stats) const override;
-    void describe(EffectReport& r) const override;
-    const ContactTable& table() const { return table_; }
 
 private:
     template <class Normal, class Tangential>
     void loop(ForceContext& ctx) const;
 
-    ContactTable table_;
     std::size_t n_species_;
 };
 

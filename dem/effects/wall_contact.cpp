@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 
 #include "dem/contact_history.hpp"
-#include "dem/contact_report.hpp"
 
 namespace efdem::dem {
 
@@ -23,23 +22,15 @@ ContactSpec wall_spec(const EffectSetup& s) {
 WallContact::WallContact(const EffectSetup& s) : WallContact(wall_spec(s), s.species) {}
 
 WallContact::WallContact(const ContactSpec& spec, const SpeciesTable& species)
-    : table_(spec, species, ContactTable::Partner::wall) {}
+    : ContactEffect(spec, species, ContactTable::Partner::wall) {}
 
 Needs WallContact::needs() const {
-    return {.contact_history = table_.spec().tangential == TangentialModel::history};
+    return {.contact_history = has_history()};
 }
 
 template <class Normal, class Tangential>
 void WallContact::loop(ForceContext& ctx, int wall, double z_wall, double normal_sign) const {
-    Particles& p = ctx.particles;
-    const std::size_t n = p.size();
-    const Vec3* x = p.x().data();
-    const Vec3* v = p.v().data();
-    const Vec3* w = p.omega().data();
-    Vec3* f = p.force().data();
-    Vec3* tq = p.torque().data();
-    const double* rad = p.radius().data();
-    const SpeciesId* sp = p.species().data();
+    const auto [n, x, v, w, f, tq, rad, sp] = ctx.particles.kernel_view();
     Vec3* hist = nullptr;
     if constexpr (Tangential::kHistory) hist = ctx.history->wall(wall).data();
     const Vec3 nrm{0.0, 0.0, normal_sign};  // from the wall into the particle
@@ -59,17 +50,12 @@ void WallContact::loop(ForceContext& ctx, int wall, double z_wall, double normal
 }
 
 void WallContact::add_forces(ForceContext& ctx) {
-    const ContactSpec& s = table_.spec();
-    const bool hertz = s.normal == NormalModel::hertz;
-    const bool history = s.tangential == TangentialModel::history;
-    auto run = [&](int wall, double z, double sign) {
-        if (!hertz && history) loop<HookeNormal, HistoryTangential>(ctx, wall, z, sign);
-        else if (!hertz) loop<HookeNormal, NoTangential>(ctx, wall, z, sign);
-        else if (history) loop<HertzNormal, HistoryTangential>(ctx, wall, z, sign);
-        else loop<HertzNormal, NoTangential>(ctx, wall, z, sign);
-    };
-    run(ContactHistory::kFloor, 0.0, 1.0);
-    if (ctx.domain.has_lid()) run(ContactHistory::kLid, ctx.domain.lid_height, -1.0);
+    with_contact_kernels(table_.spec(), [&](auto normal, auto tangential) {
+        using N = decltype(normal);
+        using T = decltype(tangential);
+        loop<N, T>(ctx, ContactHistory::kFloor, 0.0, 1.0);
+        if (ctx.domain.has_lid()) loop<N, T>(ctx, ContactHistory::kLid, ctx.domain.lid_height, -1.0);
+    });
 }
 
 double WallContact::potential_energy(const ForceContext& ctx) const {
@@ -107,8 +93,6 @@ void WallContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const 
     }
 }
 
-std::string WallContact::time_scale_label() const { return shortest_contact_label(table_); }
 
-void WallContact::describe(EffectReport& r) const { describe_contact_table(table_, r); }
 
 }  // namespace efdem::dem

@@ -5,12 +5,11 @@
 /// (m_eff = m_i, R_eff = r_i), with the same sub-models as pair contact. Doc:
 /// docs/effects/wall_contact.md.
 
-#include "dem/contact_model.hpp"
-#include "dem/effect.hpp"
+#include "dem/contact_effect.hpp"
 
 namespace efdem::dem {
 
-class WallContact final : public Effect {
+class WallContact final : public ContactEffect {
 public:
     explicit WallContact(const EffectSetup& setup);
     WallContact(const ContactSpec& spec, const SpeciesTable& species);
@@ -18,18 +17,12 @@ public:
     std::string_view name() const override { return "wall_contact"; }
     Needs needs() const override;
     void add_forces(ForceContext& ctx) override;
-    double time_scale() const override { return table_.min_contact_time(); }
-    std::string time_scale_label() const override;
     double potential_energy(const ForceContext& ctx) const override;
     void add_thermo(const ForceContext& ctx, ThermoStats& stats) const override;
-    void describe(EffectReport& r) const override;
-    const ContactTable& table() const { return table_; }
 
 private:
     template <class Normal, class Tangential>
     void loop(ForceContext& ctx, int wall, double z_wall, double normal_sign) const;
-
-    ContactTable table_;
 };
 
 }  // namespace efdem::dem
