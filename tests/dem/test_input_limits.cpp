@@ -17,18 +17,7 @@ using namespace efdem::dem;
 
 namespace {
 const std::string kScene =
-    "dt = 1e-4\n"
-    "effects = gravity pair_contact wall_contact\n"
-    "domain.lx = 4\n"
-    "domain.ly = 4\n"
-    "species.names = light heavy\n"
-    "species.density = 1 2\n"
-    "species.diameter = 1 1\n"
-    "bed.count = 20 20\n"
-    "bed.settle = false\n"
-    "pair_contact.kn = 2e5\n"
-    "pair_contact.restitution = 0.9\n"
-    "pair_contact.mu = 0.1\n";
+    test::kSmallBinaryScene + "effects = gravity pair_contact wall_contact\n";
 
 /// Builds a realization of kScene with `overrides` (key=value, in order) and returns the
 /// InputError it must raise.

@@ -152,15 +152,18 @@ TEST_CASE("stiff contacts, closed box without gravity: mechanical energy never g
     // periodic 6 x 6, for 4 time units: several hundred collisions. Sampled every 10 steps.
     const double kn = GENERATE(2e6, 2e7);
     const SpeciesTable species = test::binary_species();
-    const Domain domain{6.0, 6.0, 6.0};
+    auto closed_box = [&](const ContactSpec& spec, double dt, std::uint64_t seed) {
+        test::EffectList fx;
+        fx.pair(spec, species).wall(spec, species);
+        return test::make_system(species, Domain{6.0, 6.0, 6.0},
+                                 random_gas(80, 6, 0.6, 5.4, 1.0, species, seed), std::move(fx),
+                                 dt);
+    };
     SECTION("elastic and frictionless (e = 1): energy conserved") {
         ContactSpec spec = contact_with_kn(kn, TangentialModel::none);
         spec.restitution = 1.0;
         const double dt = light_light_tc(spec, species) / 20;
-        test::EffectList fx;
-        fx.pair(spec, species).wall(spec, species);
-        System s = test::make_system(species, domain, random_gas(80, 6, 0.6, 5.4, 1.0, species, 3),
-                                     std::move(fx), dt);
+        System s = closed_box(spec, dt, 3);
         const double e0 = mechanical_energy(s);
         double worst = 0;
         const long steps = std::lround(4.0 / dt);
@@ -180,10 +183,7 @@ TEST_CASE("stiff contacts, closed box without gravity: mechanical energy never g
     SECTION("paper model (e = 0.9, mu = 0.1): energy never increases") {
         const ContactSpec spec = contact_with_kn(kn);
         const double dt = light_light_tc(spec, species) / 20;
-        test::EffectList fx;
-        fx.pair(spec, species).wall(spec, species);
-        System s = test::make_system(species, domain, random_gas(80, 6, 0.6, 5.4, 1.0, species, 4),
-                                     std::move(fx), dt);
+        System s = closed_box(spec, dt, 4);
         const double e0 = mechanical_energy(s);
         double lowest = e0, worst_rise = 0;
         const long steps = std::lround(4.0 / dt);
