@@ -12,6 +12,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace efdem {
 
@@ -19,6 +20,12 @@ namespace efdem {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitInputError = 2;
 inline constexpr int kExitRuntimeFailure = 3;
+
+/// How a piece of user input is quoted inside a message: control bytes and bytes that are not
+/// printable ASCII or part of valid UTF-8 are shown as \xNN (a terminal never receives raw
+/// escapes or NULs), and text longer than `max_chars` is cut, saying how long it was, so that a
+/// runaway value cannot bury the message.
+std::string quote_for_message(std::string_view text, std::size_t max_chars = 120);
 
 /// Where a value came from: a file and a 1-based line, or the command line (line 0, file
 /// "<command line>"), or nowhere (empty file: a required key that is missing).

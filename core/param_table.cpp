@@ -116,13 +116,13 @@ std::optional<Int> parse_integer(const std::string& tok, std::string& problem) {
     const auto [ptr, ec] = std::from_chars(first, last, v);
     if (ec == std::errc() && ptr == last && first != last) return v;
     // Accept integral values written as reals ("1e6", "2.0"): users write step counts that way.
+    // The range test is against powers of two, which doubles hold exactly: max() itself rounds
+    // up to 2^digits as a double, and converting 2^digits back to Int would be undefined.
     std::string real_problem;
     const auto r = parse_real(tok, real_problem);
-    if (r && std::trunc(*r) == *r &&
-        *r >= static_cast<double>(std::numeric_limits<Int>::min()) &&
-        *r <= static_cast<double>(std::numeric_limits<Int>::max())) {
-        return static_cast<Int>(*r);
-    }
+    const double lo = static_cast<double>(std::numeric_limits<Int>::min());
+    const double hi_excl = std::ldexp(1.0, std::numeric_limits<Int>::digits);
+    if (r && std::trunc(*r) == *r && *r >= lo && *r < hi_excl) return static_cast<Int>(*r);
     problem = (r && std::trunc(*r) == *r) ? "is out of range" : "is not an integer";
     return std::nullopt;
 }
@@ -176,7 +176,12 @@ struct ValueTraits<double> {
 
 template <class Int>
 struct IntTraits {
-    static std::string expected(const Bounds& b) { return with_bounds("an integer", b); }
+    static std::string expected(const Bounds& b) {
+        if (b.unbounded())
+            return fmt::format("an integer from {} to {}", std::numeric_limits<Int>::min(),
+                               std::numeric_limits<Int>::max());
+        return with_bounds("an integer", b);
+    }
     static std::optional<Int> parse(const std::vector<std::string>& toks, const Bounds& b,
                                     std::string& problem) {
         if (toks.size() != 1) {
@@ -238,11 +243,11 @@ struct ValueTraits<std::vector<double>> {
         for (const auto& t : toks) {
             auto v = parse_real(t, problem);
             if (!v) {
-                problem = fmt::format("element '{}' {}", t, problem);
+                problem = fmt::format("element '{}' {}", quote_for_message(t, 40), problem);
                 return std::nullopt;
             }
             if (!b.contains(*v)) {
-                problem = fmt::format("element '{}' is out of range", t);
+                problem = fmt::format("element '{}' is out of range", quote_for_message(t, 40));
                 return std::nullopt;
             }
             out.push_back(*v);
@@ -311,7 +316,8 @@ ParamTable ParamTable::from_text(std::string_view text, std::string file,
         if (line.empty()) continue;
         const auto eq = line.find('=');
         if (eq == std::string_view::npos)
-            throw InputError(where, fmt::format("expected 'key = value', got '{}'", line));
+            throw InputError(
+                where, fmt::format("expected 'key = value', got '{}'", quote_for_message(line)));
         const std::string key(trim(line.substr(0, eq)));
         const std::string value(trim(line.substr(eq + 1)));
         if (!valid_key(key))
@@ -351,7 +357,8 @@ void ParamTable::add_override(std::string_view assignment) {
     const SourceLocation where{"<command line>", 0};
     const auto eq = assignment.find('=');
     if (eq == std::string_view::npos)
-        throw InputError(where, fmt::format("expected key=value, got '{}'", assignment));
+        throw InputError(
+            where, fmt::format("expected key=value, got '{}'", quote_for_message(assignment)));
     const std::string key(trim(assignment.substr(0, eq)));
     const std::string value(trim(assignment.substr(eq + 1)));
     if (!valid_key(key))
@@ -391,6 +398,11 @@ std::string ParamTable::closest_key(std::string_view key, bool among_queried) co
     std::size_t best_d = std::max<std::size_t>(2, key.size() / 4) + 1;
     auto consider = [&](const std::string& cand) {
         if (cand == key) return;
+        // The edit distance is at least the difference in length: skip the quadratic work
+        // for candidates that cannot win (a runaway key must not make an error message slow).
+        const std::size_t gap =
+            cand.size() > key.size() ? cand.size() - key.size() : key.size() - cand.size();
+        if (gap >= best_d) return;
         const std::size_t d = edit_distance(key, cand);
         if (d < best_d) {
             best_d = d;
@@ -425,9 +437,12 @@ void ParamTable::check_all_used(const UnusedKeyHint& hint) const {
     }
     std::string problem = "was never read: " + advice;
     if (unused.size() > 1) {
+        constexpr std::size_t kListed = 8;  // a long tail of unused keys would bury the message
         std::vector<std::string> rest;
-        for (std::size_t i = 1; i < unused.size(); ++i) rest.push_back(unused[i]->key);
-        problem += fmt::format(" ({} more unused: {})", rest.size(), join(rest));
+        for (std::size_t i = 1; i < unused.size() && rest.size() < kListed; ++i)
+            rest.push_back(quote_for_message(unused[i]->key, 60));
+        if (unused.size() - 1 > kListed) rest.push_back("...");
+        problem += fmt::format(" ({} more unused: {})", unused.size() - 1, join(rest));
     }
     throw InputError(first.where, first.key, first.value, problem,
                      "keys read by the top-level settings and by the effects in 'effects'");

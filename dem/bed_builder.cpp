@@ -37,6 +37,45 @@ double lattice_top(const BedSpec& bed, const DemScene& scene) {
     const long layers = (g.n + g.nx * g.ny - 1) / (g.nx * g.ny);
     return g.z0 + static_cast<double>(layers - 1) * g.az + bed.jitter + 0.5 * scene.species.max_diameter();
 }
+/// Duration of the free-fall stage of settling: the top of a lattice `top` high falls onto
+/// the bed (g = 1), plus one time unit.
+double free_fall_time(double top) {
+    return std::sqrt(2.0 * top) + 1.0;
+}
+}  // namespace
+
+namespace {
+/// Reads bed.count: one whole number per species, at least one particle, at most
+/// kMaxRealizationParticles in all.
+std::vector<long> read_counts(const Params& p, const DemScene& scene) {
+    const auto counts = p.get<std::vector<double>>("count", Bounds::non_negative());
+    if (counts.size() != scene.species.size())
+        p.fail("count",
+               fmt::format("has {} values for {} species", counts.size(), scene.species.size()),
+               "one particle count per name in species.names");
+    const std::string allowed =
+        fmt::format("whole numbers >= 0 adding up to 1 .. {} particles", kMaxRealizationParticles);
+    double total = 0;
+    for (double c : counts) {
+        if (std::trunc(c) != c) p.fail("count", "is not a list of whole numbers", allowed);
+        total += c;
+    }
+    if (total < 1) p.fail("count", "adds up to no particles", allowed);
+    if (total > static_cast<double>(kMaxRealizationParticles))
+        p.fail("count",
+               fmt::format("adds up to {:g} particles, more than one realization may hold", total),
+               allowed);
+    return {counts.begin(), counts.end()};
+}
+
+/// Fails on `key` when a settling stage of length `time` needs more than kMaxSettleSteps steps.
+void check_settle_steps(const Params& p, const char* key, double time, double dt) {
+    const double steps = std::ceil(time / dt);
+    if (!(steps <= static_cast<double>(kMaxSettleSteps)))
+        p.fail(key, fmt::format("makes a settling stage of {:.3g} steps of dt = {:g}", steps, dt),
+               fmt::format("at most {} steps per settling stage, i.e. <= {:.4g} time units",
+                           kMaxSettleSteps, static_cast<double>(kMaxSettleSteps) * dt));
+}
 }  // namespace
 
 BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
@@ -44,23 +83,17 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
     const std::string source = p.get_or_choice("source", "lattice", {"lattice", "lammps_data"});
     if (source == "lattice") {
         b.source = Source::lattice;
-        const auto counts = p.get<std::vector<double>>("count", Bounds::non_negative());
-        if (counts.size() != scene.species.size())
-            p.fail("count", fmt::format("has {} values for {} species", counts.size(), scene.species.size()),
-                   "one particle count per name in species.names");
-        double total = 0;
-        for (double c : counts) {
-            if (std::trunc(c) != c || c > 1e9) p.fail("count", "is not a list of whole numbers", "integers >= 0");
-            b.count.push_back(static_cast<long>(c));
-            total += c;
-        }
-        if (total < 1) p.fail("count", "adds up to no particles", "a total of at least 1");
-        b.spacing = p.get_or<double>("spacing", 1.07, Bounds::at_least(scene.species.max_diameter()));
+        b.count = read_counts(p, scene);
+        const double d_max = scene.species.max_diameter();
+        const double l_min = std::min(scene.domain.lx, scene.domain.ly);
+        b.spacing =
+            p.get_or<double>("spacing", 1.07, Bounds::closed(d_max, std::max(d_max, l_min)));
         b.jitter = p.get_or<double>("jitter", 0.03, Bounds::non_negative());
-        if (b.jitter >= 0.5 * (b.spacing - scene.species.max_diameter()) && b.jitter > 0)
+        if (b.jitter >= 0.5 * (b.spacing - d_max) && b.jitter > 0)
             p.fail("jitter", "lets neighbouring lattice spheres overlap",
-                   fmt::format("< (spacing - diameter)/2 = {:g}", 0.5 * (b.spacing - scene.species.max_diameter())));
-        b.velocity_rms = p.get_or<double>("velocity_rms", 0.2, Bounds::non_negative());
+                   fmt::format("< (spacing - diameter)/2 = {:g}", 0.5 * (b.spacing - d_max)));
+        b.velocity_rms =
+            p.get_or<double>("velocity_rms", 0.2, Bounds::closed(0.0, kMaxDomainLength));
         const std::string layering = p.get_or_choice("layering", "mixed", {"mixed", "light_on_top", "heavy_on_top"});
         b.layering = layering == "light_on_top"   ? Layering::light_on_top
                      : layering == "heavy_on_top" ? Layering::heavy_on_top
@@ -70,6 +103,12 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
             p.fail("count", fmt::format("needs a lattice {:.4g} high, above the lid at domain.lid = {:g}",
                                         top, scene.domain.lid_height),
                    "fewer particles, a wider box or a higher domain.lid");
+        if (top > kMaxDomainLength)
+            p.fail("count", fmt::format("needs a lattice {:.4g} high", top),
+                   fmt::format(
+                       "a lattice at most {:g} high: fewer particles, a wider box or a smaller "
+                       "bed.spacing",
+                       kMaxDomainLength));
         b.settle = p.get_or<bool>("settle", true);
         // The settling protocol's keys are read (and checked) even with settle = false, so that
         // a scene can be run unsettled with one override, without editing out its settle block.
@@ -78,6 +117,13 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
         b.settle_damped_time = s.get_or<double>("damped_time", 7.2, Bounds::non_negative());
         b.settle_ke_threshold = s.get_or<double>("ke_threshold", 1e-6, Bounds::positive());
         b.settle_max_time = s.get_or<double>("max_time", 100.0, Bounds::positive());
+        if (b.settle) {
+            // Each settling stage is a bounded number of steps, checked here so that
+            // `efdem --check` reports it without settling.
+            check_settle_steps(p, "count", free_fall_time(top), scene.dt);
+            check_settle_steps(s, "damped_time", b.settle_damped_time, scene.dt);
+            check_settle_steps(s, "max_time", b.settle_max_time, scene.dt);
+        }
     } else {
         b.source = Source::lammps_data;
         b.file = p.get_path("file");
@@ -150,7 +196,7 @@ Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& sc
     System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
     const auto steps = [&](double t) { return static_cast<long>(std::ceil(t / scene.dt)); };
 
-    sys.run(steps(std::sqrt(2.0 * top) + 1.0));  // free fall: the top layer reaches the bed
+    sys.run(steps(free_fall_time(top)));  // the top layer reaches the bed
     damping->set_gamma(bed.settle_damping);
     sys.run(steps(bed.settle_damped_time));
     damping->set_gamma(0.0);

@@ -9,8 +9,9 @@
 /// | key                    | meaning                                               | default   |
 /// |------------------------|-------------------------------------------------------|-----------|
 /// | source                 | `lattice` or `lammps_data`                            | lattice   |
-/// | count                  | particles per species (lattice), one per species name | required  |
-/// | spacing                | lattice spacing target; the box is filled with        | 1.07      |
+/// | count                  | particles per species (lattice), one per species name;| required  |
+/// |                        | at most kMaxRealizationParticles (1e6) in all         |           |
+/// | spacing                | lattice spacing target (<= box width); the box is     | 1.07      |
 /// |                        | floor(l/spacing) sites per row, spacing l/that        |           |
 /// | jitter                 | uniform random displacement +- jitter per coordinate  | 0.03      |
 /// | velocity_rms           | rms speed of the initial Gaussian velocities          | 0.2       |
@@ -37,6 +38,9 @@
 #include "dem/scene.hpp"
 
 namespace efdem::dem {
+
+/// Most time steps of one settling stage (free fall, damped, undamped up to settle.max_time).
+inline constexpr long kMaxSettleSteps = 1'000'000'000;
 
 struct BedSpec {
     enum class Source { lattice, lammps_data } source = Source::lattice;

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "core/bounds.hpp"
 #include "dem/contact_laws.hpp"
 #include "dem/species.hpp"
 
@@ -34,6 +35,10 @@ class Params;
 }
 
 namespace efdem::dem {
+
+/// Restitution allowed with normal = hertz. Tsuji's damping constant is found by simulating a
+/// collision; below e = 0.01 the rebound takes very long to come and the search is slow.
+inline const Bounds kHertzRestitutionRange = Bounds::closed(0.01, 1.0);
 
 enum class NormalModel { hooke, hertz };
 enum class DampingModel { restitution, gamma, none };
@@ -61,8 +66,21 @@ struct PairTypeInfo {
     double m_eff = 0;           ///< effective mass [rho_s d_p^3]
     ContactCoeffs coeffs;       ///< what the kernel uses
     double restitution = 1;     ///< resulting e (0 when overdamped)
-    double contact_time = 0;    ///< duration of a head-on contact [sqrt(d_p/g)] (hertz: at v_rel = 1)
+    /// Time scale the time step must resolve [sqrt(d_p/g)]: the duration of a head-on contact
+    /// (hertz: at v_rel = 1), or for hooke the damping time 2 pi m_eff/eta_n when that is
+    /// shorter (zeta > 1/sqrt(2), e < 0.043; overdamped contacts never end).
+    double contact_time = 0;
 };
+
+/// Hooke: damping ratio zeta for restitution e, zeta = -ln e / sqrt(pi^2 + ln^2 e) (§5.2).
+double hooke_damping_ratio(double e);
+/// Hertz with Tsuji damping: the alpha with eta_n = alpha sqrt(m_eff kn) that gives
+/// restitution e, and the dimensionless contact duration; solved numerically (RK4 + bisection).
+struct HertzDamping {
+    double alpha;
+    double contact_time;  ///< in units of tau = sqrt(m/k') L^(-1/4), L = (v^2 m/k')^(2/5)
+};
+HertzDamping hertz_tsuji_damping(double e);
 
 /**
  * \brief Coefficients for every species pair (or every species against a wall).
@@ -88,6 +106,7 @@ private:
     PairTypeInfo derive(const std::string& label, double m_eff, double r_eff) const;
 
     ContactSpec spec_;
+    HertzDamping hertz_{};  ///< Tsuji damping for hertz (depends only on e)
     std::size_t n_;
     std::vector<ContactCoeffs> coeffs_;
     std::vector<PairTypeInfo> info_;
@@ -105,15 +124,5 @@ void with_contact_kernels(const ContactSpec& spec, F&& f) {
     else if (history) f(HertzNormal{}, HistoryTangential{});
     else f(HertzNormal{}, NoTangential{});
 }
-
-/// Hooke: damping ratio zeta for restitution e, zeta = -ln e / sqrt(pi^2 + ln^2 e) (§5.2).
-double hooke_damping_ratio(double e);
-/// Hertz with Tsuji damping: the alpha with eta_n = alpha sqrt(m_eff kn) that gives
-/// restitution e, and the dimensionless contact duration; solved numerically (RK4 + bisection).
-struct HertzDamping {
-    double alpha;
-    double contact_time;  ///< in units of tau = sqrt(m/k') L^(-1/4), L = (v^2 m/k')^(2/5)
-};
-HertzDamping hertz_tsuji_damping(double e);
 
 }  // namespace efdem::dem

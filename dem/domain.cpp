@@ -6,9 +6,10 @@ namespace efdem::dem {
 
 Domain Domain::from_params(const Params& p) {
     Domain d;
-    d.lx = p.get<double>("lx", Bounds::positive());
-    d.ly = p.get<double>("ly", Bounds::positive());
-    if (p.contains("lid")) d.lid_height = p.get<double>("lid", Bounds::positive());
+    const Bounds length = Bounds::open_closed(0.0, kMaxDomainLength);
+    d.lx = p.get<double>("lx", length);
+    d.ly = p.get<double>("ly", length);
+    if (p.contains("lid")) d.lid_height = p.get<double>("lid", length);
     return d;
 }
 

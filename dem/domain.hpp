@@ -17,6 +17,11 @@ class Params;
 
 namespace efdem::dem {
 
+/// Largest box length and lid height [d_p]. Positions are doubles: below 1e6 they keep an
+/// absolute resolution of about 1e-10 d_p, far finer than the overlaps (1e-4 .. 1e-3 d_p) that
+/// the contact forces are computed from. Beyond it contact forces lose digits.
+inline constexpr double kMaxDomainLength = 1e6;
+
 struct Domain {
     double lx = 1.0;  ///< periodic length in x [d_p]
     double ly = 1.0;  ///< periodic length in y [d_p]
@@ -41,7 +46,8 @@ struct Domain {
         return d;
     }
 
-    /// Reads `domain.lx`, `domain.ly` (required, > 0) and `domain.lid` (optional height > 0).
+    /// Reads `domain.lx`, `domain.ly` (required) and `domain.lid` (optional height), each in
+    /// (0, kMaxDomainLength].
     static Domain from_params(const Params& scope);
 };
 

@@ -27,26 +27,38 @@ bool NeighborList::needs_rebuild(const Particles& p) const {
 
 void NeighborList::bin(const Particles& p, const Domain& domain, std::span<const Vec3> x) {
     const std::size_t n = p.size();
-    nx_ = std::max(1, static_cast<int>(std::floor(domain.lx / cutoff_)));
-    ny_ = std::max(1, static_cast<int>(std::floor(domain.ly / cutoff_)));
+    double z_lo = 0.0, z_hi = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!all_finite(x[i]))
+            throw RuntimeFailure("particle " + std::to_string(p.tag()[i]) +
+                                 " has a non-finite position: the simulation has blown up");
+        z_lo = i == 0 ? x[i].z : std::min(z_lo, x[i].z);
+        z_hi = i == 0 ? x[i].z : std::max(z_hi, x[i].z);
+    }
+    if (!std::isfinite(z_hi - z_lo))
+        throw RuntimeFailure(
+            "particles span an impossible height range: the simulation has blown up");
+    // Cells at least `cutoff` wide in each direction (so that the 27 neighbouring cells hold
+    // every partner), counted in doubles: a wide box or a tall, sparse column must not overflow
+    // an int or allocate far more cells than particles. If the grid would exceed 2 n + 4096 cells,
+    // its largest dimension is halved until it fits; coarser cells only cost extra distance
+    // tests, the list is the same.
+    double cells[3] = {std::max(1.0, std::floor(domain.lx / cutoff_)),
+                       std::max(1.0, std::floor(domain.ly / cutoff_)),
+                       std::floor((z_hi - z_lo) / cutoff_) + 1.0};
+    const double budget = 2.0 * static_cast<double>(n) + 4096.0;
+    EFDEM_ASSERT(std::isfinite(cells[0] * cells[1]));
+    while (cells[0] * cells[1] * cells[2] > budget) {
+        double& largest = *std::max_element(cells, cells + 3);
+        largest = std::max(1.0, std::floor(0.5 * largest));
+    }
+    nx_ = static_cast<int>(cells[0]);
+    ny_ = static_cast<int>(cells[1]);
+    nz_ = static_cast<int>(cells[2]);
     cell_x_ = domain.lx / nx_;
     cell_y_ = domain.ly / ny_;
-    double z_lo = 0.0, z_hi = 0.0;
-    if (n > 0) {
-        z_lo = z_hi = x[0].z;
-        for (std::size_t i = 1; i < n; ++i) {
-            z_lo = std::min(z_lo, x[i].z);
-            z_hi = std::max(z_hi, x[i].z);
-        }
-    }
-    cell_z_ = cutoff_;
+    cell_z_ = std::max(cutoff_, (z_hi - z_lo) / nz_);
     z_lo_ = z_lo;
-    const double z_cells = std::floor((z_hi - z_lo) / cell_z_) + 1.0;
-    if (!(z_cells < 1e7))
-        throw RuntimeFailure("particles span an impossible height range (z from " +
-                             std::to_string(z_lo) + " to " + std::to_string(z_hi) +
-                             "): the simulation has blown up");
-    nz_ = static_cast<int>(z_cells);
     const std::size_t ncell = static_cast<std::size_t>(nx_) * ny_ * nz_;
     cell_of_.resize(n);
     cell_start_.assign(ncell + 1, 0);

@@ -18,6 +18,12 @@
 
 namespace efdem::dem {
 
+/// Most particles one realization may hold (bed.count in all, or the atoms of bed.file). A
+/// realization runs serially on one rank, and the paper's bed has 12,500 particles; a million
+/// takes ~0.3 GB and seconds per hundred steps, so a larger bed is almost certainly a typo,
+/// and refusing it keeps `efdem --check` from allocating it.
+inline constexpr long kMaxRealizationParticles = 1'000'000;
+
 using Index = std::uint32_t;  ///< particle index in the arrays (not stable; see tag)
 using Tag = std::int64_t;     ///< permanent particle id
 

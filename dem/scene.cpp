@@ -36,10 +36,11 @@ std::vector<std::unique_ptr<Effect>> make_effects(const DemScene& scene, const P
         const std::string& name = scene.effect_names[k];
         for (std::size_t j = 0; j < k; ++j)
             if (scene.effect_names[j] == name)
-                root.fail("effects", "lists '" + name + "' twice", "each effect at most once");
+                root.fail("effects", "lists '" + quote_for_message(name) + "' twice",
+                          "each effect at most once");
         const auto* entry = registry.find(name);
         if (!entry)
-            root.fail("effects", "names an unknown effect '" + name + "'",
+            root.fail("effects", "names an unknown effect '" + quote_for_message(name) + "'",
                       "known effects: " + registry.names_joined());
         const EffectSetup setup{root.scope(name), root, scene.species, scene.domain,
                                 scene.effect_names};
@@ -81,6 +82,29 @@ std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::stri
     return fmt::format("is '{}' listed in 'effects'?", scope);
 }
 
+namespace {
+/// Refuses an initial bed that the first health check of the run would stop (System::run checks
+/// every SystemOptions::health_check_every steps): better at set-up, where nothing is lost, than
+/// after the first thousand steps. Lattice beds cannot overlap (bed.jitter is bounded); a LAMMPS
+/// data file can.
+void check_initial_state(const System& sys, const BedSpec& bed, const Params& bed_scope,
+                         const SystemOptions& options) {
+    const char* key = bed.source == BedSpec::Source::lammps_data ? "file" : "source";
+    const ThermoStats s = sys.thermo_stats();
+    if (s.max_overlap > options.max_overlap_fraction)
+        bed_scope.fail(
+            key,
+            fmt::format("starts with an overlap of {:.3g} diameters, beyond the limit of {:g} at "
+                        "which the health check stops a run",
+                        s.max_overlap, options.max_overlap_fraction),
+            fmt::format("initial overlaps up to {:g} of the pair's diameter (or of the diameter, "
+                        "at a wall): a looser packing",
+                        options.max_overlap_fraction));
+    if (const auto problem = sys.health_problem())
+        bed_scope.fail(key, "gives an initial state the run would stop at: " + *problem);
+}
+}  // namespace
+
 System build_system(const Params& root, const RealizationSpec& spec) {
     DemScene scene = DemScene::from_params(root);
     auto effects = make_effects(scene, root);
@@ -92,7 +116,9 @@ System build_system(const Params& root, const RealizationSpec& spec) {
     options.dt = scene.dt;
     options.skin = scene.skin;
     options.realization = spec.realization;
-    return System(scene.species, scene.domain, std::move(particles), std::move(effects), options);
+    System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
+    check_initial_state(sys, bed, root.scope("bed"), options);
+    return sys;
 }
 
 }  // namespace efdem::dem

@@ -1,6 +1,7 @@
 #include "dem/species.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <numbers>
 
 #include "core/contracts.hpp"
@@ -12,14 +13,29 @@ SpeciesTable::SpeciesTable(std::vector<Species> species) : species_(std::move(sp
     EFDEM_EXPECTS(!species_.empty() && species_.size() <= 255);
 }
 
+namespace {
+bool valid_name(const std::string& name) {
+    if (name.empty() || name.size() > 32) return false;
+    return std::all_of(name.begin(), name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+    });
+}
+}  // namespace
+
 SpeciesTable SpeciesTable::from_params(const Params& p) {
     const auto names = p.get<std::vector<std::string>>("names");
-    const auto density = p.get<std::vector<double>>("density", Bounds::positive());
-    const auto diameter = p.get<std::vector<double>>("diameter", Bounds::positive());
+    const auto density = p.get<std::vector<double>>("density", kDensityRange);
+    const auto diameter = p.get<std::vector<double>>("diameter", kDiameterRange);
     if (names.size() > 255) p.fail("names", "lists more than 255 species", "1 to 255 names");
+    for (const auto& name : names)
+        if (!valid_name(name))
+            p.fail("names", "has the name '" + quote_for_message(name) + "'",
+                   "words of 1 to 32 letters, digits, '_' or '-' (they name output columns)");
     for (std::size_t i = 0; i < names.size(); ++i)
         for (std::size_t j = 0; j < i; ++j)
-            if (names[i] == names[j]) p.fail("names", "lists '" + names[i] + "' twice", "distinct names");
+            if (names[i] == names[j])
+                p.fail("names", "lists '" + quote_for_message(names[i]) + "' twice",
+                       "distinct names");
     const std::string count = std::to_string(names.size());
     if (density.size() != names.size())
         p.fail("density", "has " + std::to_string(density.size()) + " values for " + count +

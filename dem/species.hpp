@@ -10,11 +10,20 @@
 #include <string>
 #include <vector>
 
+#include "core/bounds.hpp"
+
 namespace efdem {
 class Params;
 }
 
 namespace efdem::dem {
+
+/// Allowed densities [rho_s] and diameters [d_p]: three decades either side of the reference
+/// species (density 1, diameter 1). Wider ratios are almost always a unit mistake (a diameter
+/// in metres, a density in kg/m^3), and they would push masses and contact times towards the
+/// ends of the double range.
+inline const Bounds kDensityRange = Bounds::closed(1e-3, 1e3);
+inline const Bounds kDiameterRange = Bounds::closed(1e-3, 1e3);
 
 /// Species index as stored per particle. Binary mixtures use 0 and 1; up to 255 are possible.
 using SpeciesId = std::uint8_t;

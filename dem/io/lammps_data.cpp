@@ -90,6 +90,19 @@ std::vector<double> numbers(const std::string& line, std::size_t want, const GzL
     return out;
 }
 
+/// Largest atom id: ids are read as doubles, which hold every integer up to 2^53 exactly.
+constexpr long kMaxAtomId = 1L << 53;
+
+/// A whole number in [lo, hi] from a value read as a double (ids, types, counts); InputError
+/// naming `what` otherwise (a double outside the range of the integer is not converted).
+long whole_number(double v, long lo, long hi, const GzLines& in, const std::string& what) {
+    if (!(std::trunc(v) == v && v >= static_cast<double>(lo) && v <= static_cast<double>(hi)))
+        throw InputError(
+            {in.path(), in.line_number()},
+            fmt::format("{} is {:g}; it must be a whole number from {} to {}", what, v, lo, hi));
+    return static_cast<long>(v);
+}
+
 }  // namespace
 
 Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable& species,
@@ -120,7 +133,9 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
             continue;
         }
         if (section.empty()) {  // header
-            if (s.find("atoms") != std::string::npos) n_atoms = std::stol(s);
+            if (s.find("atoms") != std::string::npos)
+                n_atoms = whole_number(numbers(s.substr(0, s.find("atoms")), 1, in, "atoms")[0], 0,
+                                       kMaxRealizationParticles, in, "the number of atoms");
             for (int a = 0; a < 3; ++a) {
                 const char* lo = a == 0 ? "xlo" : a == 1 ? "ylo" : "zlo";
                 if (s.find(lo) != std::string::npos) {
@@ -132,26 +147,42 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
             }
         } else if (section == "Atoms") {
             const auto v = numbers(s, 7, in, "Atoms");
-            const auto type = static_cast<long>(v[1]);
-            if (type < 1 || type > static_cast<long>(species.size()))
+            const auto id = static_cast<Tag>(whole_number(v[0], 1, kMaxAtomId, in, "the atom id"));
+            const long type = whole_number(v[1], 1, 255, in, "the atom type");
+            if (type > static_cast<long>(species.size()))
                 throw InputError({in.path(), in.line_number()},
                                  fmt::format("atom type {} has no species: species.names lists {} species", type, species.size()));
+            if (static_cast<long>(atoms.size()) >= kMaxRealizationParticles)
+                throw InputError(
+                    {in.path(), in.line_number()},
+                    fmt::format("more than {} atoms; one realization holds at most that many",
+                                kMaxRealizationParticles));
             const auto sp = static_cast<SpeciesId>(type - 1);
             const double d = v[2], rho = v[3];
             if (std::abs(d - species[sp].diameter) > 1e-9 * species[sp].diameter ||
                 std::abs(rho - species[sp].density) > 1e-9 * species[sp].density)
-                throw InputError({in.path(), in.line_number()},
-                                 fmt::format("atom {} of type {} has diameter {} and density {}, but species '{}' has "
-                                             "diameter {} and density {}", static_cast<Tag>(v[0]), type, d, rho,
-                                             species[sp].name, species[sp].diameter, species[sp].density));
-            const auto id = static_cast<Tag>(v[0]);
+                throw InputError(
+                    {in.path(), in.line_number()},
+                    fmt::format(
+                        "atom {} of type {} has diameter {} and density {}, but species '{}' has "
+                        "diameter {} and density {}",
+                        id, type, d, rho, species[sp].name, species[sp].diameter,
+                        species[sp].density));
+            const double z = v[6];
+            if (z < 0 || z > (domain.has_lid() ? domain.lid_height : kMaxDomainLength))
+                throw InputError(
+                    {in.path(), in.line_number()},
+                    fmt::format(
+                        "atom {} is at z = {:g}, outside the domain (allowed: 0 <= z <= {:g})", id,
+                        z, domain.has_lid() ? domain.lid_height : kMaxDomainLength));
             if (index_of.count(id))
                 throw InputError({in.path(), in.line_number()}, fmt::format("atom id {} appears twice", id));
             index_of.emplace(id, atoms.size());
             atoms.push_back({id, sp, {v[4], v[5], v[6]}, {}, {}});
         } else if (section == "Velocities") {
             const auto v = numbers(s, 7, in, "Velocities");
-            const auto it = index_of.find(static_cast<Tag>(v[0]));
+            const auto it = index_of.find(
+                static_cast<Tag>(whole_number(v[0], 1, kMaxAtomId, in, "the atom id")));
             if (it == index_of.end())
                 throw InputError({in.path(), in.line_number()}, "velocity of an atom id not in the Atoms section");
             atoms[it->second].v = {v[1], v[2], v[3]};

@@ -2,6 +2,9 @@
 // behaviours the rest of efdem relies on (overrides win, defaults recorded, scopes, paths).
 #include <catch2/catch.hpp>
 
+#include <limits>
+#include <string>
+
 #include "core/param_table.hpp"
 #include "tests/support/input_error.hpp"
 
@@ -151,4 +154,57 @@ TEST_CASE("a missing scene file is an input error naming the file", "[unit][para
     const auto e = input_error([] { ParamTable::from_file("/nonexistent/scene.cfg"); });
     CHECK(e.where().file == "/nonexistent/scene.cfg");
     CHECK(e.problem() == "file not found");
+}
+
+TEST_CASE("integers at the edge of their type are converted or refused, never wrapped",
+          "[unit][params]") {
+    // 2^63 and 2^64 are what LONG_MAX and UINT64_MAX round to as doubles; converting them back
+    // would be undefined behaviour (the scene fuzzer's "9.3e18" seed).
+    auto t = scene(
+        "a = 9223372036854775807\nb = 9.3e18\nc = 9223372036854775808\n"
+        "d = 1.8446744073709552e19\ne = 18446744073709551615\nf = -1\ng = 2147483648\n");
+    auto p = t.root();
+    CHECK(p.get<long>("a") == std::numeric_limits<long>::max());
+    CHECK(input_error([&] { p.get<long>("b"); }).problem() == "is out of range");
+    CHECK(input_error([&] { p.get<long>("c"); }).problem() == "is out of range");
+    CHECK(input_error([&] { p.get<std::uint64_t>("d"); }).problem() == "is out of range");
+    CHECK(p.get<std::uint64_t>("b") == 9'300'000'000'000'000'000ULL);
+    CHECK(p.get<std::uint64_t>("e") == std::numeric_limits<std::uint64_t>::max());
+    const auto neg = input_error([&] { p.get<std::uint64_t>("f"); });
+    CHECK(neg.allowed() == "an integer from 0 to 18446744073709551615");
+    CHECK(input_error([&] { p.get<int>("g"); }).problem() == "is out of range");
+}
+
+TEST_CASE("messages quote runaway or binary input safely", "[unit][params]") {
+    SECTION("control bytes and invalid UTF-8 are escaped; valid UTF-8 is kept") {
+        CHECK(efdem::quote_for_message("a\x1b[31mb") == "a\\x1b[31mb");
+        CHECK(efdem::quote_for_message("x\xff\xc3\x28y") == "x\\xff\\xc3(y");
+        CHECK(efdem::quote_for_message("caf\xc3\xa9") == "caf\xc3\xa9");
+    }
+    SECTION("a long value is cut and its length given") {
+        const std::string value(1'000'000, '9');
+        auto t = scene(("dt = " + value + "\n").c_str());
+        const auto e = input_error([&] { t.root().get<double>("dt"); });
+        CHECK(std::string(e.what()).size() < 400);
+        CHECK(std::string(e.what()).find("(1000000 bytes in all)") != std::string::npos);
+        CHECK(e.value() == value);  // the exception still carries the whole value
+    }
+    SECTION("a long line without '=' and a long unused key") {
+        const std::string junk(500'000, 'y');
+        const auto e = input_error([&] { scene(("dt = 1\n" + junk + "\n").c_str()); });
+        CHECK(std::string(e.what()).size() < 400);
+        auto t = scene(("dt = 1\n" + std::string(200'000, 'k') + " = 1\n").c_str());
+        t.root().get<double>("dt");
+        CHECK(std::string(input_error([&] { t.check_all_used(); }).what()).size() < 600);
+    }
+    SECTION("many unused keys: the first is named, the rest counted and a few listed") {
+        std::string text = "dt = 1\n";
+        for (int k = 0; k < 1000; ++k) text.append("x").append(std::to_string(k)).append(" = 1\n");
+        auto t = scene(text.c_str());
+        t.root().get<double>("dt");
+        const auto e = input_error([&] { t.check_all_used(); });
+        CHECK(e.key() == "x0");
+        CHECK(e.problem().find("999 more unused: x1, x2") != std::string::npos);
+        CHECK(std::string(e.what()).size() < 600);
+    }
 }

@@ -98,6 +98,35 @@ TEST_CASE("broken LAMMPS data files are input errors naming the file and the lin
         INFO(e.what());
         CHECK(e.problem().find("domain.lx = 5") != std::string::npos);
     }
+    SECTION("counts, ids and types that no integer holds are refused, not converted") {
+        // Found by the scene fuzzer: std::stol threw a non-input exception, and doubles beyond
+        // the range of long were converted (undefined behaviour).
+        auto problem = [&](const std::string& name, const std::string& text) {
+            return error_of(write_text(name, text), d).problem();
+        };
+        std::string big = header;
+        big.replace(big.find("3 atoms"), 7, "99999999999999999999 atoms");
+        CHECK(problem("efdem_count.data", big).find("the number of atoms is 1e+20") !=
+              std::string::npos);
+        CHECK(problem("efdem_id.data", header + "1e300 1 1 1 0.5 0.5 0.5\n")
+                  .find("the atom id is 1e+300") != std::string::npos);
+        CHECK(problem("efdem_type.data", header + "1 2.5 1 1 0.5 0.5 0.5\n")
+                  .find("the atom type is 2.5") != std::string::npos);
+        CHECK(problem("efdem_vel.data",
+                      header + "1 1 1 1 0.5 0.5 0.5\n\nVelocities\n\n-7e99 0 0 0 0 0 0\n")
+                  .find("the atom id is -7e+99") != std::string::npos);
+    }
+    SECTION("an atom below the floor or above the lid") {
+        const auto low =
+            error_of(write_text("efdem_low.data", header + "1 1 1 1 0.5 0.5 -0.2\n"), d);
+        CHECK(low.where().line == 12);
+        CHECK(low.problem().find(
+                  "atom 1 is at z = -0.2, outside the domain (allowed: 0 <= z <= 1e+06)") !=
+              std::string::npos);
+        const auto high = error_of(write_text("efdem_high.data", header + "1 1 1 1 0.5 0.5 9\n"),
+                                   Domain{4, 4, 8});
+        CHECK(high.problem().find("(allowed: 0 <= z <= 8)") != std::string::npos);
+    }
     SECTION("a gzip stream cut in the middle") {
         const std::string whole = read_gz(kBed);
         const auto path = std::filesystem::temp_directory_path() / "efdem_cut.data.gz";

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -10,6 +11,7 @@
 #include "dem/contact_history.hpp"
 #include "dem/neighbor_list.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/fp_traps.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
@@ -146,4 +148,46 @@ TEST_CASE("contact history survives rebuilds and sorting, attached to the same p
     REQUIRE(order_after != order_before);
     REQUIRE(sys.neighbor_list()->builds() == builds + 1);
     CHECK(springs() == before);
+}
+
+TEST_CASE("wide sparse boxes and tall sparse columns: a bounded cell grid, the oracle's list",
+          "[unit][neighbor]") {
+    // Cells are >= the cutoff wide; a grid with a cell per cutoff would have 8e11 cells in a
+    // 1e6 x 1e6 box (an int overflow and terabytes), or 5e5 cells for two particles 5e5 apart.
+    // The grid is coarsened to at most 2 n + 4096 cells: memory O(n), list unchanged.
+    const SpeciesTable species({{"small", 1, 0.8}, {"big", 1, 1.2}});
+    struct Case {
+        double lx, ly;
+        std::vector<Vec3> x;
+    };
+    const Case cases[] = {
+        {1e6, 1e6, {{0.5, 0.5, 0.5}, {1.3, 0.6, 0.5}, {999'999.7, 0.5, 0.5}, {5e5, 5e5, 3}}},
+        {4, 4, {{1, 1, 0.5}, {1, 1, 5e5}, {1.9, 1.2, 5e5 + 0.4}, {3.8, 1, 0.5}}},
+        {1e6, 3, {{1, 1, 1}, {1e6 - 0.1, 1, 1.3}, {1.7, 1, 1}}},
+    };
+    for (const auto& c : cases) {
+        Particles p;
+        for (const auto& x : c.x)
+            p.add(static_cast<Tag>(p.size() + 1), x, {}, static_cast<SpeciesId>(p.size() % 2),
+                  species);
+        const Domain d{c.lx, c.ly};
+        NeighborList list(1.2, 0.15);
+        std::vector<Index> perm;
+        list.build(p, d, perm);
+        INFO("box " << c.lx << " x " << c.ly);
+        CHECK(listed(list, p, d) == oracle(p, d, 0.15));
+        CHECK(!listed(list, p, d).empty());  // each case has a close pair (some across the seam)
+        // cell_start_ holds one entry per cell (+1): at most 2 n + 4097 of them.
+        CHECK(list.bytes() < 64 * 1024);
+    }
+}
+
+TEST_CASE("a non-finite position stops the rebuild with a runtime failure", "[unit][neighbor]") {
+    // A blown-up state must not reach the cell binning (a NaN converted to int is undefined).
+    efdem::test::FpTrapsOff no_traps;  // making the NaN is the point
+    Particles p = random_particles(20, 5, 5, 5, 1);
+    p.x()[7].z = std::numeric_limits<double>::quiet_NaN();
+    NeighborList list(1.2, 0.1);
+    std::vector<Index> perm;
+    CHECK_THROWS_AS(list.build(p, Domain{5, 5}, perm), RuntimeFailure);
 }

@@ -13,18 +13,7 @@ using namespace efdem::dem;
 using efdem::test::input_error;
 
 namespace {
-const char* kBase =
-    "dt = 1e-4\n"
-    "domain.lx = 4\n"
-    "domain.ly = 4\n"
-    "species.names = light heavy\n"
-    "species.density = 1 2\n"
-    "species.diameter = 1 1\n"
-    "bed.count = 20 20\n"
-    "bed.settle = false\n"
-    "pair_contact.kn = 2e5\n"
-    "pair_contact.restitution = 0.9\n"
-    "pair_contact.mu = 0.1\n";
+const std::string kBase = test::kSmallBinaryScene;
 
 System build(ParamTable& t) { return build_system(t.root(), {1, 0}); }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "tests/support/collisions.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;
@@ -15,50 +16,18 @@ using efdem::test::paper_contact;
 
 namespace {
 
-struct Collision {
-    double restitution;   ///< |v_rel after| / |v_rel before| along the normal
-    double contact_time;  ///< interpolated duration of overlap
-    double max_overlap;
-};
+using test::Collision;
 
-/// Runs one head-on collision with v_rel = 1 along x (pair) or -z onto the floor (wall) and
-/// measures it. dt = t_c/2000 so that the discretisation error is far below the tolerances.
-Collision collide(const ContactSpec& spec, SpeciesId a, SpeciesId b, bool wall, double v_rel = 1.0) {
-    const SpeciesTable species = binary_species();
-    Domain domain{20.0, 20.0};
-    Particles p;
-    const double gap = 0.01;  // start just apart
-    if (wall) {
-        p.add(1, {5, 5, 0.5 + gap}, {0, 0, -v_rel}, a, species);
-    } else {
-        p.add(1, {5, 5, 5}, {0.5 * v_rel, 0, 0}, a, species);
-        p.add(2, {6 + gap, 5, 5}, {-0.5 * v_rel, 0, 0}, b, species);
-    }
-    test::EffectList fx;
-    if (wall) fx.wall(spec, species);
-    else fx.pair(spec, species);
+/// Head-on collision at v_rel = 1 (pair: +-v/2; wall: -v onto the floor), measured with
+/// dt = t_c/2000 so that the discretisation error is far below the tolerances.
+Collision collide(const ContactSpec& spec, SpeciesId a, SpeciesId b, bool wall,
+                  double v_rel = 1.0) {
     const double tc_estimate = 3.5e-3;
-    const double dt = tc_estimate / 2000;
-    System sys = test::make_system(species, domain, std::move(p), std::move(fx), dt);
-    auto overlap = [&] {
-        const auto x = sys.particles().x();
-        return wall ? 0.5 - x[0].z : 1.0 - (x[1].x - x[0].x);
-    };
-    auto normal_velocity = [&] {
-        const auto v = sys.particles().v();
-        return wall ? -v[0].z : v[0].x - v[1].x;  // positive = approaching
-    };
-    double t_in = -1, t_out = -1, prev = overlap(), max_overlap = 0;
-    for (long s = 0; s < 2'000'000 && t_out < 0; ++s) {
-        sys.step();
-        const double ov = overlap();
-        max_overlap = std::max(max_overlap, ov);
-        if (t_in < 0 && ov > 0) t_in = sys.time() - dt * ov / (ov - prev);
-        if (t_in >= 0 && ov <= 0 && prev > 0) t_out = sys.time() - dt * ov / (ov - prev);
-        prev = ov;
-    }
-    REQUIRE(t_out > 0);
-    return {-normal_velocity() / v_rel, t_out - t_in, max_overlap};
+    const double v_a = wall ? v_rel : 0.5 * v_rel;
+    const Collision c = test::head_on_collision(spec, binary_species(), a, b, wall, v_a,
+                                                -0.5 * v_rel, tc_estimate / 2000);
+    REQUIRE(c.contact_time > 0);
+    return c;
 }
 
 /// Closed form for hooke with eta_n = m_eff gamma_n: e and t_c (physics.md §5.2).

@@ -76,6 +76,21 @@ inline dem::GasDragSpec paper_gas(double superficial_velocity, double slab_thick
     return s;
 }
 
+/// A small valid binary scene without its `effects` line: 40 spheres on a lattice in 4 x 4,
+/// not settled, the paper's contact model.
+inline const std::string kSmallBinaryScene =
+    "dt = 1e-4\n"
+    "domain.lx = 4\n"
+    "domain.ly = 4\n"
+    "species.names = light heavy\n"
+    "species.density = 1 2\n"
+    "species.diameter = 1 1\n"
+    "bed.count = 20 20\n"
+    "bed.settle = false\n"
+    "pair_contact.kn = 2e5\n"
+    "pair_contact.restitution = 0.9\n"
+    "pair_contact.mu = 0.1\n";
+
 /// A scene table from text (file name "test.cfg").
 inline ParamTable scene_table(const std::string& text) {
     return ParamTable::from_text(text, "test.cfg", EFDEM_SOURCE_DIR);
