@@ -127,9 +127,9 @@ void GasDrag::add_forces(ForceContext& ctx) {
     const Vec3* a = a_.data();
     for (std::size_t i = 0; i < n; ++i, w += stride) {
         const std::uint32_t j0 = first[i];
-        Vec3 fa{};
-        double fc = 0.0;
-        for (int k = 0; k < count[i]; ++k) {
+        Vec3 fa = a[j0] * w[0];
+        double fc = c[j0] * w[0];
+        for (int k = 1; k < count[i]; ++k) {  // most spheres cut one plane: one more slab
             fa += a[j0 + static_cast<std::uint32_t>(k)] * w[k];
             fc += c[j0 + static_cast<std::uint32_t>(k)] * w[k];
         }
