@@ -85,6 +85,23 @@ def waves(data, out):
     fig.savefig(out / "waves.png", dpi=110)
 
 
+def spacetime(data, out):
+    import numpy as np
+
+    fig, axes = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    for ax, u in zip(axes, ("0.19", "0.41")):
+        d = np.loadtxt(data / f"spacetime_u{u}.csv", delimiter=",", comments="#")
+        t, phi = d[:, 0], d[:, 1:]
+        im = ax.imshow(phi.T, origin="lower", aspect="auto", extent=[t[0], t[-1], 0, phi.shape[1]],
+                       vmin=0, vmax=0.65, cmap="viridis")
+        ax.set_ylabel("height z  [d_p]")
+        ax.set_title(f"U_s = {u}", fontsize=9)
+    axes[1].set_xlabel("time  [sqrt(d_p/g)]")
+    fig.colorbar(im, ax=axes, label="solid fraction φ of the 1 d_p slab")
+    fig.suptitle("φ(z, t), binary bed of 1,250 in 5 × 5 d_p, from the packed state")
+    fig.savefig(out / "spacetime.png", dpi=110)
+
+
 def randomization(data, out):
     r = rows(data / "randomization_icdf.csv")
     ps = [k for k in r[0] if k.startswith("p")]
@@ -105,7 +122,7 @@ def randomization(data, out):
 def main():
     data, out = Path(sys.argv[1]), Path(sys.argv[2])
     out.mkdir(parents=True, exist_ok=True)
-    for plot in (dp_sweep, rz_profiles, waves, randomization):
+    for plot in (dp_sweep, rz_profiles, waves, spacetime, randomization):
         try:
             plot(data, out)
             print(f"plot_validation: {plot.__name__} written")

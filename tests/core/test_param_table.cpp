@@ -3,25 +3,15 @@
 #include <catch2/catch.hpp>
 
 #include "core/param_table.hpp"
+#include "tests/support/input_error.hpp"
 
 using efdem::Bounds;
 using efdem::InputError;
 using efdem::ParamTable;
+using efdem::test::input_error;
 
 namespace {
 ParamTable scene(const char* text) { return ParamTable::from_text(text, "bed.cfg", "/scenes"); }
-
-/// Runs `f`, requires an InputError, and returns it for inspection.
-template <class F>
-InputError input_error(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e;
-    }
-    FAIL("expected an InputError");
-    throw std::logic_error("unreachable");
-}
 }  // namespace
 
 TEST_CASE("scene text parses keys, vectors, comments and quoted words", "[unit][params]") {

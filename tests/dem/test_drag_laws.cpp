@@ -7,9 +7,11 @@
 #include "dem/drag_laws.hpp"
 #include "dem/effects/gas_drag.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/input_error.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
+using efdem::test::input_error;
 
 namespace {
 const char* kScene =
@@ -26,17 +28,6 @@ const GasDrag& gas_of(const System& s) {
     const auto* g = dynamic_cast<const GasDrag*>(s.find_effect("gas_drag"));
     REQUIRE(g != nullptr);
     return *g;
-}
-
-template <class F>
-InputError input_error(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e;
-    }
-    FAIL("expected an InputError");
-    throw std::logic_error("unreachable");
 }
 }  // namespace
 

@@ -6,9 +6,11 @@
 #include "dem/effect_registry.hpp"
 #include "dem/scene.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/input_error.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
+using efdem::test::input_error;
 
 namespace {
 const char* kBase =
@@ -25,17 +27,6 @@ const char* kBase =
     "pair_contact.mu = 0.1\n";
 
 System build(ParamTable& t) { return build_system(t.root(), {1, 0}); }
-
-template <class F>
-InputError input_error(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e;
-    }
-    FAIL("expected an InputError");
-    throw std::logic_error("unreachable");
-}
 }  // namespace
 
 TEST_CASE("a frictionless scene allocates no contact history; no contact effect, no list",
