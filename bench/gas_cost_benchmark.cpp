@@ -43,11 +43,14 @@ double median(std::vector<double> v) {
 dem::System build(const std::string& data_file, bool gas, double u, const dem::Particles* state) {
     const std::string scene =
         "dt = 1e-4\n"
-        "effects = gravity pair_contact wall_contact" + std::string(gas ? " gas_drag" : "") + "\n"
+        "effects = gravity pair_contact wall_contact" +
+        std::string(gas ? " gas_drag" : "") +
+        "\n"
         "domain.lx = 15\ndomain.ly = 15\ndomain.lid = 150\n"
         "species.names = light heavy\nspecies.density = 1 2\nspecies.diameter = 1 1\n"
         "pair_contact.kn = 2e5\npair_contact.restitution = 0.9\npair_contact.mu = 0.1\n"
-        "bed.source = lammps_data\nbed.file = \"" + data_file + "\"\n" +
+        "bed.source = lammps_data\nbed.file = \"" +
+        data_file + "\"\n" +
         (gas ? "gas_drag.superficial_velocity = " + std::to_string(u) + "\n" : std::string());
     auto table = ParamTable::from_text(scene, "<benchmark>");
     const Params root = table.root();
@@ -74,7 +77,8 @@ double time_steps(dem::System& s, long steps) {
 
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: %s DATA_FILE [fluidize=T] [steps=N] [gap=N] [reps=N] [u=U_s]\n",
+        std::fprintf(stderr,
+                     "usage: %s DATA_FILE [fluidize=T] [steps=N] [gap=N] [reps=N] [u=U_s]\n",
                      argv[0]);
         return 2;
     }
@@ -84,12 +88,18 @@ int main(int argc, char** argv) {
         long steps = 20, gap = 200, reps = 25;
         for (int a = 2; a < argc; ++a) {
             const std::string arg = argv[a];
-            if (arg.rfind("fluidize=", 0) == 0) fluidize = std::stod(arg.substr(9));
-            else if (arg.rfind("steps=", 0) == 0) steps = std::stol(arg.substr(6));
-            else if (arg.rfind("gap=", 0) == 0) gap = std::stol(arg.substr(4));
-            else if (arg.rfind("reps=", 0) == 0) reps = std::stol(arg.substr(5));
-            else if (arg.rfind("u=", 0) == 0) u = std::stod(arg.substr(2));
-            else throw std::invalid_argument("unknown argument " + arg);
+            if (arg.rfind("fluidize=", 0) == 0)
+                fluidize = std::stod(arg.substr(9));
+            else if (arg.rfind("steps=", 0) == 0)
+                steps = std::stol(arg.substr(6));
+            else if (arg.rfind("gap=", 0) == 0)
+                gap = std::stol(arg.substr(4));
+            else if (arg.rfind("reps=", 0) == 0)
+                reps = std::stol(arg.substr(5));
+            else if (arg.rfind("u=", 0) == 0)
+                u = std::stod(arg.substr(2));
+            else
+                throw std::invalid_argument("unknown argument " + arg);
         }
         dem::System reference = build(data, true, u, nullptr);
         reference.run(static_cast<long>(fluidize / reference.dt()));
@@ -114,8 +124,9 @@ int main(int argc, char** argv) {
             contacts += static_cast<double>(with.thermo_stats().contacts);
             // The gas pass alone on the same state: slab update (as System does it) + kernel.
             dem::Particles scratch = reference.particles();
-            dem::ForceContext ctx{scratch, reference.domain(), reference.species(), nullptr,
-                                  nullptr, &slabs, reference.dt(), reference.time()};
+            dem::ForceContext ctx{
+                scratch, reference.domain(), reference.species(), nullptr, nullptr,
+                &slabs,  reference.dt(),     reference.time()};
             const double t0 = cpu_seconds();
             for (long k = 0; k < steps; ++k) {
                 slabs.update(scratch, reference.domain());
@@ -126,14 +137,14 @@ int main(int argc, char** argv) {
 
         const double n = static_cast<double>(reference.particles().size());
         const double a = median(t_without), b = median(t_with), g = median(t_gas);
-        std::printf("gas_cost particles=%.0f u=%g fluidize=%g steps=%ld gap=%ld reps=%ld slabs=%zu "
-                    "contacts_per_particle=%.3f step_without_us=%.1f step_with_us=%.1f "
-                    "overhead_percent=%.1f gas_pass_us=%.1f gas_pass_over_rest_percent=%.1f "
-                    "particle_steps_per_s_with=%.3e build=\"%s\"\n",
-                    n, u, fluidize, steps, gap, reps, slabs.size(),
-                    contacts / static_cast<double>(reps) / n, 1e6 * a, 1e6 * b,
-                    100.0 * (b / a - 1.0), 1e6 * g, 100.0 * g / (b - g), n / b,
-                    build_info().c_str());
+        std::printf(
+            "gas_cost particles=%.0f u=%g fluidize=%g steps=%ld gap=%ld reps=%ld slabs=%zu "
+            "contacts_per_particle=%.3f step_without_us=%.1f step_with_us=%.1f "
+            "overhead_percent=%.1f gas_pass_us=%.1f gas_pass_over_rest_percent=%.1f "
+            "particle_steps_per_s_with=%.3e build=\"%s\"\n",
+            n, u, fluidize, steps, gap, reps, slabs.size(),
+            contacts / static_cast<double>(reps) / n, 1e6 * a, 1e6 * b, 100.0 * (b / a - 1.0),
+            1e6 * g, 100.0 * g / (b - g), n / b, build_info().c_str());
     } catch (const std::exception& e) {
         std::fprintf(stderr, "efdem_gas_cost_benchmark: %s\n", e.what());
         return 2;

@@ -15,9 +15,10 @@ namespace {
 constexpr double kMaxSlabs = 1 << 24;
 
 [[noreturn]] [[gnu::noinline]] void too_high(Tag tag, double z, double dz) {
-    throw RuntimeFailure(fmt::format("slab fields: particle {} is at z = {:.6g}, which would need "
-                                     "more than {:.0f} slabs of thickness {:g}; the run has blown up",
-                                     tag, z, kMaxSlabs, dz));
+    throw RuntimeFailure(
+        fmt::format("slab fields: particle {} is at z = {:.6g}, which would need "
+                    "more than {:.0f} slabs of thickness {:g}; the run has blown up",
+                    tag, z, kMaxSlabs, dz));
 }
 }  // namespace
 
@@ -75,7 +76,8 @@ void SlabFields::update(const Particles& p, const Domain& domain) {
         if (!std::isfinite(t_top) || std::abs(t_top) >= kMaxSlabs) too_high(p.tag()[i], z, dz);
         const auto top_trunc = static_cast<std::int64_t>(t_top);
         const std::int64_t hi = top_trunc - (static_cast<double>(top_trunc) == t_top ? 1 : 0);
-        const std::int64_t lo = std::max<std::int64_t>(0, static_cast<std::int64_t>((z - r) * inv_dz));
+        const std::int64_t lo =
+            std::max<std::int64_t>(0, static_cast<std::int64_t>((z - r) * inv_dz));
         const auto j0 = static_cast<std::uint32_t>(lo);
         const int c = static_cast<int>(std::clamp<std::int64_t>(hi, lo, lo + stride - 1) - lo) + 1;
         first[i] = j0;
@@ -94,7 +96,8 @@ void SlabFields::update(const Particles& p, const Domain& domain) {
         const double full = sphere_volume_below(z + r, z, r);
         Sums* lane = sums + j0 * kLanes + (i % kLanes);
         if (c == 2) {
-            const double g = std::min(sphere_volume_below(static_cast<double>(j0 + 1) * dz, z, r), full);
+            const double g =
+                std::min(sphere_volume_below(static_cast<double>(j0 + 1) * dz, z, r), full);
             w[0] = g;
             w[1] = full - g;
             accumulate(lane[0], v[i], w[0]);

@@ -57,7 +57,7 @@ inline double sphere_volume_below(double h, double z_c, double r) {
 }
 
 class SlabFields {
-public:
+  public:
     /// `thickness` dz [d_p] (> 0); `max_diameter` of any particle [d_p], which bounds how many
     /// slabs one sphere can touch: floor(max_diameter/dz) + 2.
     SlabFields(double thickness, double max_diameter);
@@ -96,7 +96,7 @@ public:
     const std::uint8_t* count_data() const { return count_.data(); }
     const double* weight_data() const { return weights_.data(); }
 
-private:
+  private:
     /// Running sums of one slab while the particles are scattered into it: volume and momentum.
     struct Sums {
         double volume, mx, my, mz;

@@ -24,7 +24,9 @@ double cap(double h, double r) {
 
 /// Brute force: the volume of sphere (z, r) between planes a < b, with slab 0 reaching down to
 /// -infinity (the floor convention).
-double volume_between(double a, double b, double z, double r) { return cap(b - (z - r), r) - cap(a - (z - r), r); }
+double volume_between(double a, double b, double z, double r) {
+    return cap(b - (z - r), r) - cap(a - (z - r), r);
+}
 
 }  // namespace
 

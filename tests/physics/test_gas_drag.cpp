@@ -91,7 +91,8 @@ TEST_CASE("total gas force = area x sum_j dz (-grad p)_j, to round-off", "[physi
             const Particles cluster = test::random_particles(80, l, 13.0, 13.4, 12);
             const auto species = test::binary_species();
             for (std::size_t i = 0; i < cluster.size(); ++i)
-                p.add(1000 + static_cast<Tag>(i), cluster.x()[i], cluster.v()[i], cluster.species()[i], species);
+                p.add(1000 + static_cast<Tag>(i), cluster.x()[i], cluster.v()[i],
+                      cluster.species()[i], species);
             System sys = gas_only(std::move(p), Domain{l, l}, test::paper_gas(u, dz));
             const SlabFields& slabs = *sys.slab_fields();
             double phi_max = 0;
@@ -174,7 +175,8 @@ TEST_CASE("the gas force is continuous as a particle crosses slab boundaries and
     Vec3 expected{};
     for (int k = 0; k < s.slab_count(probe); ++k) {
         const double phi = s.phi()[s.first_slab(probe) + static_cast<std::uint32_t>(k)];
-        expected += Vec3{-0.1, 0, 0.41 + 0.5} * (s.weights(probe)[k] * kA * std::pow(1 - phi, -4.65));
+        expected +=
+            Vec3{-0.1, 0, 0.41 + 0.5} * (s.weights(probe)[k] * kA * std::pow(1 - phi, -4.65));
     }
     CHECK(last_probe.x == Approx(expected.x).epsilon(1e-12));
     CHECK(last_probe.z == Approx(expected.z).epsilon(1e-12));
@@ -212,8 +214,9 @@ TEST_CASE("a scene with gas_drag builds slab fields, one without does not", "[ph
         CHECK_FALSE(s.needs().slab_fields);
         CHECK(pressure_drop(s) == 0.0);
     }
-    auto t = test::scene_table(base + "effects = gravity gas_drag\ngas_drag.superficial_velocity = 0.19\n"
-                                      "gas_drag.slab_thickness = 0.5\n");
+    auto t = test::scene_table(base +
+                               "effects = gravity gas_drag\ngas_drag.superficial_velocity = 0.19\n"
+                               "gas_drag.slab_thickness = 0.5\n");
     System s = build_system(t.root(), {1, 0});
     REQUIRE(s.slab_fields() != nullptr);
     CHECK(s.needs().slab_fields);

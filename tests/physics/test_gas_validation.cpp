@@ -49,11 +49,13 @@ std::string scene_text(long n_light, long n_heavy, double box) {
     return "dt = " + std::to_string(kDt) +
            "\n"
            "effects = gravity pair_contact wall_contact gas_drag\n"
-           "domain.lx = " + std::to_string(box) + "\ndomain.ly = " + std::to_string(box) +
+           "domain.lx = " +
+           std::to_string(box) + "\ndomain.ly = " + std::to_string(box) +
            "\ndomain.lid = 150\n"
            "species.names = light heavy\nspecies.density = 1 2\nspecies.diameter = 1 1\n"
            "pair_contact.kn = 2e5\npair_contact.restitution = 0.9\npair_contact.mu = 0.1\n"
-           "bed.count = " + std::to_string(n_light) + " " + std::to_string(n_heavy) +
+           "bed.count = " +
+           std::to_string(n_light) + " " + std::to_string(n_heavy) +
            "\n"
            "gas_drag.superficial_velocity = 0\n";
 }
@@ -102,8 +104,10 @@ struct Series {
     void write(const std::filesystem::path& file, const std::string& what) const {
         std::FILE* f = std::fopen(file.string().c_str(), "w");
         REQUIRE(f != nullptr);
-        std::fprintf(f, "# %s\n# units: d_p, sqrt(d_p/g), rho_s g d_p\ntime,pressure_drop,bed_height,"
-                        "z_com,z_com_light,z_com_heavy\n", what.c_str());
+        std::fprintf(f,
+                     "# %s\n# units: d_p, sqrt(d_p/g), rho_s g d_p\ntime,pressure_drop,bed_height,"
+                     "z_com,z_com_light,z_com_heavy\n",
+                     what.c_str());
         for (std::size_t k = 0; k < t.size(); ++k)
             std::fprintf(f, "%.4f,%.6f,%.6f,%.6f,%.6f,%.6f\n", t[k], dp[k], height[k], z_com[k],
                          z_light[k], z_heavy[k]);
@@ -145,7 +149,9 @@ PackedBed packed_bed(const System& s) {
 }
 
 /// physics.md §6.1 for a uniform layer of mean density rho at phi.
-double u_mf_uniform(double rho, double phi) { return rho / kA * std::pow(1 - phi, 4.65); }
+double u_mf_uniform(double rho, double phi) {
+    return rho / kA * std::pow(1 - phi, 4.65);
+}
 
 void report(const std::string& line) {
     std::printf("validation: %s\n", line.c_str());
@@ -162,14 +168,15 @@ TEST_CASE("Delta P(U_s): Darcy below U_mf, the bed weight per area above (light 
           "[.validation][gas]") {
     System s = settled_bed(500, 0, 1);
     const PackedBed b = packed_bed(s);
-    report(fmt::format("light bed N=500: phi_bulk {:.4f}, H {:.3f}, W/A {:.4f}, U_mf,bed {:.4f}, "
-                       "U_mf §6.1 at phi_bulk {:.4f}",
-                       b.phi_bulk, b.height, b.weight_per_area, b.u_mf_bed,
-                       u_mf_uniform(1, b.phi_bulk)));
+    report(fmt::format(
+        "light bed N=500: phi_bulk {:.4f}, H {:.3f}, W/A {:.4f}, U_mf,bed {:.4f}, "
+        "U_mf §6.1 at phi_bulk {:.4f}",
+        b.phi_bulk, b.height, b.weight_per_area, b.u_mf_bed, u_mf_uniform(1, b.phi_bulk)));
     std::FILE* f = std::fopen((out_dir() / "dp_sweep_light.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
-    std::fprintf(f, "# Delta P(U_s) for increasing U_s, light bed of 500 in 5 x 5; U_mf,bed = %.5f, "
-                    "W/A = %.5f\nu_s,u_over_umf,pressure_drop,pressure_drop_sd,bed_height\n",
+    std::fprintf(f,
+                 "# Delta P(U_s) for increasing U_s, light bed of 500 in 5 x 5; U_mf,bed = %.5f, "
+                 "W/A = %.5f\nu_s,u_over_umf,pressure_drop,pressure_drop_sd,bed_height\n",
                  b.u_mf_bed, b.weight_per_area);
     double darcy_slope = 0;
     for (double ratio : {0.2, 0.4, 0.6, 0.8, 0.9, 1.1, 1.3, 1.6, 2.2, 3.3}) {
@@ -183,10 +190,12 @@ TEST_CASE("Delta P(U_s): Darcy below U_mf, the bed weight per area above (light 
         for (double x : m.dp) var += (x - dp) * (x - dp);
         const double sd = std::sqrt(var / static_cast<double>(m.dp.size()));
         const long on_floor = s.thermo_stats().wall_contacts;
-        std::fprintf(f, "%.5f,%.3f,%.5f,%.5f,%.4f,%ld\n", u, ratio, dp, sd, m.mean(m.height), on_floor);
-        report(fmt::format("  U_s = {:.4f} ({:.1f} U_mf): Delta P = {:.4f} (sd {:.3f}) = {:.4f} W/A, "
-                           "H = {:.3f}, particles touching the floor {}",
-                           u, ratio, dp, sd, dp / b.weight_per_area, m.mean(m.height), on_floor));
+        std::fprintf(f, "%.5f,%.3f,%.5f,%.5f,%.4f,%ld\n", u, ratio, dp, sd, m.mean(m.height),
+                     on_floor);
+        report(
+            fmt::format("  U_s = {:.4f} ({:.1f} U_mf): Delta P = {:.4f} (sd {:.3f}) = {:.4f} W/A, "
+                        "H = {:.3f}, particles touching the floor {}",
+                        u, ratio, dp, sd, dp / b.weight_per_area, m.mean(m.height), on_floor));
         if (packed) {
             // Darcy: Delta P / U_s is the same for every packed point (the bed does not move).
             if (darcy_slope == 0) darcy_slope = dp / u;
@@ -222,10 +231,11 @@ TEST_CASE("U_mf of light, heavy and binary beds brackets the bed-scale predictio
                          Case{"binary", 250, 250, 1.5, 0.90}}) {
         System s = settled_bed(c.light, c.heavy, 2);
         const PackedBed b = packed_bed(s);
-        report(fmt::format("{} bed N=500: phi_bulk {:.4f}, H {:.3f}, W/A {:.4f}; U_mf,bed {:.4f} "
-                           "(profile), U_mf §6.1 at phi_bulk {:.4f}",
-                           c.name, b.phi_bulk, b.height, b.weight_per_area, b.u_mf_bed,
-                           u_mf_uniform(c.rho_mean, b.phi_bulk)));
+        report(
+            fmt::format("{} bed N=500: phi_bulk {:.4f}, H {:.3f}, W/A {:.4f}; U_mf,bed {:.4f} "
+                        "(profile), U_mf §6.1 at phi_bulk {:.4f}",
+                        c.name, b.phi_bulk, b.height, b.weight_per_area, b.u_mf_bed,
+                        u_mf_uniform(c.rho_mean, b.phi_bulk)));
         // The bulk prediction ignores the looser layers at the floor and the surface, so it
         // lies a little below the profile's; both within 15 %.
         CHECK(u_mf_uniform(c.rho_mean, b.phi_bulk) == Approx(b.u_mf_bed).epsilon(0.15));
@@ -237,8 +247,10 @@ TEST_CASE("U_mf of light, heavy and binary beds brackets the bed-scale predictio
             const Series m = record(run, 10.0);
             const double dp = m.mean(m.dp) / b.weight_per_area;
             const double dh = m.mean(m.height) / b.height - 1;
-            report(fmt::format("  {} U_s = {:.2f} U_mf,bed: Delta P = {:.4f} W/A, H/H_packed - 1 = "
-                               "{:+.4f}", c.name, ratio, dp, dh));
+            report(
+                fmt::format("  {} U_s = {:.2f} U_mf,bed: Delta P = {:.4f} W/A, H/H_packed - 1 = "
+                            "{:+.4f}",
+                            c.name, ratio, dp, dh));
             if (ratio < 1) {
                 CHECK(dp == Approx(0.9).epsilon(0.02));  // still packed: Darcy
                 CHECK(std::abs(dh) < 0.01);              // and not expanded
@@ -254,8 +266,9 @@ TEST_CASE("U_mf of light, heavy and binary beds brackets the bed-scale predictio
     }
 }
 
-TEST_CASE("Richardson-Zaki: a short fluidized bed expands to phi_hom = 1 - (U_s A rho_s/rho)^(1/4.65)",
-          "[.validation][gas]") {
+TEST_CASE(
+    "Richardson-Zaki: a short fluidized bed expands to phi_hom = 1 - (U_s A rho_s/rho)^(1/4.65)",
+    "[.validation][gas]") {
     // A short bed (about 9 d_p) does not give the 1D waves room to grow (physics.md §6.2), so it
     // stays near the homogeneous state. Bulk phi: slabs at least 2 d_p from the floor and 3 d_p
     // below the bed height, time-averaged over 30 time units. Tolerance 3 % ("a few percent").
@@ -266,17 +279,20 @@ TEST_CASE("Richardson-Zaki: a short fluidized bed expands to phi_hom = 1 - (U_s 
     // same mean drag needs a lower mean phi).
     std::FILE* f = std::fopen((out_dir() / "rz_profiles.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
-    std::fprintf(f, "# time-averaged phi(z) of short fluidized beds (300 particles in 5.5 x 5.5), slab "
-                    "j = [j, j+1) d_p\nspecies,u_s,phi_hom,slab,phi\n");
+    std::fprintf(
+        f,
+        "# time-averaged phi(z) of short fluidized beds (300 particles in 5.5 x 5.5), slab "
+        "j = [j, j+1) d_p\nspecies,u_s,phi_hom,slab,phi\n");
     struct Case {
         const char* name;
         long light, heavy;
         double rho, u;
         bool checked;
     };
-    for (const Case c : {Case{"light", 300, 0, 1.0, 0.15, true}, Case{"light", 300, 0, 1.0, 0.19, true},
-                         Case{"light", 300, 0, 1.0, 0.21, true}, Case{"light", 300, 0, 1.0, 0.25, false},
-                         Case{"heavy", 0, 300, 2.0, 0.41, true}}) {
+    for (const Case c :
+         {Case{"light", 300, 0, 1.0, 0.15, true}, Case{"light", 300, 0, 1.0, 0.19, true},
+          Case{"light", 300, 0, 1.0, 0.21, true}, Case{"light", 300, 0, 1.0, 0.25, false},
+          Case{"heavy", 0, 300, 2.0, 0.41, true}}) {
         System s = settled_bed(c.light, c.heavy, 3, 5.5);
         gas_of(s).set_superficial_velocity(c.u);
         record(s, 10.0);
@@ -294,15 +310,18 @@ TEST_CASE("Richardson-Zaki: a short fluidized bed expands to phi_hom = 1 - (U_s 
             const auto phi = s.slab_fields()->phi();
             if (profile.size() < phi.size()) profile.resize(phi.size(), 0.0);
             for (std::size_t j = 0; j < phi.size(); ++j) profile[j] += phi[j] / n_samples;
-            for (std::size_t j = 2; static_cast<double>(j) + 3 <= h; ++j) phi_sum += phi[j], ++samples;
+            for (std::size_t j = 2; static_cast<double>(j) + 3 <= h; ++j)
+                phi_sum += phi[j], ++samples;
         }
         for (std::size_t j = 0; j < profile.size(); ++j)
             std::fprintf(f, "%s,%.3f,%.5f,%zu,%.5f\n", c.name, c.u, phi_hom, j, profile[j]);
         const double phi_mean = phi_sum / samples;
         const double h_sd = std::sqrt(std::max(0.0, h2_sum - h_sum * h_sum));
-        report(fmt::format("Richardson-Zaki {} N={}, U_s = {:.2f}: bulk phi {:.4f}, phi_hom {:.4f} "
-                           "({:+.2f} %), bed height {:.3f} +- {:.3f}{}", c.name, c.light + c.heavy, c.u, phi_mean, phi_hom,
-                           100 * (phi_mean / phi_hom - 1), h_sum, h_sd, c.checked ? "" : " (not checked)"));
+        report(fmt::format(
+            "Richardson-Zaki {} N={}, U_s = {:.2f}: bulk phi {:.4f}, phi_hom {:.4f} "
+            "({:+.2f} %), bed height {:.3f} +- {:.3f}{}",
+            c.name, c.light + c.heavy, c.u, phi_mean, phi_hom, 100 * (phi_mean / phi_hom - 1),
+            h_sum, h_sd, c.checked ? "" : " (not checked)"));
         if (c.checked) CHECK(phi_mean == Approx(phi_hom).epsilon(0.03));
     }
     std::fclose(f);
@@ -318,9 +337,10 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
     System packed = settled_bed(625, 625, 4);
     const PackedBed b = packed_bed(packed);
     const double phi_hom = 1 - std::pow(0.19 * kA / 1.5, 1 / 4.65);
-    report(fmt::format("binary bed N=1250: phi_bulk {:.4f}, H {:.3f}, U_mf,bed {:.4f}; homogeneous "
-                       "expansion at U_s = 0.19: phi_bulk/phi_hom - 1 = {:.4f}",
-                       b.phi_bulk, b.height, b.u_mf_bed, b.phi_bulk / phi_hom - 1));
+    report(
+        fmt::format("binary bed N=1250: phi_bulk {:.4f}, H {:.3f}, U_mf,bed {:.4f}; homogeneous "
+                    "expansion at U_s = 0.19: phi_bulk/phi_hom - 1 = {:.4f}",
+                    b.phi_bulk, b.height, b.u_mf_bed, b.phi_bulk / phi_hom - 1));
     const Particles start = packed.particles();
     constexpr std::size_t kProbe = 10;
     double phi_rms[2] = {};
@@ -328,10 +348,14 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
         const double u = k == 0 ? 0.19 : 0.41;
         System s = system_from(start, 625, 625);
         gas_of(s).set_superficial_velocity(u);
-        std::FILE* st = std::fopen((out_dir() / fmt::format("spacetime_u{:.2f}.csv", u)).string().c_str(), "w");
+        std::FILE* st =
+            std::fopen((out_dir() / fmt::format("spacetime_u{:.2f}.csv", u)).string().c_str(), "w");
         REQUIRE(st != nullptr);
-        std::fprintf(st, "# phi(z, t) of the binary bed of 1,250 at U_s = %.2f: time, then phi of slabs "
-                         "[j, j+1) d_p, j = 0..69\n", u);
+        std::fprintf(
+            st,
+            "# phi(z, t) of the binary bed of 1,250 at U_s = %.2f: time, then phi of slabs "
+            "[j, j+1) d_p, j = 0..69\n",
+            u);
         Series m;
         std::vector<double> probe;
         const long chunk = std::lround(0.1 / s.dt());
@@ -340,7 +364,8 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
             const auto phi = s.slab_fields()->phi();
             if (n % 2 == 1) {
                 std::fprintf(st, "%.2f", s.time());
-                for (std::size_t j = 0; j < 70; ++j) std::fprintf(st, ",%.4f", j < phi.size() ? phi[j] : 0.0);
+                for (std::size_t j = 0; j < 70; ++j)
+                    std::fprintf(st, ",%.4f", j < phi.size() ? phi[j] : 0.0);
                 std::fprintf(st, "\n");
             }
             if (s.time() < 30.0) continue;  // the lift-off and expansion
@@ -348,18 +373,20 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
             probe.push_back(phi[kProbe]);
         }
         std::fclose(st);
-        m.write(out_dir() / fmt::format("waves_u{:.2f}.csv", u), fmt::format("binary bed N=1250, U_s = {}", u));
+        m.write(out_dir() / fmt::format("waves_u{:.2f}.csv", u),
+                fmt::format("binary bed N=1250, U_s = {}", u));
         const coarse::PeriodEstimate period = coarse::estimate_period(m.t, probe);
         const double mean = m.mean(probe);
         double var = 0;
         for (double x : probe) var += (x - mean) * (x - mean);
         phi_rms[k] = std::sqrt(var / static_cast<double>(probe.size()));
         const double expansion = m.mean(m.height) / b.height - 1;
-        report(fmt::format("U_s = {:.2f}: H/H_packed - 1 = {:+.4f}; phi at z = [10, 11): mean {:.4f}, "
-                           "rms {:.4f}; wave period {} ({} periods in t = 30-80){}",
-                           u, expansion, mean, phi_rms[k],
-                           period.ok() ? fmt::format("{:.3f}", period.period) : std::string("-"),
-                           period.n_periods, period.ok() ? "" : "; " + period.message));
+        report(
+            fmt::format("U_s = {:.2f}: H/H_packed - 1 = {:+.4f}; phi at z = [10, 11): mean {:.4f}, "
+                        "rms {:.4f}; wave period {} ({} periods in t = 30-80){}",
+                        u, expansion, mean, phi_rms[k],
+                        period.ok() ? fmt::format("{:.3f}", period.period) : std::string("-"),
+                        period.n_periods, period.ok() ? "" : "; " + period.message));
         if (k == 0) {
             // "The bed hardly expands": no more than the homogeneous (Richardson-Zaki) expansion
             // of this packing, plus 2 % (our settled bed, phi 0.62, is denser than the paper's
@@ -423,8 +450,10 @@ TEST_CASE("randomizing all velocities mid-run leaves the light-particle ICDF tra
     }
     std::FILE* f = std::fopen((out_dir() / "randomization_icdf.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
-    std::fprintf(f, "# light-particle ICDF Q_L(p), ensemble means of %d realizations, control and "
-                    "randomized arms; t from the fork [sqrt(d_p/g)], Q in d_p\narm,t", kR);
+    std::fprintf(f,
+                 "# light-particle ICDF Q_L(p), ensemble means of %d realizations, control and "
+                 "randomized arms; t from the fork [sqrt(d_p/g)], Q in d_p\narm,t",
+                 kR);
     for (int i = 0; i < grid.size(); ++i) std::fprintf(f, ",p%.2f", grid.p(i));
     std::fprintf(f, "\n");
     double z2 = 0, drift2 = 0, noise2 = 0;
@@ -443,7 +472,8 @@ TEST_CASE("randomizing all velocities mid-run leaves the light-particle ICDF tra
             double mean[2] = {}, var[2] = {};
             for (int arm = 0; arm < 2; ++arm) {
                 for (int r = 0; r < kR; ++r) mean[arm] += q[arm][r](k, i) / kR;
-                for (int r = 0; r < kR; ++r) var[arm] += std::pow(q[arm][r](k, i) - mean[arm], 2) / (kR - 1);
+                for (int r = 0; r < kR; ++r)
+                    var[arm] += std::pow(q[arm][r](k, i) - mean[arm], 2) / (kR - 1);
             }
             const double se2 = (var[0] + var[1]) / kR;
             if (k > 0 && se2 > 0) {
@@ -461,9 +491,11 @@ TEST_CASE("randomizing all velocities mid-run leaves the light-particle ICDF tra
     std::fclose(f);
     const double z_rms = std::sqrt(z2 / nz);
     const double drift = std::sqrt(drift2 / grid.size()), noise = std::sqrt(noise2 / grid.size());
-    report(fmt::format("velocity randomization, R = {}: z-score RMS {:.3f} over {} (p, t) points; "
-                       "control drift of Q_L over 60 time units {:.3f} d_p (RMS over p), ensemble "
-                       "standard error {:.3f} d_p", kR, z_rms, nz, drift, noise));
+    report(
+        fmt::format("velocity randomization, R = {}: z-score RMS {:.3f} over {} (p, t) points; "
+                    "control drift of Q_L over 60 time units {:.3f} d_p (RMS over p), ensemble "
+                    "standard error {:.3f} d_p",
+                    kR, z_rms, nz, drift, noise));
     CHECK(z_rms < 2.0);
     CHECK(drift > 2 * noise);
 }
