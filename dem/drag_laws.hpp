@@ -33,7 +33,9 @@ namespace efdem::dem {
  * §6.4); with the pressure gradient it gives the Richardson-Zaki exponent n = 4.65.
  * \pre 0 <= phi < 1 (gas_drag caps phi below 1 first).
  */
-inline double wen_yu_low_re_resistance(double phi) { return std::pow(1.0 - phi, -2.65); }
+inline double wen_yu_low_re_resistance(double phi) {
+    return std::pow(1.0 - phi, -2.65);
+}
 
 /// One row of the drag-law table.
 struct DragLaw {

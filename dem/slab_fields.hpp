@@ -48,16 +48,16 @@
 
 namespace efdem::dem {
 
-/// Volume of a sphere of radius r centred at height z_c that lies below the plane z = h:
-/// (pi r^3/3)(1+t)^2 (2-t) with t = clamp((h - z_c)/r, -1, 1) [d_p^3].
+/// Volume of a sphere of radius r centred at height z_c that lies below the plane z = h: a cap
+/// of height a = clamp(h - (z_c - r), 0, 2r), of volume (pi/3) a^2 (3r - a) [d_p^3]. At a = 2r
+/// this is exactly the formula's whole sphere (4/3) pi r^3.
 inline double sphere_volume_below(double h, double z_c, double r) {
-    const double t = std::clamp((h - z_c) / r, -1.0, 1.0);
-    const double a = 1.0 + t;
-    return std::numbers::pi * r * r * r / 3.0 * a * a * (2.0 - t);
+    const double a = std::clamp(h - (z_c - r), 0.0, 2.0 * r);
+    return std::numbers::pi / 3.0 * a * a * (3.0 * r - a);
 }
 
 class SlabFields {
-public:
+  public:
     /// `thickness` dz [d_p] (> 0); `max_diameter` of any particle [d_p], which bounds how many
     /// slabs one sphere can touch: floor(max_diameter/dz) + 2.
     SlabFields(double thickness, double max_diameter);
@@ -96,7 +96,18 @@ public:
     const std::uint8_t* count_data() const { return count_.data(); }
     const double* weight_data() const { return weights_.data(); }
 
-private:
+  private:
+    /// Running sums of one slab while the particles are scattered into it: volume and momentum.
+    struct Sums {
+        double volume, mx, my, mz;
+    };
+    /// Independent copies of the sums, used round-robin by consecutive particles: particles
+    /// sorted in space mostly hit the same slab, and one copy would chain every addition to the
+    /// previous one through memory.
+    static constexpr std::size_t kLanes = 4;
+    void grow(std::size_t n_slabs);
+    static void accumulate(Sums& s, const Vec3& v, double w);
+
     double dz_;
     int stride_;
     std::size_t n_slabs_ = 0;
@@ -104,6 +115,7 @@ private:
     std::vector<std::uint32_t> first_;
     std::vector<std::uint8_t> count_;
     std::vector<double> weights_;
+    std::vector<Sums> sums_;  ///< kLanes per slab, slab-major; all zero between updates
     std::vector<double> phi_;
     std::vector<double> volume_;
     std::vector<Vec3> u_s_;

@@ -15,8 +15,12 @@ double GasProperties::drag_number() const {
     return 18.0 * viscosity /
            (particle_density * particle_diameter * std::sqrt(particle_diameter * gravity));
 }
-double GasProperties::velocity_unit() const { return std::sqrt(gravity * particle_diameter); }
-double GasProperties::time_unit() const { return std::sqrt(particle_diameter / gravity); }
+double GasProperties::velocity_unit() const {
+    return std::sqrt(gravity * particle_diameter);
+}
+double GasProperties::time_unit() const {
+    return std::sqrt(particle_diameter / gravity);
+}
 
 GasDragSpec GasDragSpec::from_params(const Params& p) {
     GasDragSpec s;
@@ -34,8 +38,10 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     if (p.contains("A")) {
         for (const char* key : kPhysical)
             if (p.contains(key))
-                p.fail(key, fmt::format("is given together with {} (A is either given or derived "
-                                        "from the physical inputs)", p.full_key("A")),
+                p.fail(key,
+                       fmt::format("is given together with {} (A is either given or derived "
+                                   "from the physical inputs)",
+                                   p.full_key("A")),
                        fmt::format("either {} alone, or {}, {}, {}, {} (SI units)", p.full_key("A"),
                                    p.full_key(kPhysical[0]), p.full_key(kPhysical[1]),
                                    p.full_key(kPhysical[2]), p.full_key(kPhysical[3])));
@@ -57,8 +63,9 @@ GasDragSpec checked_spec(const EffectSetup& s) {
     for (std::size_t k = 0; k < s.species.size(); ++k)
         if (s.species[static_cast<SpeciesId>(k)].diameter != 1.0)
             s.root.scope("species").fail(
-                "diameter", "is not 1 for every species, but gas_drag's drag law (Eq. 2) is "
-                            "written for one particle size, the unit length d_p",
+                "diameter",
+                "is not 1 for every species, but gas_drag's drag law (Eq. 2) is "
+                "written for one particle size, the unit length d_p",
                 "1 for every species when gas_drag is listed in effects");
     return GasDragSpec::from_params(s.scope);
 }
@@ -127,9 +134,9 @@ void GasDrag::add_forces(ForceContext& ctx) {
     const Vec3* a = a_.data();
     for (std::size_t i = 0; i < n; ++i, w += stride) {
         const std::uint32_t j0 = first[i];
-        Vec3 fa{};
-        double fc = 0.0;
-        for (int k = 0; k < count[i]; ++k) {
+        Vec3 fa = a[j0] * w[0];
+        double fc = c[j0] * w[0];
+        for (int k = 1; k < count[i]; ++k) {  // most spheres cut one plane: one more slab
             fa += a[j0 + static_cast<std::uint32_t>(k)] * w[k];
             fc += c[j0 + static_cast<std::uint32_t>(k)] * w[k];
         }
@@ -179,7 +186,8 @@ void GasDrag::describe(EffectReport& r) const {
                           100 * spec_.superficial_velocity * spec_.gas.velocity_unit(),
                           1000 * spec_.gas.time_unit()));
     else
-        r.add("superficial velocity U_s", fmt::format("{:g} sqrt(g d_p)", spec_.superficial_velocity));
+        r.add("superficial velocity U_s",
+              fmt::format("{:g} sqrt(g d_p)", spec_.superficial_velocity));
     r.add("slabs", fmt::format("thickness {:g} d_p from the floor to the highest particle; phi "
                                "capped at {:g} inside the (1-phi) factors",
                                spec_.slab_thickness, spec_.phi_cap));

@@ -37,10 +37,10 @@ namespace efdem::dem {
 
 /// Physical inputs from which A is derived (SI units).
 struct GasProperties {
-    double viscosity = 1.8e-5;   ///< mu_g [Pa s] (air)
-    double particle_density = 900;  ///< rho_s of the density-1 species [kg/m^3]
+    double viscosity = 1.8e-5;        ///< mu_g [Pa s] (air)
+    double particle_density = 900;    ///< rho_s of the density-1 species [kg/m^3]
     double particle_diameter = 1e-4;  ///< d_p [m]
-    double gravity = 9.81;       ///< g [m/s^2]
+    double gravity = 9.81;            ///< g [m/s^2]
 
     /// A = 18 mu_g/(rho_s d_p^1.5 g^0.5) [-]; 0.114939 for the defaults.
     double drag_number() const;
@@ -65,7 +65,7 @@ struct GasDragSpec {
 };
 
 class GasDrag final : public Effect {
-public:
+  public:
     explicit GasDrag(const EffectSetup& setup);
     GasDrag(const GasDragSpec& spec, const SpeciesTable& species);
 
@@ -89,7 +89,7 @@ public:
     /// solid fraction phi (physics.md §6.1): U_mf = density (1-phi)^2/(A r(phi)).
     double minimum_fluidization_velocity(double density, double phi) const;
 
-private:
+  private:
     /// Per-slab coefficients of the force kernel: c_j = A r(phi_c,j) and
     /// a_j = c_j (u_s,j - (u_s,j - U_s)/(1 - phi_c,j)^2), so that F_i = sum_j V_ij (a_j - c_j v_i).
     void slab_coefficients(const SlabFields& slabs);
@@ -97,7 +97,7 @@ private:
     GasDragSpec spec_;
     std::vector<double> density_;  ///< per species [rho_s], for reports
     std::vector<std::string> species_names_;
-    std::vector<double> c_;        ///< per slab (grows, never shrinks)
+    std::vector<double> c_;  ///< per slab (grows, never shrinks)
     std::vector<Vec3> a_;
 };
 

@@ -9,7 +9,8 @@ namespace efdem::dem {
 
 BedTimeSeries::BedTimeSeries(const std::filesystem::path& file, const System& s)
     : file_(std::fopen(file.string().c_str(), "w")) {
-    if (!file_) throw RuntimeFailure("cannot open the bed time series " + file.string() + " for writing");
+    if (!file_)
+        throw RuntimeFailure("cannot open the bed time series " + file.string() + " for writing");
     fmt::print(file_,
                "# efdem bed time series (dem/io/bed_time_series.hpp)\n"
                "# units: length d_p, time sqrt(d_p/g), pressure rho_s g d_p, energy rho_s g d_p^4\n"

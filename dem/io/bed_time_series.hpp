@@ -18,7 +18,7 @@
 namespace efdem::dem {
 
 class BedTimeSeries {
-public:
+  public:
     /// Opens (truncates) `file` and writes the header, naming `system`'s species; RuntimeFailure
     /// if it cannot.
     BedTimeSeries(const std::filesystem::path& file, const System& system);
@@ -28,7 +28,7 @@ public:
     /// Appends one row for the current state of `system` (flushed, so a crash loses nothing).
     void write(const System& system);
 
-private:
+  private:
     std::FILE* file_ = nullptr;
 };
 

@@ -23,12 +23,14 @@ Particles lattice(int layers) {
     for (int k = 0; k < layers; ++k)
         for (int a = 0; a < 4; ++a)
             for (int b = 0; b < 4; ++b)
-                p.add(tag++, {a + 0.5, b + 0.5, k + 0.5}, {}, static_cast<SpeciesId>(k % 2), species);
+                p.add(tag++, {a + 0.5, b + 0.5, k + 0.5}, {}, static_cast<SpeciesId>(k % 2),
+                      species);
     return p;
 }
 }  // namespace
 
-TEST_CASE("bed height, centre-of-mass heights and phi(z) of a simple-cubic stack", "[unit][diagnostics]") {
+TEST_CASE("bed height, centre-of-mass heights and phi(z) of a simple-cubic stack",
+          "[unit][diagnostics]") {
     const Particles p = lattice(10);
     // Half of the volume lies below z = 5; 95 % below the middle of the top layer, z = 9.5.
     CHECK(bed_height(p, 0.5) == Approx(5.0).margin(1e-8));
@@ -86,8 +88,9 @@ TEST_CASE("the bed time series writes a commented header, column names and one r
         for (std::string cell; std::getline(ss, cell, ',');) last.push_back(cell);
     }
     CHECK(comments >= 3);
-    CHECK(header == "step,time,pressure_drop,weight_per_area,bed_height,z_com,z_com_light,"
-                    "z_com_heavy,ke_per_particle");
+    CHECK(header ==
+          "step,time,pressure_drop,weight_per_area,bed_height,z_com,z_com_light,"
+          "z_com_heavy,ke_per_particle");
     CHECK(rows == 2);
     REQUIRE(last.size() == 9);
     CHECK(last[0] == "10");

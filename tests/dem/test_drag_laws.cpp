@@ -7,9 +7,11 @@
 #include "dem/drag_laws.hpp"
 #include "dem/effects/gas_drag.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/input_error.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
+using efdem::test::input_error;
 
 namespace {
 const char* kScene =
@@ -20,23 +22,14 @@ const char* kScene =
     "effects = gravity gas_drag\n"
     "gas_drag.superficial_velocity = 0.41\n";
 
-System build(ParamTable& t) { return build_system(t.root(), {1, 0}); }
+System build(ParamTable& t) {
+    return build_system(t.root(), {1, 0});
+}
 
 const GasDrag& gas_of(const System& s) {
     const auto* g = dynamic_cast<const GasDrag*>(s.find_effect("gas_drag"));
     REQUIRE(g != nullptr);
     return *g;
-}
-
-template <class F>
-InputError input_error(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e;
-    }
-    FAIL("expected an InputError");
-    throw std::logic_error("unreachable");
 }
 }  // namespace
 
@@ -66,7 +59,8 @@ TEST_CASE("A from the physical defaults is 0.114939 (physics.md §3.3)", "[unit]
     CHECK(GasProperties{}.drag_number() == Approx(0.114939).margin(5e-7));
     // A = 18 mu_g/(rho_s d_p^1.5 g^0.5): linear in mu_g, inverse in rho_s.
     CHECK(GasProperties{.viscosity = 3.6e-5}.drag_number() == Approx(2 * 0.114939).margin(1e-6));
-    CHECK(GasProperties{.particle_density = 1800}.drag_number() == Approx(0.114939 / 2).margin(1e-6));
+    CHECK(GasProperties{.particle_density = 1800}.drag_number() ==
+          Approx(0.114939 / 2).margin(1e-6));
     // Units of the Fig. 1 parameters: 3.193 ms and 3.132 cm/s (physics.md §2).
     CHECK(GasProperties{}.time_unit() == Approx(3.193e-3).epsilon(1e-3));
     CHECK(GasProperties{}.velocity_unit() == Approx(3.132e-2).epsilon(1e-3));
@@ -82,7 +76,8 @@ TEST_CASE("A from the physical defaults is 0.114939 (physics.md §3.3)", "[unit]
     CHECK_NOTHROW(t.check_all_used());
     // The defaults are recorded, so that the run log is a complete record.
     bool logged = false;
-    for (const auto& r : t.resolved()) logged |= r.key == "gas_drag.gas_viscosity" && r.origin == "default";
+    for (const auto& r : t.resolved())
+        logged |= r.key == "gas_drag.gas_viscosity" && r.origin == "default";
     CHECK(logged);
 }
 
@@ -94,7 +89,8 @@ TEST_CASE("A is given directly or derived, never both", "[unit][gas]") {
         CHECK_FALSE(gas_of(s).spec().physical);
     }
     SECTION("both") {
-        auto t = test::scene_table(std::string(kScene) + "gas_drag.A = 0.2\ngas_drag.gas_viscosity = 2e-5\n");
+        auto t = test::scene_table(std::string(kScene) +
+                                   "gas_drag.A = 0.2\ngas_drag.gas_viscosity = 2e-5\n");
         const auto e = input_error([&] { build(t); });
         CHECK(e.key() == "gas_drag.gas_viscosity");
         CHECK(e.problem().find("together with gas_drag.A") != std::string::npos);
@@ -148,8 +144,10 @@ TEST_CASE("U_mf and the Stokes numbers match physics.md §6.1 and §12.3", "[uni
     for (const auto& [k, v] : r.lines) text += k + ": " + v + "\n";
     INFO(text);
     CHECK(text.find("A: 0.114939") != std::string::npos);
-    CHECK(text.find("species light: Stokes terminal velocity and relaxation time 8.7") != std::string::npos);
-    CHECK(text.find("species heavy: Stokes terminal velocity and relaxation time 17.4") != std::string::npos);
+    CHECK(text.find("species light: Stokes terminal velocity and relaxation time 8.7") !=
+          std::string::npos);
+    CHECK(text.find("species heavy: Stokes terminal velocity and relaxation time 17.4") !=
+          std::string::npos);
     CHECK(text.find("U_mf at phi = 0.6: 0.1228") != std::string::npos);
     CHECK(text.find("1.284 cm/s") != std::string::npos);  // U_s = 0.41 (physics.md §2)
 }

@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <numbers>
-#include <random>
 
 #include "dem/slab_fields.hpp"
 #include "tests/support/dem_fixtures.hpp"
@@ -25,19 +24,10 @@ double cap(double h, double r) {
 
 /// Brute force: the volume of sphere (z, r) between planes a < b, with slab 0 reaching down to
 /// -infinity (the floor convention).
-double volume_between(double a, double b, double z, double r) { return cap(b - (z - r), r) - cap(a - (z - r), r); }
-
-Particles random_particles(int n, double l, double z_lo, double z_hi, std::uint32_t seed) {
-    const auto species = test::binary_species();
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<double> ux(0, l), uz(z_lo, z_hi);
-    std::normal_distribution<double> nv(0, 1);
-    Particles p;
-    for (int i = 0; i < n; ++i)
-        p.add(i + 1, {ux(gen), ux(gen), uz(gen)}, {nv(gen), nv(gen), nv(gen)},
-              static_cast<SpeciesId>(i % 2), species);
-    return p;
+double volume_between(double a, double b, double z, double r) {
+    return cap(b - (z - r), r) - cap(a - (z - r), r);
 }
+
 }  // namespace
 
 TEST_CASE("a sphere is split exactly over the slabs it cuts", "[unit][slabs]") {
@@ -64,7 +54,7 @@ TEST_CASE("slab volumes add up to the particle volume, slab by slab and in total
     // Property test on random beds, particles cut by slab boundaries and by the floor (z from
     // -0.3: up to 0.8 d_p below the floor). Round-off: a few ulps per weight, so 1e-12 relative.
     const double l = 6;
-    const Particles p = random_particles(400, l, -0.3, 15, 7);
+    const Particles p = test::random_particles(400, l, -0.3, 15, 7);
     const Domain d{l, l};
     for (double dz : {0.3, 0.7, 1.0, 1.5, 2.5}) {
         INFO("dz = " << dz);
@@ -124,7 +114,7 @@ TEST_CASE("the part of a sphere below the floor is counted in slab 0", "[unit][s
 }
 
 TEST_CASE("a particle far above the bed adds empty slabs and nothing else", "[unit][slabs]") {
-    Particles p = random_particles(50, 4, 0.5, 5, 3);
+    Particles p = test::random_particles(50, 4, 0.5, 5, 3);
     const auto species = test::binary_species();
     p.add(99, {1, 1, 1e4 + 0.2}, {0, 0, -3}, 1, species);
     SlabFields s(1.0, 1.0);
@@ -145,7 +135,7 @@ TEST_CASE("a particle far above the bed adds empty slabs and nothing else", "[un
 }
 
 TEST_CASE("updating the slab fields does not reallocate in steady state", "[unit][slabs]") {
-    Particles p = random_particles(100, 4, 0, 10, 5);
+    Particles p = test::random_particles(100, 4, 0, 10, 5);
     SlabFields s(1.0, 1.0);
     s.update(p, Domain{4, 4});
     const double* w = s.weight_data();

@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <numbers>
-#include <random>
 
 #include "dem/bed_diagnostics.hpp"
 #include "dem/slab_fields.hpp"
@@ -25,18 +24,6 @@ System gas_only(Particles p, const Domain& d, const GasDragSpec& spec, bool grav
     if (gravity) fx.gravity();
     fx.gas(spec, species);
     return test::make_system(species, d, std::move(p), std::move(fx), dt);
-}
-
-Particles random_bed(int n, double l, double z_lo, double z_hi, std::uint32_t seed) {
-    const auto species = test::binary_species();
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<double> ux(0, l), uz(z_lo, z_hi);
-    std::normal_distribution<double> nv(0, 1);
-    Particles p;
-    for (int i = 0; i < n; ++i)
-        p.add(i + 1, {ux(gen), ux(gen), uz(gen)}, {nv(gen), nv(gen), nv(gen)},
-              static_cast<SpeciesId>(i % 2), species);
-    return p;
 }
 
 Vec3 total_force(const System& s) {
@@ -100,11 +87,12 @@ TEST_CASE("total gas force = area x sum_j dz (-grad p)_j, to round-off", "[physi
     for (double dz : {0.5, 1.0, 2.0})
         for (double u : {0.0, 0.19, 0.41}) {
             INFO("dz = " << dz << ", U_s = " << u);
-            Particles p = random_bed(300, l, -0.3, 12, 11);
-            const Particles cluster = random_bed(80, l, 13.0, 13.4, 12);
+            Particles p = test::random_particles(300, l, -0.3, 12, 11);
+            const Particles cluster = test::random_particles(80, l, 13.0, 13.4, 12);
             const auto species = test::binary_species();
             for (std::size_t i = 0; i < cluster.size(); ++i)
-                p.add(1000 + static_cast<Tag>(i), cluster.x()[i], cluster.v()[i], cluster.species()[i], species);
+                p.add(1000 + static_cast<Tag>(i), cluster.x()[i], cluster.v()[i],
+                      cluster.species()[i], species);
             System sys = gas_only(std::move(p), Domain{l, l}, test::paper_gas(u, dz));
             const SlabFields& slabs = *sys.slab_fields();
             double phi_max = 0;
@@ -159,7 +147,7 @@ TEST_CASE("the gas force is continuous as a particle crosses slab boundaries and
     // O(h |dF/dz|) per step; a centre-binning scheme would jump by O(|F|) at each boundary. The
     // bound 1 % of max |F| per step sits between the two (smooth: ~0.1-0.3 %).
     const double l = 4;
-    Particles p = random_bed(90, l, 0.5, 3.5, 5);
+    Particles p = test::random_particles(90, l, 0.5, 3.5, 5);
     p.add(999, {1, 1, 2.0}, {0.1, 0, -0.5}, 0, test::binary_species());
     System sys = gas_only(std::move(p), Domain{l, l}, test::paper_gas(0.41));
     const std::size_t probe = sys.particles().size() - 1;
@@ -187,7 +175,8 @@ TEST_CASE("the gas force is continuous as a particle crosses slab boundaries and
     Vec3 expected{};
     for (int k = 0; k < s.slab_count(probe); ++k) {
         const double phi = s.phi()[s.first_slab(probe) + static_cast<std::uint32_t>(k)];
-        expected += Vec3{-0.1, 0, 0.41 + 0.5} * (s.weights(probe)[k] * kA * std::pow(1 - phi, -4.65));
+        expected +=
+            Vec3{-0.1, 0, 0.41 + 0.5} * (s.weights(probe)[k] * kA * std::pow(1 - phi, -4.65));
     }
     CHECK(last_probe.x == Approx(expected.x).epsilon(1e-12));
     CHECK(last_probe.z == Approx(expected.z).epsilon(1e-12));
@@ -199,7 +188,7 @@ TEST_CASE("a particle ejected far above the bed feels Stokes drag and nothing br
     // a 15 x 15 box: its slabs hold only itself (phi = pi/6/225 = 0.0023), so its force is Stokes
     // drag toward U_s within the hindrance (1 - phi)^-4.65 - 1 = 1.1 %.
     const double l = 15;
-    Particles p = random_bed(500, l, 0.5, 4, 9);
+    Particles p = test::random_particles(500, l, 0.5, 4, 9);
     p.add(777, {3, 3, 5000.3}, {0, 0, 2.0}, 1, test::binary_species());
     System sys = gas_only(std::move(p), Domain{l, l}, test::paper_gas(0.41), true, 1e-3);
     const std::size_t top = sys.particles().size() - 1;
@@ -225,8 +214,9 @@ TEST_CASE("a scene with gas_drag builds slab fields, one without does not", "[ph
         CHECK_FALSE(s.needs().slab_fields);
         CHECK(pressure_drop(s) == 0.0);
     }
-    auto t = test::scene_table(base + "effects = gravity gas_drag\ngas_drag.superficial_velocity = 0.19\n"
-                                      "gas_drag.slab_thickness = 0.5\n");
+    auto t = test::scene_table(base +
+                               "effects = gravity gas_drag\ngas_drag.superficial_velocity = 0.19\n"
+                               "gas_drag.slab_thickness = 0.5\n");
     System s = build_system(t.root(), {1, 0});
     REQUIRE(s.slab_fields() != nullptr);
     CHECK(s.needs().slab_fields);

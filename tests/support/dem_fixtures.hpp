@@ -2,6 +2,7 @@
 // Small builders for DEM tests: systems made programmatically (exact initial states) and from
 // scene text (the real input path).
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,21 @@ inline const std::string kSmallBinaryScene =
     "pair_contact.kn = 2e5\n"
     "pair_contact.restitution = 0.9\n"
     "pair_contact.mu = 0.1\n";
+
+/// n binary-species particles (alternating light, heavy) at uniform random positions in
+/// [0, l)^2 x [z_lo, z_hi) with standard-normal velocity components; overlaps are not avoided
+/// (for tests of fields and forces that do not involve contacts).
+inline dem::Particles random_particles(int n, double l, double z_lo, double z_hi, std::uint32_t seed) {
+    const auto species = binary_species();
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<double> ux(0, l), uz(z_lo, z_hi);
+    std::normal_distribution<double> nv(0, 1);
+    dem::Particles p;
+    for (int i = 0; i < n; ++i)
+        p.add(i + 1, {ux(gen), ux(gen), uz(gen)}, {nv(gen), nv(gen), nv(gen)},
+              static_cast<dem::SpeciesId>(i % 2), species);
+    return p;
+}
 
 /// A scene table from text (file name "test.cfg").
 inline ParamTable scene_table(const std::string& text) {

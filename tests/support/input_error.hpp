@@ -1,5 +1,5 @@
 #pragma once
-// Runs a callable that must throw an InputError, and returns the error for inspection.
+// input_error(f): runs f, requires that it throws an InputError, and returns it for inspection.
 #include <catch2/catch.hpp>
 
 #include <stdexcept>
