@@ -25,6 +25,10 @@ EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, std::vector<std::
 
 double EnsembleStepper::time() const { return local_.front()->time(); }
 
+bool EnsembleStepper::needs_top_half() const {
+    return observable_->needs_top_half() || (settings_.recorded && settings_.recorded->needs_top_half());
+}
+
 void EnsembleStepper::fail(const std::string& message, long realization) const {
     layout_.mpi().abort(fmt::format("realization {}: {}", realization, message), kExitRuntimeFailure);
 }
@@ -36,7 +40,7 @@ EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
 }
 
 void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
-    const bool top = observable_->needs_top_half();
+    const bool top = needs_top_half();
     broadcast({Command::run, duration, top});
     do_run(std::lround(duration / settings_.sample_interval), top, &out);
 }
@@ -112,8 +116,12 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     rec.com = all_scalars.col(0);
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
     const Eigen::VectorXd x = observable_->restrict_ensemble(all_icdf, all_top);
-    rec.compact = top ? x : Eigen::VectorXd();
+    rec.compact = observable_->needs_top_half() ? x : Eigen::VectorXd();
     rec.compact_status = observable_->status();
+    if (!observable_->needs_top_half() && settings_.recorded) {
+        rec.compact = settings_.recorded->restrict_ensemble(all_icdf, all_top);
+        rec.compact_status = settings_.recorded->status();
+    }
     if (out) {
         out->t.push_back(rec.time);
         out->x.push_back(x);

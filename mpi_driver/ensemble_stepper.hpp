@@ -44,6 +44,9 @@ struct StepperSettings {
     int quantiles = 19;               ///< m of the p-grid
     std::uint64_t seed = 1;           ///< master seed (for the lifting streams)
     InjectedFailure failure;
+    /// Root: an observable evaluated at every sample only to be recorded (e.g. the compact
+    /// (A,B,C,D) of a direct run, for comparison with a compact CPI run); null for none.
+    coarse::EnsembleObservable* recorded = nullptr;
 };
 
 class EnsembleStepper final : public coarse::CoarseStepper {
@@ -75,6 +78,9 @@ public:
     /// the feasible range of a lifting target.
     std::pair<double, double> height_range() const { return height_range_; }
     void set_observable(coarse::EnsembleObservable& observable) { observable_ = &observable; }
+    /// Root: whether samples need the top-half ICDF (for the integrator's or the recorded
+    /// observable).
+    bool needs_top_half() const;
 
     /// Wall time spent in the ensemble-level work of the coarse loop (not in the DEM), summed
     /// so far [s]: restriction (observe, gather, average, record) and lifting (gather heights

@@ -66,6 +66,9 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     if (cpi && s.cpi.observable == CpiSettings::Observable::compact)
         compact = std::make_unique<coarse::CompactObservable>(coarse::ProbabilityGrid(s.observe.quantiles));
     coarse::EnsembleObservable& observable = compact ? *compact : icdf;
+    std::unique_ptr<coarse::EnsembleObservable> recorded;
+    if (s.observe.compact && !compact)
+        recorded = std::make_unique<coarse::CompactObservable>(coarse::ProbabilityGrid(s.observe.quantiles));
 
     std::unique_ptr<RecorderList> recorders;
     std::vector<std::unique_ptr<Realization>> local;
@@ -97,6 +100,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.quantiles = s.observe.quantiles;
     ss.seed = s.seed;
     ss.failure = injected;
+    ss.recorded = recorded.get();
     const double t0 = local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
     const ColourLifter lifter;

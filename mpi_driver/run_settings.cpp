@@ -26,6 +26,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.observe.interval = observe.get_or<double>("interval", 0.5, Bounds::positive());
     s.observe.steps_per_sample = whole_multiple(observe, "interval", s.observe.interval, scene.dt, "dt");
     s.observe.quantiles = observe.get_or<int>("quantiles", 19, Bounds::closed(1, 999));
+    s.observe.compact = observe.get_or<bool>("compact", false);
     std::vector<std::string> names;
     for (std::size_t k = 0; k < scene.species.size(); ++k) names.push_back(scene.species[static_cast<dem::SpeciesId>(k)].name);
     const std::string observed = observe.get_or_choice("species", names.front(), names);

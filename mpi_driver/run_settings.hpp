@@ -13,6 +13,8 @@
 /// | observe.interval               | time between ICDF samples (a multiple of dt)        | 0.5     |
 /// | observe.species                | species whose heights make the ICDF                 | first   |
 /// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19      |
+/// | observe.compact                | also record (A,B,C,D) of y = Q_top - Q_L at every   | false   |
+/// |                                | sample (a direct reference for a compact CPI run)   |         |
 /// | cpi.observable                 | `icdf` (the ICDF nodes) or `compact` ((A,B,C,D))    | icdf    |
 /// | cpi.projection                 | `fixed` (DT = cpi.dt) or `periods` (DT = k T)       | fixed   |
 /// | cpi.warmup                     | direct simulation before the first coarse step (the | 0       |
@@ -43,6 +45,7 @@ struct ObserveSettings {
     double interval = 0.5;
     long steps_per_sample = 0;  ///< interval / dt
     int quantiles = 19;
+    bool compact = false;        ///< record (A,B,C,D) at every sample
     dem::SpeciesId species = 0;  ///< the observed ("light") species
     dem::SpeciesId other = 1;    ///< the other species (colour 0), binary mixtures
 };
