@@ -114,6 +114,7 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     rec.mean = coarse::ensemble_mean(all_icdf);
     rec.variance = coarse::ensemble_variance(all_icdf, rec.mean);
     rec.com = all_scalars.col(0);
+    rec.top_mean = top ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
     const Eigen::VectorXd x = observable_->restrict_ensemble(all_icdf, all_top);
     rec.compact = observable_->needs_top_half() ? x : Eigen::VectorXd();

@@ -61,6 +61,7 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> icdf = s.realizations;
     series("/samples/icdf", {r, m}, T::real).append(std::span<const double>(icdf.data(), static_cast<std::size_t>(icdf.size())));
     series("/samples/com", {r}, T::real).append(as_span(s.com));
+    if (s.top_mean.size() == m_) series("/samples/top_mean", {m}, T::real).append(as_span(s.top_mean));
     if (s.compact.size() == 4) {
         series("/samples/compact", {4}, T::real).append(as_span(s.compact));
         series("/samples/compact_status", {}, T::integer).append_integer(s.compact_status);

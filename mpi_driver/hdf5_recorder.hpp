@@ -12,7 +12,8 @@
 ///   /scene                the scene text as read;  /parameters  every parameter with its origin
 ///   /p                    the p-grid (m)
 ///   /samples/time (n), mean (n x m), variance (n x m), icdf (n x R x m), com (n x R)
-///   /samples/compact (n x 4), compact_status (n)                 [cpi.observable = compact]
+///   /samples/top_mean (n x m), compact (n x 4), compact_status (n)
+///                         [cpi.observable = compact or observe.compact = true]
 ///   /cpi/t_start, burst_length, healing, window, dt_requested, dt, period, periods, t_end (n)
 ///   /cpi/status (text), message (text), slope, x_end, x_projected (n x dim)
 ///   /cpi/repair_max_adjustment, repair_clipped, repair_non_monotone (n)

@@ -21,6 +21,7 @@ struct SampleRecord {
     Eigen::VectorXd variance;      ///< unbiased ensemble variance per node (zeros when R = 1)
     Eigen::MatrixXd realizations;  ///< R x m: each realization's ICDF
     Eigen::VectorXd com;           ///< R: centre-of-mass height of each realization
+    Eigen::VectorXd top_mean;      ///< ensemble-mean ICDF of the N/2 highest particles, when gathered
     Eigen::VectorXd compact;       ///< (A, B, C, D) of the mean y(p), when used (else empty)
     int compact_status = 0;        ///< 0 ok; otherwise the fit's status code
 };
