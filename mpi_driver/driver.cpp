@@ -119,8 +119,10 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
         if (compact && !fell_back && rec.status == coarse::StepStatus::invalid_burst) {
             // The compact fit failed (y = 0 at full demixing, or no convergence): continue with
             // the full ICDF, which is always defined.
-            log::warn("the compact (A,B,C,D) observable failed ({}); continuing with the full ICDF "
-                      "as the coarse variable", rec.message);
+            const std::string why = stepper.observable().status_message();
+            log::warn("the compact (A,B,C,D) observable failed at t = {:.6g}: {} ({}); continuing "
+                      "with the full ICDF as the coarse variable",
+                      stepper.time(), why.empty() ? "the fit is not usable" : why, rec.message);
             stepper.set_observable(fallback);
             integrator = make_integrator(s, icdf_repair);
             fell_back = true;

@@ -78,6 +78,8 @@ public:
     /// the feasible range of a lifting target.
     std::pair<double, double> height_range() const { return height_range_; }
     void set_observable(coarse::EnsembleObservable& observable) { observable_ = &observable; }
+    /// Root: the coarse observable in use (its status_message() says why a sample failed).
+    const coarse::EnsembleObservable& observable() const { return *observable_; }
     /// Root: whether samples need the top-half ICDF (for the integrator's or the recorded
     /// observable).
     bool needs_top_half() const;
