@@ -18,24 +18,6 @@ cmake --build "$build" -j 2 --target efdem efdem_root_cost_benchmark > /dev/null
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-effects = gravity pair_contact wall_contact gas_drag
-dt = 1e-4
-domain.lx = 15
-domain.ly = 15
-domain.lid = 150
-species.names = light heavy
-species.density = 1 2
-species.diameter = 1 1
-pair_contact.kn = 2e5
-pair_contact.restitution = 0.9
-pair_contact.mu = 0.1
-gas_drag.superficial_velocity = 0.19
-bed.source = lammps_data
-bed.file = $src/tests/data/packed_bed_12500.data.gz
-bed.permute_species = true
-run.duration = 1
-observe.interval = 0.5
-EOC
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(lscpu | sed -n 's/^Model name: *//p') ($(nproc) cores)"
 echo "## (a) ensemble throughput, one 12,500-particle realization per rank, 1e4 steps each"
 for np in 1 2; do
