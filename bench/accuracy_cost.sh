@@ -2,7 +2,7 @@
 # The accuracy-vs-cost study (issue 9): builds efdem and runs scripts/accuracy_cost.py.
 #   bash bench/accuracy_cost.sh [--quick] [--out DIR]
 # --quick: tiny bed, a handful of runs, under 15 minutes on 2 cores; default: the full study
-# (a few hours; resumable: completed runs are not repeated). Output: runs/accuracy[_quick]/.
+# (about an hour on 2 cores; resumable: completed runs are not repeated). Output: runs/accuracy[_quick]/.
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${EFDEM_BUILD_DIR:-$src/build}
