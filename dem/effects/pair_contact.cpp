@@ -34,8 +34,9 @@ void PairContact::loop(ForceContext& ctx) const {
     const double dt = ctx.dt;
 
     for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 xi = x[i], vi = v[i], wi = w[i];
+        const Vec3 xi = x[i], vi = v[i];
         const double ri = rad[i];
+        const Vec3 wri = w[i] * ri;  // r_i w_i, the same for all partners of i
         const ContactCoeffs* ci = coeffs + sp[i] * ns;
         Vec3 fi{}, ti{};
         for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
@@ -51,7 +52,7 @@ void PairContact::loop(ForceContext& ctx) const {
             const double r = std::sqrt(rsq);
             const Vec3 nrm = d * (1.0 / r);
             const ContactForce cf = contact_force<Normal, Tangential>(
-                nrm, radsum - r, vi - v[j], wi * ri + w[j] * rad[j], ci[sp[j]], dt,
+                nrm, radsum - r, vi - v[j], wri + w[j] * rad[j], ci[sp[j]], dt,
                 Tangential::kHistory ? hist + k : nullptr);
             fi += cf.total;
             f[j] -= cf.total;
