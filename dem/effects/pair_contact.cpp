@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 
@@ -124,8 +124,8 @@ EFDEM_TARGET_AVX2 void PairContact::loop_avx2(ForceContext& ctx) const {
 }
 
 void PairContact::add_forces(ForceContext& ctx) {
-    // Same results either way (no FMA in the AVX2 build); the AVX2 build of the contact path
-    // runs about 19 % fewer instructions.
+    // Same results either way (no FMA in the AVX2 build), with about 19 % fewer instructions
+    // in the AVX2 one (docs/performance.md).
     const bool avx2 = cpu_has_avx2();
     with_contact_kernels(table_.spec(), [&](auto normal, auto tangential) {
         using N = decltype(normal);
