@@ -96,13 +96,13 @@ inline ContactForce contact_force(const Vec3& n, double delta, const Vec3& v_rel
         s += vt * dt;
         const double kt = s_e * c.kt;
         const double eta_t = s_d * c.eta_t;
-        Vec3 ft = -(s * kt) - vt * eta_t;
+        Vec3 ft = -(s * kt + vt * eta_t);  // = -(s kt) - vt eta_t exactly, one negation
         const double ft2 = norm2(ft);
         const double limit = c.mu * std::abs(fn);
         if (ft2 > limit * limit) {
             // Sliding: scale the force to the Coulomb limit, and the spring to match it.
             ft *= limit / std::sqrt(ft2);
-            s = -(ft + vt * eta_t) * (1.0 / kt);
+            s = (ft + vt * eta_t) * (-1.0 / kt);
         }
         *xi = s;
         out.total += ft;

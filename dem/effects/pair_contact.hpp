@@ -25,8 +25,12 @@ public:
     void add_thermo(const ForceContext& ctx, ThermoStats& stats) const override;
 
 private:
+    /// The force loop; inlined into both builds below.
     template <class Normal, class Tangential>
     void loop(ForceContext& ctx) const;
+    /// loop() built for AVX2 (core/cpu_dispatch.hpp), chosen at run time when the CPU has it.
+    template <class Normal, class Tangential>
+    void loop_avx2(ForceContext& ctx) const;
 
     std::size_t n_species_;
 };
