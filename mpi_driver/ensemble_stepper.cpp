@@ -59,9 +59,54 @@ void EnsembleStepper::serve() {
         switch (m.command) {
             case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
             case Command::lift: do_lift(m.value, m.top_half, nullptr); break;
+            case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr); break;
             case Command::finish: return;
         }
     }
+}
+
+std::filesystem::path EnsembleStepper::checkpoint(long sequence, const DriverState& driver) {
+    EFDEM_EXPECTS(writer_ != nullptr);
+    broadcast({Command::checkpoint, static_cast<double>(sequence), false});
+    CheckpointHeader header;
+    header.stepper = saved_state();
+    header.driver = driver;
+    return do_checkpoint(sequence, &header);
+}
+
+std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const CheckpointHeader* header) {
+    std::vector<RealizationState> states;
+    try {
+        for (const auto& r : local_) states.push_back(r->save_state());
+        return writer_->write(sequence, states, header);
+    } catch (const std::exception& e) {
+        layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()), kExitRuntimeFailure);
+    }
+}
+
+StepperState EnsembleStepper::saved_state() const {
+    StepperState s;
+    s.samples_taken = samples_taken_;
+    s.micro_time = micro_time_;
+    s.particle_steps = particle_steps_;
+    s.height_lo = height_range_.first;
+    s.height_hi = height_range_.second;
+    for (const auto& l : lifting_) s.lifting.push_back(l.state());
+    s.observable = observable_->saved_state();
+    if (settings_.recorded) s.recorded = settings_.recorded->saved_state();
+    return s;
+}
+
+void EnsembleStepper::restore_state(const StepperState& s) {
+    samples_taken_ = s.samples_taken;
+    micro_time_ = s.micro_time;
+    particle_steps_ = s.particle_steps;
+    height_range_ = {s.height_lo, s.height_hi};
+    if (!layout_.is_root()) return;
+    EFDEM_EXPECTS(s.lifting.size() == lifting_.size());
+    for (std::size_t r = 0; r < lifting_.size(); ++r) lifting_[r].set_state(s.lifting[r]);
+    observable_->restore_state(s.observable);
+    if (settings_.recorded) settings_.recorded->restore_state(s.recorded);
 }
 
 void EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {

@@ -25,6 +25,7 @@
 #include "coarse/ensemble_observable.hpp"
 #include "coarse/probability_grid.hpp"
 #include "core/rng.hpp"
+#include "mpi_driver/checkpoint_format.hpp"
 #include "mpi_driver/ensemble_layout.hpp"
 #include "mpi_driver/progress.hpp"
 #include "mpi_driver/realization.hpp"
@@ -62,6 +63,17 @@ public:
     void run(double duration, coarse::BurstSamples& out) override;
     void lift(const Eigen::VectorXd& target, double new_time) override;
 
+    /// Root: write a whole-ensemble checkpoint numbered `sequence` with the driver's state
+    /// (every rank joins through serve()). Needs set_checkpoint_writer(). Returns its path.
+    std::filesystem::path checkpoint(long sequence, const DriverState& driver);
+    /// Every rank: the writer used by checkpoint() (null: none).
+    void set_checkpoint_writer(const CheckpointSink* writer) { writer_ = writer; }
+    /// The coarse layer's state (root: all of it; elsewhere the counters), and its restoration
+    /// on a restart (every rank; the lifting streams and warm starts matter on the root only).
+    StepperState saved_state() const;
+    void restore_state(const StepperState& state);
+    long samples_taken() const { return samples_taken_; }
+
     /// Non-root ranks: execute the root's commands until finish(). Collective.
     void serve();
     /// Root: release the other ranks from serve().
@@ -95,7 +107,7 @@ public:
     std::vector<std::unique_ptr<Realization>>& local() { return local_; }
 
 private:
-    enum class Command : int { run = 1, lift = 2, finish = 3 };
+    enum class Command : int { run = 1, lift = 2, finish = 3, checkpoint = 4 };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
     /// exactly the collectives the root joins).
@@ -108,6 +120,7 @@ private:
     void do_run(long samples, bool top_half, coarse::BurstSamples* out);
     void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target);
     void take_sample(bool top_half, coarse::BurstSamples* out);
+    std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header);
     [[noreturn]] void fail(const std::string& message, long realization) const;
 
     const EnsembleLayout& layout_;
@@ -117,6 +130,7 @@ private:
     const Lifter& lifter_;
     RunRecorder* recorder_;
     Progress* progress_;
+    const CheckpointSink* writer_ = nullptr;
     coarse::ProbabilityGrid grid_;
     std::vector<RandomStream> lifting_;  ///< root: one lifting stream per realization
     long samples_taken_ = 0;
