@@ -44,7 +44,9 @@ std::vector<Vec3> vectors(const std::vector<double>& flat) {
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
     return with_checkpoint<CheckpointHeader>(path, [&](const H5File& f) {
         if (!f.has_attribute("/", "format_version"))
-            refuse(path, "is not an efdem checkpoint (no format_version attribute)");
+            refuse(path, path.extension() == ".tmp"
+                             ? "is incomplete: a .tmp file left by an interrupted write (use the previous checkpoint)"
+                             : "is not an efdem checkpoint (no format_version attribute)");
         CheckpointHeader h;
         h.format_version = f.attribute_integer("/", "format_version");
         if (h.format_version != kCheckpointFormatVersion)
