@@ -30,7 +30,19 @@ bool EnsembleStepper::needs_top_half() const {
 }
 
 void EnsembleStepper::fail(const std::string& message, long realization) const {
-    layout_.mpi().abort(fmt::format("realization {}: {}", realization, message), kExitRuntimeFailure);
+    // The failed state is not written: it is not healthy, and the other ranks are not at a
+    // point where they could join a collective write. The newest checkpoint is the last
+    // healthy state saved.
+    std::string saved;
+    if (!writer_) saved = "checkpointing is off (checkpoint.interval = 0): there is no checkpoint to restart from";
+    else if (last_checkpoint_.empty()) saved = "no checkpoint had been written yet";
+    else
+        saved = fmt::format("the failed state is not checkpointed; the newest checkpoint, {} (t = {:.6g}), "
+                            "holds the last saved healthy state (restart=FILE)",
+                            last_checkpoint_.string(), last_checkpoint_time_);
+    const std::string who = fmt::format("realization {}: ", realization);
+    layout_.mpi().abort(fmt::format("{}{}; {}", message.rfind(who, 0) == 0 ? "" : who, message, saved),
+                        kExitRuntimeFailure);
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
@@ -78,7 +90,9 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
     std::vector<RealizationState> states;
     try {
         for (const auto& r : local_) states.push_back(r->save_state());
-        return writer_->write(sequence, states, header);
+        last_checkpoint_ = writer_->write(sequence, states, header);
+        last_checkpoint_time_ = time();
+        return last_checkpoint_;
     } catch (const std::exception& e) {
         layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()), kExitRuntimeFailure);
     }

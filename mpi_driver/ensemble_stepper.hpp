@@ -14,8 +14,9 @@
 ///
 /// Only the root runs the macro integrator. The root's run()/lift() first broadcast a command;
 /// the other ranks sit in serve(), which executes the same collectives, until finish().
-/// A failure while running (e.g. a blown-up realization) is printed with the rank and
-/// realization named, and MPI_Abort ends the job: nobody waits in a collective.
+/// A failure while running (e.g. a blown-up realization: the watchdog of dem::System) is printed
+/// with the rank and realization named, and where the last checkpoint is, and MPI_Abort ends the
+/// job: nobody waits in a collective.
 
 #include <memory>
 #include <utility>
@@ -131,6 +132,8 @@ private:
     RunRecorder* recorder_;
     Progress* progress_;
     const CheckpointSink* writer_ = nullptr;
+    std::filesystem::path last_checkpoint_;  ///< every rank: the newest checkpoint written
+    double last_checkpoint_time_ = 0;
     coarse::ProbabilityGrid grid_;
     std::vector<RandomStream> lifting_;  ///< root: one lifting stream per realization
     long samples_taken_ = 0;
