@@ -21,6 +21,10 @@ std::uint64_t as_uint64(std::int64_t i) {
     throw InputError(SourceLocation{path.string(), 0}, "checkpoint " + problem);
 }
 
+/// What a `.tmp` is, however far its writing got before the job was killed.
+constexpr const char* kPartialWrite =
+    "is incomplete: a .tmp file left by an interrupted write (use the previous checkpoint)";
+
 /// Runs `body` on the opened file; any HDF5 failure becomes an InputError naming the file.
 template <class T>
 T with_checkpoint(const std::filesystem::path& path, const std::function<T(const H5File&)>& body) {
@@ -30,6 +34,7 @@ T with_checkpoint(const std::filesystem::path& path, const std::function<T(const
         const H5File f = H5File::open(path, false);
         return body(f);
     } catch (const RuntimeFailure& e) {
+        if (path.extension() == ".tmp") refuse(path, kPartialWrite);
         refuse(path, fmt::format("cannot be read: it is truncated or corrupted ({})", e.what()));
     }
 }
@@ -44,9 +49,8 @@ std::vector<Vec3> vectors(const std::vector<double>& flat) {
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
     return with_checkpoint<CheckpointHeader>(path, [&](const H5File& f) {
         if (!f.has_attribute("/", "format_version"))
-            refuse(path, path.extension() == ".tmp"
-                             ? "is incomplete: a .tmp file left by an interrupted write (use the previous checkpoint)"
-                             : "is not an efdem checkpoint (no format_version attribute)");
+            refuse(path, path.extension() == ".tmp" ? kPartialWrite
+                                                    : "is not an efdem checkpoint (no format_version attribute)");
         CheckpointHeader h;
         h.format_version = f.attribute_integer("/", "format_version");
         if (h.format_version != kCheckpointFormatVersion)

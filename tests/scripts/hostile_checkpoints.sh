@@ -64,6 +64,8 @@ mutate "$work/incomplete.h5" "del f.attrs['complete']"
 expect incomplete "$work/incomplete.h5" "incomplete"
 expect wrong_scene "$good" "different physics: pair_contact.kn = 300000 (checkpoint: 2e5)" pair_contact.kn=300000
 expect wrong_count "$good" "holds 2 realizations but this run has 4" ensemble.realizations_per_rank=2
+expect other_bed "$good" "checkpoint does not fit the scene: realization 0: the checkpoint has 256 particles, the scene builds 200" \
+  "bed.count=100 100" restart.allow_physics_change=true
 
 # The same physics change is accepted when asked for.
 timeout 120 "$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=allowed restart="$good" \
