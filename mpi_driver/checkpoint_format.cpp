@@ -17,11 +17,6 @@ std::uint64_t hash_text(const std::string& s, std::uint64_t h) {
     h = hash_value(static_cast<std::uint64_t>(s.size()), h);
     return fnv1a(s.data(), s.size(), h);
 }
-template <class T>
-std::uint64_t hash_vector(const std::vector<T>& v, std::uint64_t h) {
-    h = hash_value(static_cast<std::uint64_t>(v.size()), h);
-    return v.empty() ? h : fnv1a(v.data(), v.size() * sizeof(T), h);
-}
 }  // namespace
 
 std::uint64_t CheckpointHeader::checksum() const {
@@ -34,9 +29,9 @@ std::uint64_t CheckpointHeader::checksum() const {
     const StepperState& s = stepper;
     for (double d : {s.micro_time, s.particle_steps, s.height_lo, s.height_hi}) h = hash_value(d, h);
     h = hash_value(s.samples_taken, h);
-    h = hash_vector(s.lifting, h);
-    h = hash_vector(s.observable, h);
-    h = hash_vector(s.recorded, h);
+    h = fnv1a_array(s.lifting, h);
+    h = fnv1a_array(s.observable, h);
+    h = fnv1a_array(s.recorded, h);
     h = hash_value(driver.t_origin, h);
     h = hash_value(driver.coarse_steps, h);
     h = hash_value(driver.without_progress, h);

@@ -1,6 +1,5 @@
 #include "mpi_driver/checkpoint_reader.hpp"
 
-#include <cstring>
 #include <functional>
 
 #include <fmt/format.h>
@@ -11,12 +10,6 @@
 namespace efdem::mpi_driver {
 
 namespace {
-std::uint64_t as_uint64(std::int64_t i) {
-    std::uint64_t u = 0;
-    std::memcpy(&u, &i, sizeof u);
-    return u;
-}
-
 [[noreturn]] void refuse(const std::filesystem::path& path, const std::string& problem) {
     throw InputError(SourceLocation{path.string(), 0}, "checkpoint " + problem);
 }
@@ -79,8 +72,8 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
             refuse(path, "has a malformed /driver/lifting dataset");
         for (std::size_t r = 0; r < lifting.size(); r += 4)
-            h.stepper.lifting.push_back({as_uint64(lifting[r]), as_uint64(lifting[r + 1]), as_uint64(lifting[r + 2]),
-                                         as_uint64(lifting[r + 3])});
+            h.stepper.lifting.push_back({from_stored(lifting[r]), from_stored(lifting[r + 1]), from_stored(lifting[r + 2]),
+                                         from_stored(lifting[r + 3])});
         h.stepper.observable = f.read_doubles("/driver/observable");
         h.stepper.recorded = f.read_doubles("/driver/recorded");
         for (const std::string& name : f.members("/output")) {
@@ -88,7 +81,7 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
             h.outputs.push_back({name, std::string(bytes.begin(), bytes.end())});
         }
         if (!f.has_attribute("/", "header_checksum") ||
-            as_uint64(f.attribute_integer("/", "header_checksum")) != h.checksum())
+            from_stored(f.attribute_integer("/", "header_checksum")) != h.checksum())
             refuse(path, "is corrupted: the checksum of its root-level state does not match");
         return h;
     });
@@ -136,7 +129,7 @@ std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem
             if (pt.size() != 2 * np || px.size() != 3 * np || s.x.size() != n)
                 refuse(path, fmt::format("realization {} is truncated", r));
             for (hsize_t k = 0; k < np; ++k) s.pairs.push_back({pt[2 * k], pt[2 * k + 1], {px[3 * k], px[3 * k + 1], px[3 * k + 2]}});
-            if (s.checksum() != as_uint64(checksum.at(static_cast<std::size_t>(r))))
+            if (s.checksum() != from_stored(checksum.at(static_cast<std::size_t>(r))))
                 refuse(path, fmt::format("is corrupted: the checksum of realization {} does not match", r));
             out.push_back(std::move(s));
             n_off += n;

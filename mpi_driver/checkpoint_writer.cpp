@@ -4,9 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <fstream>
-#include <iterator>
 #include <sstream>
 #include <thread>
 
@@ -19,12 +17,6 @@
 namespace efdem::mpi_driver {
 
 namespace {
-std::int64_t as_int64(std::uint64_t u) {
-    std::int64_t i = 0;
-    std::memcpy(&i, &u, sizeof i);
-    return i;
-}
-
 std::string read_whole_file(const std::filesystem::path& p) {
     std::ifstream in(p, std::ios::binary);
     if (!in) throw RuntimeFailure(fmt::format("checkpoint: cannot read the output file {}", p.string()));
@@ -153,7 +145,7 @@ void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
         meta.insert(meta.end(), {s.index, s.step, static_cast<std::int64_t>(n),
                                  static_cast<std::int64_t>(s.pairs.size()), s.reference.empty() ? 0 : 1,
                                  s.wall[0].empty() ? 0 : 1});
-        checksum.push_back(as_int64(s.checksum()));
+        checksum.push_back(to_stored(s.checksum()));
         time.push_back(s.time);
         const std::vector<Vec3>* arrays[8] = {&s.x, &s.v, &s.omega, &s.force, &s.torque,
                                                    &s.reference, &s.wall[0], &s.wall[1]};
@@ -214,7 +206,7 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
     std::vector<std::int64_t> lifting;
     for (const auto& st : s.lifting)
-        for (std::uint64_t w : st) lifting.push_back(as_int64(w));
+        for (std::uint64_t w : st) lifting.push_back(to_stored(w));
     f.write("/driver/lifting", std::span<const std::int64_t>(lifting), {s.lifting.size(), 4});
     f.write("/driver/observable", std::span<const double>(s.observable), {s.observable.size()});
     f.write("/driver/recorded", std::span<const double>(s.recorded), {s.recorded.size()});
@@ -222,7 +214,7 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     for (const auto& o : h.outputs)
         f.write_bytes("/output/" + o.name, std::span<const std::uint8_t>(
                                                reinterpret_cast<const std::uint8_t*>(o.bytes.data()), o.bytes.size()));
-    f.attribute("/", "header_checksum", as_int64(h.checksum()));
+    f.attribute("/", "header_checksum", to_stored(h.checksum()));
     f.flush();
     f.attribute("/", "complete", std::int64_t{1});  // last: marks the file as whole
     f.flush();

@@ -54,7 +54,7 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
 }  // namespace
 
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress, const RunControl& control) {
-    const DriverState state = control.resume.value_or(DriverState{stepper.time(), 0, 0, false});
+    const DriverState state = control.resume.value_or(DriverState{stepper.time()});
     const double t_end = state.t_origin + s.duration;
     const long total = std::lround(s.duration / s.observe.interval);
     long done = stepper.samples_taken();
@@ -87,7 +87,7 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
 
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::EnsembleObservable& fallback,
                    RunRecorder* recorder, Progress& progress, const RunControl& control) {
-    const DriverState resumed = control.resume.value_or(DriverState{stepper.time(), 0, 0, false});
+    const DriverState resumed = control.resume.value_or(DriverState{stepper.time()});
     const double t_start = resumed.t_origin;
     const double t_end = t_start + s.duration;
     const bool compact = s.cpi.observable == CpiSettings::Observable::compact;

@@ -70,6 +70,7 @@ template <class F>
 void with_attribute(const H5File& f, const std::string& object, const std::string& name, hid_t type,
                     F&& write) {
     const hid_t obj = f.check_id(H5Oopen(f.id(), object.c_str(), H5P_DEFAULT), "open " + object);
+    if (H5Aexists(obj, name.c_str()) > 0) H5Adelete(obj, name.c_str());  // rewrite: replace
     const hid_t space = H5Screate(H5S_SCALAR);
     const hid_t attr = H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
     const herr_t status = attr < 0 ? -1 : write(attr);

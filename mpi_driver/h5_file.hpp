@@ -62,7 +62,7 @@ public:
     H5File& operator=(const H5File&) = delete;
 
     void create_group(const std::string& path);
-    /// Attributes on an existing object ("/" for the file).
+    /// Attributes on an existing object ("/" for the file); an existing one is replaced.
     void attribute(const std::string& object, const std::string& name, const std::string& value);
     void attribute(const std::string& object, const std::string& name, double value);
     void attribute(const std::string& object, const std::string& name, std::int64_t value);

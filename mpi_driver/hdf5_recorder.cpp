@@ -25,7 +25,11 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& file, const RunProvenanc
                            Eigen::Index coarse_dimension, bool resume)
     : file_(resume ? H5File::open(file, true) : H5File::create(file)), realizations_(p.realizations),
       m_(p.p_grid.size()), dim_(coarse_dimension) {
-    if (resume) return;
+    if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
+        file_.attribute("/", "ranks", std::int64_t{p.ranks});
+        file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
+        return;
+    }
     file_.attribute("/", "format_version", kRunFileFormatVersion);
     file_.attribute("/", "efdem_version", version());
     file_.attribute("/", "git_hash", git_hash());

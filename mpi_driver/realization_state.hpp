@@ -8,6 +8,7 @@
 /// recomputing them from the full-step velocities would not give the same numbers.
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "dem/contact_history.hpp"
@@ -32,5 +33,25 @@ struct RealizationState {
 
 /// FNV-1a 64 of raw bytes, continuing from `h`.
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 0xcbf29ce484222325ULL);
+
+/// FNV-1a of an array's length and contents (trivially copyable elements).
+template <class T>
+std::uint64_t fnv1a_array(const std::vector<T>& a, std::uint64_t h) {
+    const std::uint64_t n = a.size();
+    h = fnv1a(&n, sizeof n, h);
+    return a.empty() ? h : fnv1a(a.data(), a.size() * sizeof(T), h);
+}
+
+/// HDF5 has no unsigned 64-bit type we use: checksums and random states are stored bit-cast.
+inline std::int64_t to_stored(std::uint64_t u) {
+    std::int64_t i = 0;
+    std::memcpy(&i, &u, sizeof i);
+    return i;
+}
+inline std::uint64_t from_stored(std::int64_t i) {
+    std::uint64_t u = 0;
+    std::memcpy(&u, &i, sizeof u);
+    return u;
+}
 
 }  // namespace efdem::mpi_driver
