@@ -252,8 +252,9 @@ int main(int argc, char** argv) {
         message = e.what();
     } catch (const std::filesystem::filesystem_error& e) {
         code = kExitInputError;
-        message = fmt::format("output.directory = '{}' cannot be created: {}",
-                              settings->output.directory.string(), e.code().message());
+        message = fmt::format("{} = '{}' cannot be created: {}",
+                              e.path1() == settings->output.directory ? "output.directory" : "checkpoint.directory",
+                              e.path1().string(), e.code().message());
     } catch (const std::exception& e) {
         code = kExitRuntimeFailure;
         message = std::string("unexpected failure during set-up: ") + e.what();
