@@ -23,4 +23,15 @@ Eigen::VectorXd CompactObservable::lift_target(const Eigen::VectorXd& x, const E
     return light_icdf_from_compact(top, CompactParameters::from_vector(x), grid_);
 }
 
+std::vector<double> CompactObservable::saved_state() const {
+    if (!previous_) return {};
+    return {previous_->a, previous_->b, previous_->c, previous_->d};
+}
+
+void CompactObservable::restore_state(const std::vector<double>& state) {
+    EFDEM_EXPECTS(state.empty() || state.size() == 4);
+    if (state.empty()) previous_.reset();
+    else previous_ = CompactParameters{state[0], state[1], state[2], state[3]};
+}
+
 }  // namespace efdem::coarse

@@ -28,6 +28,9 @@ public:
     int status() const override { return static_cast<int>(last_.status); }
     std::string status_message() const override { return last_.message; }
     const CompactFit& last_fit() const { return last_; }
+    /// The warm start of the next fit: (a, b, c, d) of the last usable one, or empty.
+    std::vector<double> saved_state() const override;
+    void restore_state(const std::vector<double>& state) override;
 
 private:
     ProbabilityGrid grid_;

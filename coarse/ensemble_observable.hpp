@@ -10,6 +10,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -31,6 +32,9 @@ public:
     /// 0 when the last restrict_ensemble() succeeded; a message otherwise.
     virtual int status() const { return 0; }
     virtual std::string status_message() const { return {}; }
+    /// State carried from sample to sample (a warm start), for checkpoints; empty if none.
+    virtual std::vector<double> saved_state() const { return {}; }
+    virtual void restore_state(const std::vector<double>& state) { (void)state; }
 };
 
 /// X = the ensemble-mean ICDF of the observed species (m nodes); every realization is lifted to

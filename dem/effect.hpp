@@ -53,6 +53,8 @@ struct ThermoStats {
     long contacts = 0;          ///< touching particle pairs
     long wall_contacts = 0;     ///< particles touching a wall
     double max_overlap = 0.0;   ///< largest overlap / diameter of the pair
+    Tag max_overlap_tag = -1;      ///< a particle of that contact (-1: none)
+    Tag max_overlap_partner = -1;  ///< the other particle, or -1 for a wall
 };
 
 /// Derived parameters an effect reports for `efdem --check` and the run log.

@@ -116,6 +116,10 @@ System build_system(const Params& root, const RealizationSpec& spec) {
     options.dt = scene.dt;
     options.skin = scene.skin;
     options.realization = spec.realization;
+    // The numerical watchdog (System::health_problem): how often, and the largest overlap.
+    const Params watchdog = root.scope("watchdog");
+    options.health_check_every = watchdog.get_or<long>("check_every", 1000, Bounds::closed(0, 1000000000));
+    options.max_overlap_fraction = watchdog.get_or<double>("max_overlap", 0.1, Bounds::open_closed(0.0, 1.0));
     System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
     check_initial_state(sys, bed, root.scope("bed"), options);
     return sys;

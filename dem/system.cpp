@@ -192,9 +192,12 @@ std::optional<std::string> System::health_problem() const {
     }
     const ThermoStats s = thermo_stats();
     if (s.max_overlap > options_.max_overlap_fraction)
-        return fmt::format("an overlap of {:.3g} diameters exceeds the limit {:.3g}: contacts are "
-                           "too soft for the impact speeds or the time step is too large",
-                           s.max_overlap, options_.max_overlap_fraction);
+        return fmt::format("an overlap of {:.3g} diameters exceeds the limit {:.3g} (watchdog.max_overlap), "
+                           "particle {} with {}: contacts are too soft for the impact speeds or the "
+                           "time step is too large",
+                           s.max_overlap, options_.max_overlap_fraction, s.max_overlap_tag,
+                           s.max_overlap_partner < 0 ? std::string("a wall")
+                                                     : fmt::format("particle {}", s.max_overlap_partner));
     return std::nullopt;
 }
 

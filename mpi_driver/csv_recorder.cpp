@@ -8,16 +8,20 @@
 namespace efdem::mpi_driver {
 
 namespace {
-std::FILE* open_or_fail(const std::filesystem::path& p) {
-    std::FILE* f = std::fopen(p.string().c_str(), "w");
+std::FILE* open_or_fail(const std::filesystem::path& p, bool append = false) {
+    std::FILE* f = std::fopen(p.string().c_str(), append ? "a" : "w");
     if (!f) throw RuntimeFailure("cannot open " + p.string() + " for writing");
     return f;
 }
 }  // namespace
 
 CsvRecorder::CsvRecorder(const std::filesystem::path& dir, const std::string& prefix,
-                         const RunProvenance& prov)
-    : steps_path_(dir / (prefix + "_cpi_steps.csv")), icdf_(open_or_fail(dir / (prefix + "_mean_icdf.csv"))) {
+                         const RunProvenance& prov, bool resume)
+    : steps_path_(dir / (prefix + "_cpi_steps.csv")), icdf_(open_or_fail(dir / (prefix + "_mean_icdf.csv"), resume)) {
+    if (resume) {
+        if (prov.mode == "cpi") steps_ = open_or_fail(steps_path_, true);
+        return;
+    }
     fmt::print(icdf_, "# efdem {} ({}): ensemble-mean ICDF of '{}' heights [d_p] over R = {} realizations\n",
                version(), git_hash(), prov.observed_species, prov.realizations);
     fmt::print(icdf_, "# scene {}; mode {}; time in sqrt(d_p/g)\n", prov.scene_file, prov.mode);

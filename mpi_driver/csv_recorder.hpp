@@ -12,8 +12,9 @@ namespace efdem::mpi_driver {
 
 class CsvRecorder final : public RunRecorder {
 public:
+    /// `resume`: append to the files a restart put back (no headers written).
     CsvRecorder(const std::filesystem::path& directory, const std::string& prefix,
-                const RunProvenance& provenance);
+                const RunProvenance& provenance, bool resume = false);
     ~CsvRecorder() override;
     CsvRecorder(const CsvRecorder&) = delete;
     CsvRecorder& operator=(const CsvRecorder&) = delete;

@@ -25,8 +25,10 @@ struct RealizationOutput {
 class DemRealization final : public Realization {
 public:
     /// `observed`: the species whose heights make the ICDF (colour 1); `other`: colour 0.
+    /// `restarting`: the state will be restored from a checkpoint, so the per-realization
+    /// outputs do not record the (discarded) initial state.
     DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
-                   const RealizationOutput& output);
+                   const RealizationOutput& output, bool restarting = false);
 
     long index() const override { return system_.realization(); }
     double time() const override { return system_.time(); }
@@ -39,6 +41,9 @@ public:
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
     void apply_lift(const LiftPayload& lifted) override;
     void after_sample(long samples_taken) override;
+    RealizationState save_state() const override;
+    /// RuntimeFailure if the state does not fit this realization (particle count, tags, history).
+    void restore_state(const RealizationState& state) override;
 
     dem::System& system() { return system_; }
     const dem::System& system() const { return system_; }

@@ -53,17 +53,25 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
 }
 }  // namespace
 
-RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress) {
-    const double t_end = stepper.time() + s.duration;
-    long remaining = std::lround(s.duration / s.observe.interval);
+RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress, const RunControl& control) {
+    const DriverState state = control.resume.value_or(DriverState{stepper.time()});
+    const double t_end = state.t_origin + s.duration;
+    const long total = std::lround(s.duration / s.observe.interval);
+    long done = stepper.samples_taken();
+    const long every = control.checkpoint_interval;
     // Chunks of about 10 time units keep the burst buffer small; sampling is unaffected.
     const long chunk = std::max(1L, std::lround(10.0 / s.observe.interval));
     coarse::BurstSamples scratch;
-    while (remaining > 0) {
-        const long n = std::min(chunk, remaining);
+    while (done < total) {
+        long n = std::min(chunk, total - done);
+        if (every > 0) n = std::min(n, every - done % every);
         scratch = {};
         stepper.run(static_cast<double>(n) * s.observe.interval, scratch);
-        remaining -= n;
+        done += n;
+        if (every > 0 && done % every == 0 && done < total) {
+            const auto path = stepper.checkpoint(done, state);
+            log::info("checkpoint {} (t = {:.6g})", path.string(), stepper.time());
+        }
     }
     stepper.finish();
     progress.update(stepper.time(), stepper.particle_steps(), "done", true);
@@ -78,8 +86,9 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
 }
 
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::EnsembleObservable& fallback,
-                   RunRecorder* recorder, Progress& progress) {
-    const double t_start = stepper.time();
+                   RunRecorder* recorder, Progress& progress, const RunControl& control) {
+    const DriverState resumed = control.resume.value_or(DriverState{stepper.time()});
+    const double t_start = resumed.t_origin;
     const double t_end = t_start + s.duration;
     const bool compact = s.cpi.observable == CpiSettings::Observable::compact;
     // ICDF targets are made non-decreasing and clipped into the heights the particles occupy
@@ -94,11 +103,17 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
                   "mass; with {} realizations the wave phases average out and the period may not be "
                   "measurable. DT = k T is the single-realization method of the paper (Fig. 2b); for "
                   "an ensemble use cpi.projection = fixed", stepper.realizations());
-    bool fell_back = false;
+    bool fell_back = resumed.fell_back;
+    if (fell_back) {
+        stepper.set_observable(fallback);
+        integrator = make_integrator(s, icdf_repair);
+    }
     RunSummary sum;
     sum.end_status = "completed";
-    int without_progress = 0;
-    if (s.cpi.warmup > 0) {
+    sum.coarse_steps = resumed.coarse_steps;
+    long without_progress = resumed.without_progress;
+    long last_checkpoint = sum.coarse_steps;
+    if (s.cpi.warmup > 0 && !control.resume) {
         // The initial bed (packed, at rest) is far from the slow manifold: run it directly
         // until the fast transients (fluidization) are gone before the first projection.
         coarse::BurstSamples warmup;
@@ -106,6 +121,13 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
         log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step", s.cpi.warmup);
     }
     while (stepper.time() < t_end - kTimeTolerance * std::max(1.0, t_end)) {
+        // Between coarse steps: nothing of the last burst is needed any more.
+        const long every = control.checkpoint_interval;
+        if (every > 0 && sum.coarse_steps != last_checkpoint && sum.coarse_steps % every == 0) {
+            const auto path = stepper.checkpoint(sum.coarse_steps, {t_start, sum.coarse_steps, without_progress, fell_back});
+            log::info("checkpoint {} (t = {:.6g}, after coarse step {})", path.string(), stepper.time(), sum.coarse_steps);
+            last_checkpoint = sum.coarse_steps;
+        }
         const coarse::ProjectiveStepRecord rec = integrator->step(stepper);
         ++sum.coarse_steps;
         const LiftRecord lift = rec.lifted ? stepper.last_lift() : LiftRecord{};

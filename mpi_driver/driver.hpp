@@ -6,9 +6,15 @@
 /// * cpi: repeat { burst -> slope -> projective forward Euler jump -> lift } until run.duration
 ///   is reached (DT fixed, or DT = k T with travelling waves).
 ///
-/// Both end with EnsembleStepper::finish() so that the other ranks leave serve().
+/// Both end with EnsembleStepper::finish() so that the other ranks leave serve(). Both write a
+/// checkpoint every RunControl::checkpoint_interval coarse steps / samples (a whole-ensemble
+/// file, checkpoint_writer.hpp) and continue a restarted run from RunControl::resume, so that
+/// the output equals that of the uninterrupted run.
+
+#include <optional>
 
 #include "coarse/ensemble_observable.hpp"
+#include "mpi_driver/checkpoint_format.hpp"
 #include "mpi_driver/ensemble_stepper.hpp"
 #include "mpi_driver/progress.hpp"
 #include "mpi_driver/run_recorder.hpp"
@@ -16,11 +22,22 @@
 
 namespace efdem::mpi_driver {
 
-RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Progress& progress);
+/// Checkpointing and restart of a run loop.
+struct RunControl {
+    /// Checkpoint every this many coarse steps (cpi) or samples (direct); 0: never. Needs the
+    /// stepper's checkpoint writer.
+    long checkpoint_interval = 0;
+    /// The loop state saved in the checkpoint a restarted run continues from.
+    std::optional<DriverState> resume;
+};
+
+RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Progress& progress,
+                      const RunControl& control = {});
 
 /// `fallback`: the ICDF observable the run switches to when the compact observable fails
 /// (y(p) identically zero, or a fit that does not converge); ignored with cpi.observable = icdf.
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& settings,
-                   coarse::EnsembleObservable& fallback, RunRecorder* recorder, Progress& progress);
+                   coarse::EnsembleObservable& fallback, RunRecorder* recorder, Progress& progress,
+                   const RunControl& control = {});
 
 }  // namespace efdem::mpi_driver

@@ -30,7 +30,19 @@ bool EnsembleStepper::needs_top_half() const {
 }
 
 void EnsembleStepper::fail(const std::string& message, long realization) const {
-    layout_.mpi().abort(fmt::format("realization {}: {}", realization, message), kExitRuntimeFailure);
+    // The failed state is not written: it is not healthy, and the other ranks are not at a
+    // point where they could join a collective write. The newest checkpoint is the last
+    // healthy state saved.
+    std::string saved;
+    if (!writer_) saved = "checkpointing is off (checkpoint.interval = 0): there is no checkpoint to restart from";
+    else if (last_checkpoint_.empty()) saved = "no checkpoint had been written yet";
+    else
+        saved = fmt::format("the failed state is not checkpointed; the newest checkpoint, {} (t = {:.6g}), "
+                            "holds the last saved healthy state (restart=FILE)",
+                            last_checkpoint_.string(), last_checkpoint_time_);
+    const std::string who = fmt::format("realization {}: ", realization);
+    layout_.mpi().abort(fmt::format("{}{}; {}", message.rfind(who, 0) == 0 ? "" : who, message, saved),
+                        kExitRuntimeFailure);
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
@@ -59,9 +71,56 @@ void EnsembleStepper::serve() {
         switch (m.command) {
             case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
             case Command::lift: do_lift(m.value, m.top_half, nullptr); break;
+            case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr); break;
             case Command::finish: return;
         }
     }
+}
+
+std::filesystem::path EnsembleStepper::checkpoint(long sequence, const DriverState& driver) {
+    EFDEM_EXPECTS(writer_ != nullptr);
+    broadcast({Command::checkpoint, static_cast<double>(sequence), false});
+    CheckpointHeader header;
+    header.stepper = saved_state();
+    header.driver = driver;
+    return do_checkpoint(sequence, &header);
+}
+
+std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const CheckpointHeader* header) {
+    std::vector<RealizationState> states;
+    try {
+        for (const auto& r : local_) states.push_back(r->save_state());
+        last_checkpoint_ = writer_->write(sequence, states, header);
+        last_checkpoint_time_ = time();
+        return last_checkpoint_;
+    } catch (const std::exception& e) {
+        layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()), kExitRuntimeFailure);
+    }
+}
+
+StepperState EnsembleStepper::saved_state() const {
+    StepperState s;
+    s.samples_taken = samples_taken_;
+    s.micro_time = micro_time_;
+    s.particle_steps = particle_steps_;
+    s.height_lo = height_range_.first;
+    s.height_hi = height_range_.second;
+    for (const auto& l : lifting_) s.lifting.push_back(l.state());
+    s.observable = observable_->saved_state();
+    if (settings_.recorded) s.recorded = settings_.recorded->saved_state();
+    return s;
+}
+
+void EnsembleStepper::restore_state(const StepperState& s) {
+    samples_taken_ = s.samples_taken;
+    micro_time_ = s.micro_time;
+    particle_steps_ = s.particle_steps;
+    height_range_ = {s.height_lo, s.height_hi};
+    if (!layout_.is_root()) return;
+    EFDEM_EXPECTS(s.lifting.size() == lifting_.size());
+    for (std::size_t r = 0; r < lifting_.size(); ++r) lifting_[r].set_state(s.lifting[r]);
+    observable_->restore_state(s.observable);
+    if (settings_.recorded) settings_.recorded->restore_state(s.recorded);
 }
 
 void EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {

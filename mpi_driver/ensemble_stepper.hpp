@@ -14,8 +14,9 @@
 ///
 /// Only the root runs the macro integrator. The root's run()/lift() first broadcast a command;
 /// the other ranks sit in serve(), which executes the same collectives, until finish().
-/// A failure while running (e.g. a blown-up realization) is printed with the rank and
-/// realization named, and MPI_Abort ends the job: nobody waits in a collective.
+/// A failure while running (e.g. a blown-up realization: the watchdog of dem::System) is printed
+/// with the rank and realization named, and where the last checkpoint is, and MPI_Abort ends the
+/// job: nobody waits in a collective.
 
 #include <memory>
 #include <utility>
@@ -25,6 +26,7 @@
 #include "coarse/ensemble_observable.hpp"
 #include "coarse/probability_grid.hpp"
 #include "core/rng.hpp"
+#include "mpi_driver/checkpoint_format.hpp"
 #include "mpi_driver/ensemble_layout.hpp"
 #include "mpi_driver/progress.hpp"
 #include "mpi_driver/realization.hpp"
@@ -62,6 +64,17 @@ public:
     void run(double duration, coarse::BurstSamples& out) override;
     void lift(const Eigen::VectorXd& target, double new_time) override;
 
+    /// Root: write a whole-ensemble checkpoint numbered `sequence` with the driver's state
+    /// (every rank joins through serve()). Needs set_checkpoint_writer(). Returns its path.
+    std::filesystem::path checkpoint(long sequence, const DriverState& driver);
+    /// Every rank: the writer used by checkpoint() (null: none).
+    void set_checkpoint_writer(const CheckpointSink* writer) { writer_ = writer; }
+    /// The coarse layer's state (root: all of it; elsewhere the counters), and its restoration
+    /// on a restart (every rank; the lifting streams and warm starts matter on the root only).
+    StepperState saved_state() const;
+    void restore_state(const StepperState& state);
+    long samples_taken() const { return samples_taken_; }
+
     /// Non-root ranks: execute the root's commands until finish(). Collective.
     void serve();
     /// Root: release the other ranks from serve().
@@ -97,7 +110,7 @@ public:
     std::vector<std::unique_ptr<Realization>>& local() { return local_; }
 
 private:
-    enum class Command : int { run = 1, lift = 2, finish = 3 };
+    enum class Command : int { run = 1, lift = 2, finish = 3, checkpoint = 4 };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
     /// exactly the collectives the root joins).
@@ -110,6 +123,7 @@ private:
     void do_run(long samples, bool top_half, coarse::BurstSamples* out);
     void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target);
     void take_sample(bool top_half, coarse::BurstSamples* out);
+    std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header);
     [[noreturn]] void fail(const std::string& message, long realization) const;
 
     const EnsembleLayout& layout_;
@@ -119,6 +133,9 @@ private:
     const Lifter& lifter_;
     RunRecorder* recorder_;
     Progress* progress_;
+    const CheckpointSink* writer_ = nullptr;
+    std::filesystem::path last_checkpoint_;  ///< every rank: the newest checkpoint written
+    double last_checkpoint_time_ = 0;
     coarse::ProbabilityGrid grid_;
     std::vector<RandomStream> lifting_;  ///< root: one lifting stream per realization
     long samples_taken_ = 0;

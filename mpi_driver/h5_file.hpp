@@ -22,6 +22,8 @@ class H5Series {
 public:
     enum class Type { real, integer, text };
     H5Series(H5File& file, const std::string& name, std::vector<hsize_t> row_shape, Type type);
+    /// Opens the existing series `name` of `file` to append to it (a restarted run).
+    static H5Series open(H5File& file, const std::string& name, Type type);
     ~H5Series();
     H5Series(H5Series&& other) noexcept;
     H5Series& operator=(H5Series&&) = delete;
@@ -36,6 +38,7 @@ public:
     hsize_t rows() const { return rows_; }
 
 private:
+    H5Series() = default;
     void extend_and_write(const void* data, hid_t memtype);
     H5File* file_;
     std::string name_;
@@ -50,6 +53,8 @@ class H5File {
 public:
     /// Creates (truncates) `path`.
     static H5File create(const std::filesystem::path& path);
+    /// Opens an existing file (serial driver); RuntimeFailure naming the file if it cannot.
+    static H5File open(const std::filesystem::path& path, bool writable);
     ~H5File();
     H5File(H5File&& other) noexcept;
     H5File& operator=(H5File&&) = delete;
@@ -57,7 +62,7 @@ public:
     H5File& operator=(const H5File&) = delete;
 
     void create_group(const std::string& path);
-    /// Attributes on an existing object ("/" for the file).
+    /// Attributes on an existing object ("/" for the file); an existing one is replaced.
     void attribute(const std::string& object, const std::string& name, const std::string& value);
     void attribute(const std::string& object, const std::string& name, double value);
     void attribute(const std::string& object, const std::string& name, std::int64_t value);
@@ -65,7 +70,25 @@ public:
     void write(const std::string& name, std::span<const double> data, std::vector<hsize_t> shape);
     /// A scalar variable-length string dataset.
     void write_text(const std::string& name, const std::string& text);
+    /// Fixed datasets of 64-bit integers and of bytes (row-major; any shape may have a zero).
+    void write(const std::string& name, std::span<const std::int64_t> data, std::vector<hsize_t> shape);
+    void write_bytes(const std::string& name, std::span<const std::uint8_t> data);
     void flush();
+
+    // Reading (checkpoints): RuntimeFailure naming the file and object on any failure.
+    bool exists(const std::string& name) const;
+    bool has_attribute(const std::string& object, const std::string& name) const;
+    std::int64_t attribute_integer(const std::string& object, const std::string& name) const;
+    std::string attribute_text(const std::string& object, const std::string& name) const;
+    /// Dimensions of a dataset.
+    std::vector<hsize_t> shape(const std::string& name) const;
+    /// Rows [first, first + count) of a dataset (all of it: first = 0, count = rows), flattened.
+    std::vector<double> read_doubles(const std::string& name, hsize_t first = 0, hsize_t count = ~hsize_t{0}) const;
+    std::vector<std::int64_t> read_integers(const std::string& name, hsize_t first = 0, hsize_t count = ~hsize_t{0}) const;
+    std::vector<std::uint8_t> read_bytes(const std::string& name, hsize_t first = 0, hsize_t count = ~hsize_t{0}) const;
+    /// Names of the members of a group, in name order.
+    std::vector<std::string> members(const std::string& group) const;
+    std::string read_text(const std::string& name) const;
 
     hid_t id() const { return file_; }
     const std::string& path() const { return path_; }

@@ -22,8 +22,14 @@ std::span<const double> as_span(const Eigen::VectorXd& v) { return {v.data(), st
 }  // namespace
 
 Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& file, const RunProvenance& p,
-                           Eigen::Index coarse_dimension)
-    : file_(H5File::create(file)), realizations_(p.realizations), m_(p.p_grid.size()), dim_(coarse_dimension) {
+                           Eigen::Index coarse_dimension, bool resume)
+    : file_(resume ? H5File::open(file, true) : H5File::create(file)), realizations_(p.realizations),
+      m_(p.p_grid.size()), dim_(coarse_dimension) {
+    if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
+        file_.attribute("/", "ranks", std::int64_t{p.ranks});
+        file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
+        return;
+    }
     file_.attribute("/", "format_version", kRunFileFormatVersion);
     file_.attribute("/", "efdem_version", version());
     file_.attribute("/", "git_hash", git_hash());
@@ -47,7 +53,9 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& file, const RunProvenanc
 
 H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type) {
     auto it = series_.find(name);
-    if (it == series_.end()) it = series_.emplace(name, H5Series(file_, name, std::move(row_shape), type)).first;
+    if (it == series_.end())
+        it = series_.emplace(name, file_.exists(name) ? H5Series::open(file_, name, type)
+                                                      : H5Series(file_, name, std::move(row_shape), type)).first;
     return it->second;
 }
 

@@ -32,8 +32,9 @@ inline constexpr std::int64_t kRunFileFormatVersion = 1;
 
 class Hdf5Recorder final : public RunRecorder {
 public:
+    /// `resume`: continue the existing file (put back by a restart) instead of creating one.
     Hdf5Recorder(const std::filesystem::path& file, const RunProvenance& provenance,
-                 Eigen::Index coarse_dimension);
+                 Eigen::Index coarse_dimension, bool resume = false);
     void sample(const SampleRecord& s) override;
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;

@@ -25,11 +25,14 @@
 #include "mpi_driver/ensemble_layout.hpp"
 #include "mpi_driver/ensemble_stepper.hpp"
 #if EFDEM_HAVE_HDF5
+#include "mpi_driver/checkpoint_writer.hpp"
 #include "mpi_driver/hdf5_recorder.hpp"
 #endif
 #include "mpi_driver/mpi_broadcast.hpp"
 #include "mpi_driver/mpi_session.hpp"
 #include "mpi_driver/recorder_list.hpp"
+#include "mpi_driver/restart_check.hpp"
+#include "mpi_driver/restart_loader.hpp"
 #include "mpi_driver/run_options.hpp"
 #include "mpi_driver/run_settings.hpp"
 #include "mpi_driver/scene_input.hpp"
@@ -56,8 +59,9 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
 }
 
 /// Runs the scene: the root drives (direct or cpi loop) and records; the other ranks serve.
+/// `restart`: the checkpoint to continue from (null: a new run).
 int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
-        std::vector<dem::System> systems, InjectedFailure injected) {
+        std::vector<dem::System> systems, InjectedFailure injected, const RestartData* restart) {
     const RunProvenance prov = provenance(mpi, table, s, systems.front());
     const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
     const bool cpi = s.mode == RunSettings::Mode::cpi;
@@ -72,23 +76,43 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
 
     std::unique_ptr<RecorderList> recorders;
     std::vector<std::unique_ptr<Realization>> local;
+    const bool resume = restart != nullptr;
     try {
         if (mpi.is_root()) {
+            if (resume) restore_outputs(restart->header, s.output.directory, s.output.prefix);
             std::vector<std::unique_ptr<RunRecorder>> owned;
 #if EFDEM_HAVE_HDF5
             owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory / (s.output.prefix + ".h5"), prov,
-                                                           observable.dimension()));
+                                                           observable.dimension(), resume));
 #endif
-            owned.push_back(std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov));
+            owned.push_back(std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov, resume));
             recorders = std::make_unique<RecorderList>(std::move(owned));
         }
         RealizationOutput out{s.output.directory, s.output.prefix,
                               std::lround(s.output.vtk_interval / s.observe.interval),
                               std::lround(s.output.thermo_interval / s.observe.interval)};
         for (auto& sys : systems)
-            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species, s.observe.other, out));
+            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species, s.observe.other, out,
+                                                             resume));
     } catch (const std::exception& e) {
         mpi.abort(e.what(), kExitRuntimeFailure);
+    }
+    if (resume) {
+        // A state that does not fit the scene's realizations (another bed) is an input error.
+        int code = kExitOk;
+        std::string message;
+        try {
+            for (std::size_t j = 0; j < local.size(); ++j) local[j]->restore_state(restart->local[j]);
+        } catch (const std::exception& e) {
+            code = kExitInputError;
+            message = fmt::format("{}: checkpoint does not fit the scene: {}", restart->path.string(), e.what());
+        }
+        const Agreement agreed = agree_on_failure(mpi.comm(), code, message);
+        if (agreed.exit_code != kExitOk) {
+            if (mpi.is_root()) log::error("{}", agreed.message);
+            return agreed.exit_code;
+        }
+        log::info("restarted from {} at t = {:.6g}", restart->path.string(), local.front()->time());
     }
     log::info("efdem {}: {} run of {} on {} ranks x {} = {} realizations ({} particles each), output {}/{}.*",
               version(), prov.mode, table.file(), mpi.size(), s.realizations_per_rank, prov.realizations,
@@ -101,18 +125,43 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.seed = s.seed;
     ss.failure = injected;
     ss.recorded = recorded.get();
-    const double t0 = local.front()->time();
+    // The run's start (progress counts from there; on the non-root ranks it is not used).
+    const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
     const ColourLifter lifter;
     EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, recorders.get(),
                             mpi.is_root() ? &progress : nullptr);
+    RunControl control;
+    if (resume) {
+        stepper.restore_state(restart->header.stepper);
+        control.resume = restart->header.driver;
+    }
+#if EFDEM_HAVE_HDF5
+    std::unique_ptr<CheckpointWriter> writer;
+    if (s.checkpoint.enabled()) {
+        CheckpointHeader identity;
+        identity.mode = prov.mode;
+        identity.realizations = prov.realizations;
+        identity.scene_text = table.text();
+        identity.parameters = parameter_lines(table);
+        const auto& dir = s.output.directory;
+        const auto& prefix = s.output.prefix;
+        writer = std::make_unique<CheckpointWriter>(
+            layout, s.checkpoint, prefix, std::move(identity),
+            std::vector<std::filesystem::path>{dir / (prefix + ".h5"), dir / (prefix + "_mean_icdf.csv"),
+                                               dir / (prefix + "_cpi_steps.csv")});
+        stepper.set_checkpoint_writer(writer.get());
+        control.checkpoint_interval = s.checkpoint.interval;
+    }
+#endif
     if (!mpi.is_root()) {
         stepper.serve();
         return kExitOk;
     }
     RunSummary summary;
     try {
-        summary = cpi ? run_cpi(stepper, s, icdf, recorders.get(), progress) : run_direct(stepper, s, progress);
+        summary = cpi ? run_cpi(stepper, s, icdf, recorders.get(), progress, control)
+                      : run_direct(stepper, s, progress, control);
         recorders->finish(summary);
     } catch (const std::exception& e) {
         mpi.abort(e.what(), kExitRuntimeFailure);
@@ -186,7 +235,15 @@ int main(int argc, char** argv) {
         }
         table->check_all_used(
             [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
-        if (!check) std::filesystem::create_directories(settings->output.directory);
+        if (!check) {
+            std::filesystem::create_directories(settings->output.directory);
+            if (settings->checkpoint.enabled()) std::filesystem::create_directories(settings->checkpoint.directory);
+        }
+#if !EFDEM_HAVE_HDF5
+        if (settings->checkpoint.enabled() || !options.restart.empty())
+            throw InputError(SourceLocation{"<command line>", 0},
+                             "checkpoints need HDF5, and this efdem was built without it (EFDEM_ENABLE_HDF5=OFF)");
+#endif
     } catch (const InputError& e) {
         code = kExitInputError;
         message = e.what();
@@ -195,8 +252,9 @@ int main(int argc, char** argv) {
         message = e.what();
     } catch (const std::filesystem::filesystem_error& e) {
         code = kExitInputError;
-        message = fmt::format("output.directory = '{}' cannot be created: {}",
-                              settings->output.directory.string(), e.code().message());
+        message = fmt::format("{} = '{}' cannot be created: {}",
+                              e.path1() == settings->output.directory ? "output.directory" : "checkpoint.directory",
+                              e.path1().string(), e.code().message());
     } catch (const std::exception& e) {
         code = kExitRuntimeFailure;
         message = std::string("unexpected failure during set-up: ") + e.what();
@@ -211,5 +269,16 @@ int main(int argc, char** argv) {
             std::printf("%s", check_report(*table, *settings, systems.front(), mpi.size()).c_str());
         return kExitOk;
     }
-    return run(mpi, *table, *settings, std::move(systems), injected);
+    std::optional<RestartData> restart;
+    if (!options.restart.empty()) {
+        restart.emplace();
+        const Agreement loaded = load_restart(mpi.world(), options.restart, parameter_lines(*table),
+                                              settings->realizations_per_rank,
+                                              settings->checkpoint.allow_physics_change, *restart);
+        if (loaded.exit_code != kExitOk) {
+            if (mpi.is_root()) log::error("{}", loaded.message);
+            return loaded.exit_code;
+        }
+    }
+    return run(mpi, *table, *settings, std::move(systems), injected, restart ? &*restart : nullptr);
 }

@@ -15,7 +15,9 @@
 #include <Eigen/Core>
 
 #include "coarse/probability_grid.hpp"
+#include "core/error.hpp"
 #include "core/rng.hpp"
+#include "mpi_driver/realization_state.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -60,6 +62,15 @@ public:
     virtual void apply_lift(const LiftPayload& lifted) = 0;
     /// Called after every sample with the running sample count (per-realization outputs).
     virtual void after_sample(long samples_taken) { (void)samples_taken; }
+    /// The complete state for a checkpoint, and its exact restoration (checkpoint restart).
+    /// Realizations that cannot be checkpointed (test models) keep the defaults, which refuse.
+    virtual RealizationState save_state() const {
+        throw RuntimeFailure("this realization type cannot be checkpointed");
+    }
+    virtual void restore_state(const RealizationState& state) {
+        (void)state;
+        throw RuntimeFailure("this realization type cannot be restored from a checkpoint");
+    }
 };
 
 /// Root side of lifting: a pure function of the target, the realization's report and its

@@ -15,7 +15,10 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
         else if (arg == "--check") o.action = Action::check;
         else if (arg.rfind("--", 0) == 0)
             throw InputError(where, "unknown option '" + arg + "'; see efdem --help");
-        else if (arg.find('=') != std::string::npos) o.overrides.push_back(arg);
+        else if (arg.rfind("restart=", 0) == 0) {
+            o.restart = arg.substr(8);
+            if (o.restart.empty()) throw InputError(where, "restart= needs a checkpoint file: restart=FILE");
+        } else if (arg.find('=') != std::string::npos) o.overrides.push_back(arg);
         else if (o.scene.empty()) o.scene = arg;
         else
             throw InputError(where, "a second scene file '" + arg + "' was given after '" + o.scene +
@@ -31,6 +34,7 @@ std::string RunOptions::usage() {
 
 usage:
   mpirun -np P efdem SCENE [key=value ...]    run the scene (direct or cpi mode)
+  mpirun -np P efdem SCENE restart=FILE [...] continue from a checkpoint
   efdem --check SCENE [key=value ...]         read the scene, build one realization, report the
                                               active effects and everything derived from the
                                               inputs, run zero steps
@@ -39,6 +43,9 @@ usage:
   efdem --help                                this text
 
 key=value arguments override the scene file (e.g. seed=7 output.directory=runs/a).
+restart=FILE continues the run saved in the checkpoint FILE (checkpoint.interval = N writes
+one every N coarse steps, or N samples in direct mode); the scene must have the same physics
+unless restart.allow_physics_change=true.
 Exit codes: 0 success, 2 input error (nothing was computed), 3 failure while running.
 Documentation: README.md, docs/ (effects in docs/effects/).
 )";

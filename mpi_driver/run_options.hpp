@@ -16,6 +16,7 @@ struct RunOptions {
     enum class Action { run, check, help, version, list_effects } action = Action::run;
     std::string scene;                   ///< path of the scene file
     std::vector<std::string> overrides;  ///< "key=value"
+    std::string restart;                 ///< `restart=FILE`: the checkpoint to continue from
 
     /// Parses argv; InputError (location "<command line>") for anything it does not understand.
     static RunOptions parse(int argc, const char* const* argv);

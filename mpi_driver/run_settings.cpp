@@ -88,6 +88,15 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.output.thermo_interval = output.get_or<double>("thermo_interval", 0.0, Bounds::non_negative());
     if (s.output.thermo_interval > 0)
         whole_multiple(output, "thermo_interval", s.output.thermo_interval, s.observe.interval, "observe.interval");
+
+    // Read in every run (get_or), so that a scene with a checkpoint block is valid whether or
+    // not it checkpoints, and a restart may change these keys freely.
+    const Params checkpoint = root.scope("checkpoint");
+    s.checkpoint.interval = checkpoint.get_or<long>("interval", 0, Bounds::closed(0, 1000000000));
+    s.checkpoint.keep = checkpoint.get_or<int>("keep", 2, Bounds::closed(1, 1000));
+    s.checkpoint.directory = checkpoint.get_or_path("directory", s.output.directory);
+    s.checkpoint.allow_physics_change = root.scope("restart").get_or<bool>("allow_physics_change", false);
+    s.checkpoint.debug_delay = root.scope("debug").get_or<double>("checkpoint_delay", 0.0, Bounds::closed(0, 3600));
     return s;
 }
 

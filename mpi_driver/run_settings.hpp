@@ -30,6 +30,13 @@
 /// | output.prefix                  | file stem of the run's files                        | efdem   |
 /// | output.vtk_interval            | time between VTK snapshots per realization (0: none)| 0       |
 /// | output.thermo_interval         | time between thermo lines per realization (0: none) | 0       |
+/// | checkpoint.interval            | checkpoint every N coarse steps (cpi) or N samples  | 0 (off) |
+/// |                                | (direct: N x observe.interval of DEM time)          |         |
+/// | checkpoint.keep                | K: how many of the newest checkpoints are kept      | 2       |
+/// | checkpoint.directory           | where checkpoints are written                       | output.directory |
+/// | restart.allow_physics_change   | accept a restart whose scene changes physics keys   | false   |
+/// | debug.checkpoint_delay         | test only: seconds to sleep inside every checkpoint | 0       |
+/// |                                | write (between the collective part and the marker)  |         |
 
 #include <cstdint>
 #include <filesystem>
@@ -69,6 +76,16 @@ struct OutputSettings {
     double thermo_interval = 0;
 };
 
+/// Whole-ensemble checkpoints (mpi_driver/checkpoint_writer.hpp). interval = 0: none.
+struct CheckpointSettings {
+    long interval = 0;            ///< coarse steps (cpi) or samples (direct) between checkpoints
+    int keep = 2;                 ///< newest checkpoints kept on disk
+    std::filesystem::path directory;
+    bool allow_physics_change = false;  ///< restart.allow_physics_change
+    double debug_delay = 0;       ///< seconds slept inside each write (kill tests)
+    bool enabled() const { return interval > 0; }
+};
+
 struct RunSettings {
     enum class Mode { direct, cpi } mode = Mode::direct;
     std::uint64_t seed = 1;
@@ -77,6 +94,7 @@ struct RunSettings {
     ObserveSettings observe;
     CpiSettings cpi;
     OutputSettings output;
+    CheckpointSettings checkpoint;
 
     /// Reads and cross-checks the run keys (dt and species come from the DEM scene).
     static RunSettings from_params(const Params& root, const dem::DemScene& scene);

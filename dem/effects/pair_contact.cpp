@@ -171,9 +171,15 @@ double PairContact::potential_energy(const ForceContext& ctx) const {
 }
 
 void PairContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const {
-    for_each_touching(ctx, [&](std::size_t, Index, std::uint32_t, const Vec3& d, double radsum) {
+    const auto tag = ctx.particles.tag();
+    for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t, const Vec3& d, double radsum) {
         ++stats.contacts;
-        stats.max_overlap = std::max(stats.max_overlap, (radsum - norm(d)) / radsum);
+        const double overlap = (radsum - norm(d)) / radsum;
+        if (overlap > stats.max_overlap) {
+            stats.max_overlap = overlap;
+            stats.max_overlap_tag = tag[i];
+            stats.max_overlap_partner = tag[j];
+        }
     });
 }
 

@@ -88,7 +88,11 @@ void WallContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const 
         if (ctx.domain.has_lid()) delta = std::max(delta, rad[i] - (ctx.domain.lid_height - x[i].z));
         if (delta > 0) {
             ++stats.wall_contacts;
-            stats.max_overlap = std::max(stats.max_overlap, delta / (2 * rad[i]));
+            if (delta / (2 * rad[i]) > stats.max_overlap) {
+                stats.max_overlap = delta / (2 * rad[i]);
+                stats.max_overlap_tag = ctx.particles.tag()[i];
+                stats.max_overlap_partner = -1;
+            }
         }
     }
 }

@@ -1,0 +1,92 @@
+#pragma once
+/// \file
+/// What a whole-ensemble checkpoint holds besides the realizations (root-level state), how
+/// checkpoint files are named, and the format version. Writing: checkpoint_writer.hpp;
+/// reading and validation: checkpoint_reader.hpp. Format (docs/reliability.md):
+///
+///   /                       attributes format_version, efdem_version, git_hash, build, mode,
+///                           realizations, sequence, header_checksum and, written last,
+///                           complete = 1 (a file without it was interrupted)
+///   /scene, /parameters     the scene text; every parameter as "key = value" lines
+///   /driver/reals           t_origin, micro_time, particle_steps, height_lo, height_hi
+///   /driver/integers        samples_taken, coarse_steps, without_progress, fell_back
+///   /driver/lifting         R x 4: each realization's lifting random stream (xoshiro state)
+///   /driver/observable, /driver/recorded   warm starts of the coarse observables
+///   /output/<suffix>        the run's output files (HDF5, CSV) as they were at the checkpoint,
+///                           named by what follows output.prefix (".h5", "_mean_icdf.csv", ...)
+///   /realizations/...       per realization (global index order): meta (index, step,
+///                           particles, pairs), time, checksum; per particle (rows offset by
+///                           the particle counts) x, v, omega, force, torque, reference,
+///                           wall_floor, wall_lid, tag, species; per pair pair_tags, pair_xi
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/rng.hpp"
+
+namespace efdem::mpi_driver {
+
+inline constexpr std::int64_t kCheckpointFormatVersion = 1;
+
+/// The root's state of the coarse layer (EnsembleStepper).
+struct StepperState {
+    long samples_taken = 0;
+    double micro_time = 0;
+    double particle_steps = 0;
+    double height_lo = 0, height_hi = 0;
+    std::vector<RandomStream::State> lifting;  ///< per realization
+    std::vector<double> observable;            ///< warm start of the integrator's observable
+    std::vector<double> recorded;              ///< warm start of the recorded-only observable
+};
+
+/// The run loop's state (driver.cpp).
+struct DriverState {
+    double t_origin = std::numeric_limits<double>::quiet_NaN();  ///< time the run started at
+    long coarse_steps = 0;
+    long without_progress = 0;
+    bool fell_back = false;  ///< the compact observable failed; the run continues on the ICDF
+};
+
+/// One of the run's output files, saved whole.
+struct OutputBlob {
+    std::string name;  ///< file name inside output.directory after output.prefix (".h5", ...)
+    std::string bytes;
+};
+
+/// Everything root-level in a checkpoint.
+struct CheckpointHeader {
+    std::int64_t format_version = kCheckpointFormatVersion;
+    std::string mode;
+    long realizations = 0;
+    long sequence = 0;  ///< coarse steps (cpi) or samples (direct) done
+    std::string scene_text;
+    std::string parameters;  ///< "key = value" lines
+    StepperState stepper;
+    DriverState driver;
+    std::vector<OutputBlob> outputs;
+
+    /// FNV-1a over every field: stored with the header, verified on restart.
+    std::uint64_t checksum() const;
+};
+
+struct RealizationState;
+
+/// Where the EnsembleStepper sends a checkpoint (CheckpointWriter; an interface so that the
+/// stepper does not depend on HDF5).
+class CheckpointSink {
+public:
+    virtual ~CheckpointSink() = default;
+    /// Collective; `header` on the root only. Returns the path written.
+    virtual std::filesystem::path write(long sequence, const std::vector<RealizationState>& local,
+                                        const CheckpointHeader* header) const = 0;
+};
+
+/// `<prefix>_ckpt_<sequence, 8 digits>.h5`: names sort in the order they were written.
+std::string checkpoint_file_name(const std::string& prefix, long sequence);
+/// Whether `name` is a complete checkpoint file name of `prefix` (not a .tmp).
+bool is_checkpoint_file_name(const std::string& name, const std::string& prefix);
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,119 @@
+// Checkpoint pieces that need no file: a realization's saved state put into a freshly built
+// realization continues bit for bit; checksums see one changed bit; which scene keys a restart
+// may change; checkpoint file names. (Whole-program restart tests: tests/scripts/restart_*.sh.)
+#include <catch2/catch.hpp>
+
+#include <cstring>
+
+#include "core/error.hpp"
+#include "core/param_table.hpp"
+#include "dem/scene.hpp"
+#include "mpi_driver/checkpoint_format.hpp"
+#include "mpi_driver/dem_realization.hpp"
+#include "mpi_driver/restart_check.hpp"
+
+using namespace efdem;
+using namespace efdem::mpi_driver;
+
+namespace {
+constexpr const char* kScene = R"(effects = gravity pair_contact wall_contact gas_drag
+dt = 1e-4
+domain.lx = 4.28
+domain.ly = 4.28
+domain.lid = 60
+species.names = light heavy
+species.density = 1 2
+species.diameter = 1 1
+pair_contact.kn = 2e5
+pair_contact.restitution = 0.9
+pair_contact.mu = 0.1
+gas_drag.superficial_velocity = 0.41
+bed.count = 64 64
+bed.settle = false
+)";
+
+DemRealization build(long realization) {
+    ParamTable table = ParamTable::from_text(kScene, "checkpoint_test.cfg");
+    dem::System sys = dem::build_system(table.root(), {3, realization, false});
+    return DemRealization(std::move(sys), 0, 1, RealizationOutput{});
+}
+
+bool same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
+}
+}  // namespace
+
+TEST_CASE("a saved realization restored into a fresh one continues bit for bit", "[mpi][checkpoint]") {
+    DemRealization original = build(2);
+    original.advance(6000);  // falling, colliding, neighbour list rebuilt, springs loaded
+    const RealizationState saved = original.save_state();
+    REQUIRE_FALSE(saved.pairs.empty());
+    DemRealization restored = build(2);
+    restored.restore_state(saved);
+    CHECK(restored.save_state().checksum() == saved.checksum());
+    original.advance(4000);
+    restored.advance(4000);
+    const RealizationState a = original.save_state(), b = restored.save_state();
+    CHECK(a.time == b.time);
+    CHECK(a.step == b.step);
+    CHECK(same_bits(a.x, b.x));
+    CHECK(same_bits(a.v, b.v));
+    CHECK(same_bits(a.omega, b.omega));
+    CHECK(a.checksum() == b.checksum());
+}
+
+TEST_CASE("a state that does not fit the realization is refused", "[mpi][checkpoint]") {
+    DemRealization r = build(0);
+    RealizationState s = r.save_state();
+    SECTION("another realization") {
+        s.index = 5;
+        CHECK_THROWS_WITH(r.restore_state(s), Catch::Contains("holds realization 5"));
+    }
+    SECTION("another particle count") {
+        s.x.pop_back();
+        CHECK_THROWS_WITH(r.restore_state(s), Catch::Contains("the checkpoint has 127 particles"));
+    }
+    SECTION("an unknown tag") {
+        s.tag[3] = 999999;
+        CHECK_THROWS_WITH(r.restore_state(s), Catch::Contains("tag 999999"));
+    }
+}
+
+TEST_CASE("the checksum of a realization sees one flipped bit", "[mpi][checkpoint]") {
+    RealizationState s = build(1).save_state();
+    const std::uint64_t before = s.checksum();
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &s.v[17].z, sizeof bits);
+    bits ^= 1;
+    std::memcpy(&s.v[17].z, &bits, sizeof bits);
+    CHECK(s.checksum() != before);
+    CHECK(from_stored(to_stored(before)) == before);
+}
+
+TEST_CASE("a restart may change run length, output and layout keys, not physics", "[mpi][checkpoint]") {
+    for (const char* key : {"run.duration", "output.prefix", "checkpoint.interval", "restart.allow_physics_change",
+                            "debug.checkpoint_delay", "watchdog.max_overlap", "ensemble.realizations_per_rank"})
+        CHECK(may_change_on_restart(key));
+    for (const char* key : {"dt", "seed", "pair_contact.kn", "cpi.dt", "mode", "observe.interval"})
+        CHECK_FALSE(may_change_on_restart(key));
+
+    CheckpointHeader h;
+    h.realizations = 4;
+    h.parameters = "dt = 1e-4\npair_contact.kn = 2e5\nrun.duration = 6\n";
+    CHECK(check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 2e5\nrun.duration = 60\n", 4, false).empty());
+    CHECK_THROWS_WITH(check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 3e5\nrun.duration = 6\n", 4, false),
+                      Catch::Contains("c.h5: checkpoint was written by a scene with different physics: "
+                                      "pair_contact.kn = 3e5 (checkpoint: 2e5)"));
+    CHECK_THAT(check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 3e5\n", 4, true),
+               Catch::Contains("pair_contact.kn = 3e5 (checkpoint: 2e5)"));
+    CHECK_THROWS_WITH(check_restart("c.h5", h, h.parameters, 2, false),
+                      Catch::Contains("holds 4 realizations but this run has 2"));
+}
+
+TEST_CASE("checkpoint file names sort in writing order and exclude .tmp files", "[mpi][checkpoint]") {
+    CHECK(checkpoint_file_name("run", 12) == "run_ckpt_00000012.h5");
+    CHECK(is_checkpoint_file_name("run_ckpt_00000012.h5", "run"));
+    CHECK_FALSE(is_checkpoint_file_name("run_ckpt_00000012.h5.tmp", "run"));
+    CHECK_FALSE(is_checkpoint_file_name("other_ckpt_00000012.h5", "run"));
+    CHECK_FALSE(is_checkpoint_file_name("run_ckpt_0000001x.h5", "run"));
+}

@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Hostile checkpoints: each bad restart ends every rank with exit code 2 and one message that
+# names the file and what is wrong; none crashes or hangs (`timeout` is the hang detector).
+#   hostile_checkpoints.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+set -uo pipefail
+efdem=$1; mpiexec=$2; shift 2
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+scene="$here/tiny_scene.cfg"
+common=(mode=direct run.duration=2 output.directory="$work")
+"$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=good checkpoint.interval=4 \
+  > "$work/good.log" 2>&1 || { cat "$work/good.log"; echo "FAIL: could not write a checkpoint"; exit 1; }
+good="$work/good_ckpt_00000004.h5"
+[ -f "$good" ] || { ls "$work"; echo "FAIL: no checkpoint"; exit 1; }
+failures=0
+
+# expect NAME FILE PATTERN [extra arguments]: exit code 2 and PATTERN (and the file) in the output
+expect() {
+  local name=$1 file=$2 pattern=$3; shift 3
+  timeout 120 "$mpiexec" -n 2 "${mpi_flags[@]}" "$efdem" "$scene" "${common[@]}" output.prefix=hostile \
+    restart="$file" "$@" > "$work/$name.log" 2>&1
+  local code=$?
+  if [ $code -eq 2 ] && grep -q -- "$pattern" "$work/$name.log" && grep -qF -- "$file" "$work/$name.log" \
+     && ! grep -qi "signal\|segmentation\|core dumped" "$work/$name.log"; then
+    echo "PASS: $name -> exit 2: $(grep -m1 -- "$pattern" "$work/$name.log")"
+  else
+    echo "FAIL: $name -> exit $code, expected 2 and '$pattern':"; cat "$work/$name.log"; failures=$((failures + 1))
+  fi
+}
+mpi_flags=("$@")
+
+mutate() {  # mutate COPY PYTHON-CODE (h5py file `f`)
+  cp "$good" "$1"
+  /usr/bin/python3 -c "import h5py, numpy as np
+with h5py.File('$1', 'r+') as f:
+    $2"
+}
+poke() {  # poke COPY DATASET: overwrite 8 bytes of a contiguous dataset in place (no HDF5 API)
+  cp "$good" "$1"
+  /usr/bin/python3 - "$1" "$2" <<'PY'
+import sys, h5py
+path, name = sys.argv[1], sys.argv[2]
+with h5py.File(path, "r") as f:
+    offset = f[name].id.get_offset()
+with open(path, "r+b") as raw:
+    raw.seek(offset + 16)
+    raw.write(b"\x13\x37\x13\x37\x13\x37\x13\x37")
+PY
+}
+
+expect missing "$work/no_such_checkpoint.h5" "file not found"
+head -c 5000 "$good" > "$work/truncated.h5"
+expect truncated "$work/truncated.h5" "truncated or corrupted"
+echo "not an HDF5 file" > "$work/text.h5"
+expect not_hdf5 "$work/text.h5" "truncated or corrupted"
+poke "$work/corrupt_particles.h5" /realizations/x
+expect corrupted_particles "$work/corrupt_particles.h5" "checksum of realization 0 does not match"
+poke "$work/corrupt_header.h5" /output/.h5
+expect corrupted_header "$work/corrupt_header.h5" "checksum of its root-level state does not match"
+mutate "$work/version.h5" "f.attrs['format_version'] = np.int64(99)"
+expect wrong_version "$work/version.h5" "format version 99"
+mutate "$work/incomplete.h5" "del f.attrs['complete']"
+expect incomplete "$work/incomplete.h5" "incomplete"
+expect wrong_scene "$good" "different physics: pair_contact.kn = 300000 (checkpoint: 2e5)" pair_contact.kn=300000
+expect wrong_count "$good" "holds 2 realizations but this run has 4" ensemble.realizations_per_rank=2
+expect other_bed "$good" "checkpoint does not fit the scene: realization 0: the checkpoint has 256 particles, the scene builds 200" \
+  "bed.count=100 100" restart.allow_physics_change=true
+
+# The same physics change is accepted when asked for.
+timeout 120 "$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=allowed restart="$good" \
+  pair_contact.kn=300000 restart.allow_physics_change=true > "$work/allowed.log" 2>&1 \
+  && grep -q "changed physics" "$work/allowed.log" \
+  && echo "PASS: restart.allow_physics_change=true accepts the change with a warning" \
+  || { cat "$work/allowed.log"; echo "FAIL: allowed physics change"; failures=$((failures + 1)); }
+
+[ $failures -eq 0 ] || { echo "$failures hostile-checkpoint case(s) failed"; exit 1; }
