@@ -39,13 +39,6 @@ System settled_binary_bed(long per_species, std::uint64_t seed) {
     return s;
 }
 
-GasDrag& gas_of(System& s) {
-    for (const auto& e : s.effects())
-        if (auto* g = dynamic_cast<GasDrag*>(e.get())) return *g;
-    FAIL("no gas_drag effect");
-    throw std::logic_error("unreachable");
-}
-
 struct FluidizedStats {
     double dp_min = INFINITY, dp_max = -INFINITY, dp_mean = 0, weight = 0;
     double v_max = 0, z_max = 0;
@@ -56,7 +49,7 @@ struct FluidizedStats {
 /// Runs `steps` at U_s = 0.41, sampling every `every` steps after the first 10 time units (the
 /// lift-off of the packed bed): the pressure drop, the fastest particle, the highest centre.
 FluidizedStats run_fluidized(System& s, long steps, long every) {
-    gas_of(s).set_superficial_velocity(0.41);
+    test::gas_effect(s).set_superficial_velocity(0.41);
     const double t0 = s.time();
     FluidizedStats r;
     r.weight = weight_per_area(s.particles(), s.domain());

@@ -78,13 +78,6 @@ System system_from(const Particles& p, long n_light, long n_heavy) {
     return System(scene.species, scene.domain, p, make_effects(scene, t.root()), o);
 }
 
-GasDrag& gas_of(System& s) {
-    for (const auto& e : s.effects())
-        if (auto* g = dynamic_cast<GasDrag*>(e.get())) return *g;
-    FAIL("no gas_drag effect");
-    throw std::logic_error("unreachable");
-}
-
 /// Time series of the bed observables, sampled every `every` time units.
 struct Series {
     std::vector<double> t, dp, height, z_com, z_light, z_heavy;
@@ -181,7 +174,7 @@ TEST_CASE("Delta P(U_s): Darcy below U_mf, the bed weight per area above (light 
     double darcy_slope = 0;
     for (double ratio : {0.2, 0.4, 0.6, 0.8, 0.9, 1.1, 1.3, 1.6, 2.2, 3.3}) {
         const double u = ratio * b.u_mf_bed;
-        gas_of(s).set_superficial_velocity(u);
+        test::gas_effect(s).set_superficial_velocity(u);
         const bool packed = ratio < 1;
         record(s, packed ? 2.0 : 10.0);  // relaxation
         const Series m = record(s, packed ? 2.0 : 20.0);
@@ -242,7 +235,7 @@ TEST_CASE("U_mf of light, heavy and binary beds brackets the bed-scale predictio
         const Particles start = s.particles();
         for (double ratio : {0.9, 1.1}) {
             System run = system_from(start, c.light, c.heavy);
-            gas_of(run).set_superficial_velocity(ratio * b.u_mf_bed);
+            test::gas_effect(run).set_superficial_velocity(ratio * b.u_mf_bed);
             record(run, 5.0);
             const Series m = record(run, 10.0);
             const double dp = m.mean(m.dp) / b.weight_per_area;
@@ -294,7 +287,7 @@ TEST_CASE(
           Case{"light", 300, 0, 1.0, 0.21, true}, Case{"light", 300, 0, 1.0, 0.25, false},
           Case{"heavy", 0, 300, 2.0, 0.41, true}}) {
         System s = settled_bed(c.light, c.heavy, 3, 5.5);
-        gas_of(s).set_superficial_velocity(c.u);
+        test::gas_effect(s).set_superficial_velocity(c.u);
         record(s, 10.0);
         const double phi_hom = 1 - std::pow(c.u * kA / c.rho, 1 / 4.65);
         double phi_sum = 0;
@@ -347,7 +340,7 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
     for (int k = 0; k < 2; ++k) {
         const double u = k == 0 ? 0.19 : 0.41;
         System s = system_from(start, 625, 625);
-        gas_of(s).set_superficial_velocity(u);
+        test::gas_effect(s).set_superficial_velocity(u);
         std::FILE* st =
             std::fopen((out_dir() / fmt::format("spacetime_u{:.2f}.csv", u)).string().c_str(), "w");
         REQUIRE(st != nullptr);
@@ -418,12 +411,12 @@ TEST_CASE("randomizing all velocities mid-run leaves the light-particle ICDF tra
     std::vector<Eigen::MatrixXd> q[2];  // [arm][realization](time, p)
     for (int r = 0; r < kR; ++r) {
         System s = settled_bed(250, 250, 100 + static_cast<std::uint64_t>(r));
-        gas_of(s).set_superficial_velocity(0.41);
+        test::gas_effect(s).set_superficial_velocity(0.41);
         record(s, 10.0);
         const Particles fork = s.particles();
         for (int arm = 0; arm < 2; ++arm) {
             System a = system_from(fork, 250, 250);
-            gas_of(a).set_superficial_velocity(0.41);
+            test::gas_effect(a).set_superficial_velocity(0.41);
             if (arm == 1) {
                 auto v = a.particles().v();
                 Vec3 mean{};

@@ -3,6 +3,7 @@
 // scene text (the real input path).
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,13 @@ inline dem::Particles random_particles(int n, double l, double z_lo, double z_hi
 /// A scene table from text (file name "test.cfg").
 inline ParamTable scene_table(const std::string& text) {
     return ParamTable::from_text(text, "test.cfg", EFDEM_SOURCE_DIR);
+}
+
+/// The system's gas_drag effect, to change U_s mid-run (a test error if the scene has none).
+inline dem::GasDrag& gas_effect(dem::System& s) {
+    for (const auto& e : s.effects())
+        if (auto* g = dynamic_cast<dem::GasDrag*>(e.get())) return *g;
+    throw std::logic_error("the system has no gas_drag effect");
 }
 
 }  // namespace efdem::test
