@@ -103,11 +103,15 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
                   "mass; with {} realizations the wave phases average out and the period may not be "
                   "measurable. DT = k T is the single-realization method of the paper (Fig. 2b); for "
                   "an ensemble use cpi.projection = fixed", stepper.realizations());
-    bool fell_back = resumed.fell_back;
-    if (fell_back) {
+    bool fell_back = false;
+    // From here on the full ICDF is the coarse variable (the compact fit failed, now or before
+    // the checkpoint this run resumed from).
+    auto fall_back_to_icdf = [&] {
         stepper.set_observable(fallback);
         integrator = make_integrator(s, icdf_repair);
-    }
+        fell_back = true;
+    };
+    if (resumed.fell_back) fall_back_to_icdf();
     RunSummary sum;
     sum.end_status = "completed";
     sum.coarse_steps = resumed.coarse_steps;
@@ -145,9 +149,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
             log::warn("the compact (A,B,C,D) observable failed at t = {:.6g}: {} ({}); continuing "
                       "with the full ICDF as the coarse variable",
                       stepper.time(), why.empty() ? "the fit is not usable" : why, rec.message);
-            stepper.set_observable(fallback);
-            integrator = make_integrator(s, icdf_repair);
-            fell_back = true;
+            fall_back_to_icdf();
             continue;
         }
         if (rec.status == coarse::StepStatus::stopped_unstable ||
