@@ -25,7 +25,10 @@
 ///   fields: sum_j phi_j lx ly dz = sum_i (pi/6) d_i^3 to round-off.
 ///
 /// Per-particle weights are kept (a fixed stride of slots per particle) so that the force pass
-/// reuses them: update() is the only place they are computed. No allocation once the arrays
+/// reuses them: update() is the only place they are computed. When no sphere is wider than a
+/// slab (the gas default: dz = d_p) each touches at most two slabs, the stride is 2, and a
+/// vectorized kernel computes them (dem/slab_split.hpp); the sums are then added in a second
+/// pass, so that the first has independent iterations. No allocation once the arrays
 /// have reached the particle count and the highest slab count seen (they only grow).
 /// Not done here: the gas (dem/effects/gas_drag.hpp), any smoothing beyond the exact weights.
 ///
@@ -52,7 +55,8 @@ namespace efdem::dem {
 /// of height a = clamp(h - (z_c - r), 0, 2r), of volume (pi/3) a^2 (3r - a) [d_p^3]. At a = 2r
 /// this is exactly the formula's whole sphere (4/3) pi r^3.
 inline double sphere_volume_below(double h, double z_c, double r) {
-    const double a = std::clamp(h - (z_c - r), 0.0, 2.0 * r);
+    // min(max()) rather than std::clamp: the same value, without branches.
+    const double a = std::min(std::max(h - (z_c - r), 0.0), 2.0 * r);
     return std::numbers::pi / 3.0 * a * a * (3.0 * r - a);
 }
 
@@ -107,6 +111,16 @@ class SlabFields {
     static constexpr std::size_t kLanes = 4;
     void grow(std::size_t n_slabs);
     static void accumulate(Sums& s, const Vec3& v, double w);
+    /// First slab, slab count and weights of every particle; returns the slab count n. The
+    /// common case (no sphere wider than a slab: at most two slabs each) has its own loop.
+    std::size_t split_two(const Particles& p);
+    std::size_t split_many(const Particles& p);
+    /// Throws the RuntimeFailure naming the first particle too high (or NaN) for the slabs.
+    [[noreturn]] [[gnu::noinline]] void report_blown_up(const Particles& p) const;
+    /// Adds every particle's weights and weighted velocity into the slab sums.
+    void scatter(const Particles& p);
+    /// Slab sums -> phi, u_s, volume; clears the sums.
+    void reduce();
 
     double dz_;
     int stride_;

@@ -3,10 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "dem/slab_fields.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/fp_traps.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
@@ -131,6 +133,49 @@ TEST_CASE("a particle far above the bed adds empty slabs and nothing else", "[un
         FAIL("expected a RuntimeFailure");
     } catch (const RuntimeFailure& e) {
         CHECK(std::string(e.what()).find("particle 99") != std::string::npos);
+    }
+    // So is a position that is not a number (it would convert to a garbage slab index). The
+    // vectorized kernel compares it with a signalling compare, which the tests' floating-point
+    // traps would turn into SIGFPE: a NaN is an input here, not something the kernel made.
+    p.x()[50].z = std::numeric_limits<double>::quiet_NaN();
+    const test::FpTrapsOff traps_off;
+    CHECK_THROWS_WITH(s.update(p, Domain{4, 4}), Catch::Contains("particle 99") &&
+                                                     Catch::Contains("NaN"));
+}
+
+TEST_CASE("the two-slab kernel and the general split give the same fields to the bit",
+          "[unit][slabs]") {
+    // Spheres no wider than a slab take the vectorized two-slab kernel (dem/slab_split.hpp);
+    // a max_diameter just above dz forces the general loop on the same particles. Both compute
+    // the same cap differences in the same order, so every weight and field must be equal
+    // exactly (==, no tolerance): a difference would mean the kernels disagree on a slab index.
+    const double l = 5;
+    Particles p = test::random_particles(300, l, -0.3, 12, 11);
+    const auto species = test::binary_species();
+    p.add(500, {1, 1, 0.5}, {0, 0, 1}, 0, species);   // top exactly on the plane z = 1
+    p.add(501, {2, 2, -3}, {0, 0, 1}, 1, species);    // entirely below the floor
+    p.add(502, {3, 3, 4.5}, {1, 0, 0}, 0, species);   // bottom exactly on the plane z = 4
+    const Domain d{l, l};
+    SlabFields fast(1.0, 1.0), general(1.0, 1.0 + 1e-9);
+    REQUIRE(fast.max_slabs_per_particle() == 2);
+    REQUIRE(general.max_slabs_per_particle() == 3);
+    fast.update(p, d);
+    general.update(p, d);
+    REQUIRE(fast.size() == general.size());
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        INFO("particle " << i << " at z = " << p.x()[i].z);
+        REQUIRE(fast.first_slab(i) == general.first_slab(i));
+        REQUIRE(fast.slab_count(i) == general.slab_count(i));
+        for (int k = 0; k < fast.slab_count(i); ++k)
+            CHECK(fast.weights(i)[k] == general.weights(i)[k]);
+    }
+    CHECK(fast.slab_count(300) == 1);
+    CHECK(fast.slab_count(301) == 1);
+    CHECK(fast.first_slab(302) == 4);
+    CHECK(fast.slab_count(302) == 1);
+    for (std::size_t j = 0; j < fast.size(); ++j) {
+        CHECK(fast.phi()[j] == general.phi()[j]);
+        CHECK(fast.solid_velocity()[j] == general.solid_velocity()[j]);
     }
 }
 
