@@ -44,6 +44,7 @@ ProjectiveStepRecord ProjectiveForwardEuler::step(CoarseStepper& stepper) {
     for (int i = 0; i <= settings_.max_halvings; ++i)
         plan.dt_candidates.push_back(std::ldexp(settings_.dt, -i));
     plan.dt_candidates.push_back(0.0);
+    plan.dt_max = jump_limit(rec.t_end, settings_.dt, rec.burst_length);
     project_and_lift(rec, stepper, plan, repair_);
     return rec;
 }

@@ -1,5 +1,10 @@
 #include "coarse/projective_integrator.hpp"
 
+#include <algorithm>
+#include <cmath>
+
+#include "coarse/slope_estimators.hpp"
+
 namespace efdem::coarse {
 
 std::string_view to_string(StepStatus status) {
@@ -18,6 +23,15 @@ std::string_view to_string(StepStatus status) {
             return "infeasible_projection";
     }
     return "unknown";
+}
+
+double ProjectiveIntegrator::jump_limit(double t_after_burst, double dt, double burst) const {
+    if (!std::isfinite(end_time_)) return std::numeric_limits<double>::infinity();
+    const double left = end_time_ - t_after_burst;
+    const double tol = time_tolerance(end_time_);
+    if (left <= dt + tol) return std::max(0.0, left);
+    if (left - dt < burst - tol) return std::max(0.0, left - burst);
+    return std::numeric_limits<double>::infinity();
 }
 
 }  // namespace efdem::coarse

@@ -81,6 +81,21 @@ class ProjectiveIntegrator {
     /// One outer step. Never throws for a numerical condition: the record's status says what
     /// happened (check advanced()). Collective if the stepper is.
     virtual ProjectiveStepRecord step(CoarseStepper& stepper) = 0;
+
+    /// The run ends at `t_end`: from now on a jump never carries the state past it, and the
+    /// jump before the last burst leaves room for exactly that burst, so that a run whose
+    /// remaining time is at least one burst ends at t_end exactly (default: no end).
+    void set_end_time(double t_end) { end_time_ = t_end; }
+    double end_time() const { return end_time_; }
+
+  protected:
+    /// Largest DT allowed after a burst ending at `t_after_burst`, when the planned DT is
+    /// `dt` and a burst lasts `burst`: the time left if it is at most dt; the time left minus
+    /// one burst if a full jump would leave less than a burst; otherwise +infinity.
+    double jump_limit(double t_after_burst, double dt, double burst) const;
+
+  private:
+    double end_time_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace efdem::coarse

@@ -1,5 +1,6 @@
 #include "coarse/projective_jump.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -55,7 +56,13 @@ void project_and_lift(ProjectiveStepRecord& rec, CoarseStepper& stepper, const J
     EFDEM_EXPECTS(!plan.dt_candidates.empty() && plan.dt_candidates.front() >= 0.0);
     EFDEM_EXPECTS(rec.slope.size() == rec.x_end.size());
     CpiCycle cycle = plan.cycle;
-    cycle.dt = rec.dt_requested = rec.dt = plan.dt_candidates.front();
+    std::vector<double> candidates = plan.dt_candidates;
+    for (double& c : candidates) c = std::min(c, plan.dt_max);
+    rec.dt_requested = plan.dt_candidates.front();
+    cycle.dt = rec.dt = candidates.front();
+    if (rec.dt < rec.dt_requested)
+        append_message(rec, fmt::format("DT shortened from {:.6g} to {:.6g}: the run ends soon",
+                                        rec.dt_requested, rec.dt));
     rec.stability = assess_stability(plan.decay, cycle);
     rec.x_projected = rec.x_end;
 
@@ -71,8 +78,8 @@ void project_and_lift(ProjectiveStepRecord& rec, CoarseStepper& stepper, const J
                 return;
             case StabilityPolicy::halve_step:
                 rec.dt = 0.0;
-                for (std::size_t i = 1; i < plan.dt_candidates.size(); ++i) {
-                    cycle.dt = plan.dt_candidates[i];
+                for (std::size_t i = 1; i < candidates.size(); ++i) {
+                    cycle.dt = candidates[i];
                     if (std::abs(cpi_amplification(cycle, rec.stability.rate)) <= 1.0) {
                         rec.dt = cycle.dt;
                         break;

@@ -3,6 +3,7 @@
 /// The half of an outer step that both projective integrators share: checking the burst, and
 /// stability check -> extrapolation from the raw end-of-burst value -> repair -> lift.
 
+#include <limits>
 #include <vector>
 
 #include "coarse/coarse_stepper.hpp"
@@ -29,6 +30,8 @@ struct JumpPlan {
     /// DT values in order of preference: the planned one first, then the reductions the
     /// halve_step policy may take, ending with 0.
     std::vector<double> dt_candidates;
+    /// No candidate larger than this is taken (the end of the run); the record says so.
+    double dt_max = std::numeric_limits<double>::infinity();
     DecayRateEstimate decay;
     StabilityPolicy policy = StabilityPolicy::warn;
 };

@@ -98,6 +98,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
         return coarse::repair_monotone(x, lo, hi);
     };
     auto integrator = make_integrator(s, compact ? coarse::RepairHook{} : icdf_repair);
+    integrator->set_end_time(t_end);
     if (s.cpi.projection == CpiSettings::Projection::periods && stepper.realizations() > 1)
         log::warn("cpi.projection = periods measures the wave period from the ensemble-mean centre of "
                   "mass; with {} realizations the wave phases average out and the period may not be "
@@ -109,6 +110,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     auto fall_back_to_icdf = [&] {
         stepper.set_observable(fallback);
         integrator = make_integrator(s, icdf_repair);
+        integrator->set_end_time(t_end);
         fell_back = true;
     };
     if (resumed.fell_back) fall_back_to_icdf();
@@ -131,6 +133,14 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
             const auto path = stepper.checkpoint(sum.coarse_steps, {t_start, sum.coarse_steps, without_progress, fell_back});
             log::info("checkpoint {} (t = {:.6g}, after coarse step {})", path.string(), stepper.time(), sum.coarse_steps);
             last_checkpoint = sum.coarse_steps;
+        }
+        // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
+        // plus one burst (or one whose period bursts were extended) can be left with less.
+        const double burst = s.cpi.healing + s.cpi.window;
+        if (t_end - stepper.time() < burst - kTimeTolerance * std::max(1.0, t_end)) {
+            log::info("stopping at t = {:.6g}: the {:.4g} time units left are less than one "
+                      "burst ({:.4g})", stepper.time(), t_end - stepper.time(), burst);
+            break;
         }
         const coarse::ProjectiveStepRecord rec = integrator->step(stepper);
         ++sum.coarse_steps;

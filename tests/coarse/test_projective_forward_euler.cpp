@@ -264,3 +264,50 @@ TEST_CASE("invalid bursts are reported, not projected", "[unit][coarse]") {
         CHECK_THAT(backwards.message, Catch::Contains("not strictly increasing"));
     }
 }
+
+TEST_CASE("with an end time the jumps are shortened so that the run ends there exactly",
+          "[unit][coarse]") {
+    // Burst 20 (healing 10 + window 10, h = 0.5), DT 80, from t = 10 to the end 200: full
+    // cycles end at 110, 210, ... Planned: burst to 130, then the jump shortened to 70 (what
+    // is left). For an end at 225 a full second jump (to 210) would leave 15, less than a
+    // burst: it is shortened to 75, and the last cycle is a burst only (205 to 225).
+    // Times are sums of multiples of h and of the DT values: equal to 1e-9.
+    const auto run_to = [](double t_end) {
+        LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5,
+                             Eigen::VectorXd::Ones(1), 10.0);
+        ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
+        pfe.set_end_time(t_end);
+        std::vector<ProjectiveStepRecord> recs;
+        while (toy.time() < t_end - 1e-9 && recs.size() < 20) {
+            recs.push_back(pfe.step(toy));
+            REQUIRE(recs.back().advanced());
+        }
+        return std::pair{toy.time(), recs};
+    };
+    {
+        const auto [t, recs] = run_to(200);
+        CHECK(t == Approx(200).margin(1e-9));
+        REQUIRE(recs.size() == 2);
+        CHECK(recs[0].dt == 80);
+        CHECK(recs[1].dt == Approx(70).margin(1e-9));
+        CHECK(recs[1].dt_requested == 80);
+        CHECK(recs[1].message.find("DT shortened from 80 to 70") != std::string::npos);
+    }
+    {
+        const auto [t, recs] = run_to(225);
+        CHECK(t == Approx(225).margin(1e-9));
+        REQUIRE(recs.size() == 3);
+        CHECK(recs[1].dt == Approx(75).margin(1e-9));
+        CHECK(recs[2].status == StepStatus::burst_only);
+        CHECK(recs[2].dt == 0.0);
+    }
+    {
+        // No end time: the full DT every cycle (210 for a run asked to stop at 200).
+        LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5,
+                             Eigen::VectorXd::Ones(1), 10.0);
+        ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
+        pfe.step(toy);
+        pfe.step(toy);
+        CHECK(toy.time() == Approx(210).margin(1e-9));
+    }
+}
