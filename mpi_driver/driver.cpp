@@ -85,6 +85,19 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
     return sum;
 }
 
+double planned_dem_time(double t_now, double t_end, double burst, double dt) {
+    const double tol = kTimeTolerance * std::max(1.0, t_end);
+    double dem = 0.0;
+    for (double t = t_now; t_end - t >= burst - tol;) {
+        t += burst;
+        dem += burst;
+        const double left = t_end - t;
+        if (left <= dt + tol) break;  // the jump ends the run
+        t += left - dt < burst - tol ? std::min(dt, std::max(0.0, left - burst)) : dt;
+    }
+    return dem;
+}
+
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::EnsembleObservable& fallback,
                    RunRecorder* recorder, Progress& progress, const RunControl& control) {
     const DriverState resumed = control.resume.value_or(DriverState{stepper.time()});
@@ -147,6 +160,13 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
         const LiftRecord lift = rec.lifted ? stepper.last_lift() : LiftRecord{};
         if (recorder) recorder->coarse_step(rec, lift);
         log::info("{}", describe_step(sum.coarse_steps, rec, lift));
+        if (stepper.micro_time() > 0.0) {
+            const double steps_per_time = stepper.particle_steps() / stepper.micro_time();
+            const double dt_next = rec.dt > 0.0 ? rec.dt : rec.dt_requested;
+            progress.set_expected_particle_steps(
+                stepper.particle_steps() +
+                steps_per_time * planned_dem_time(stepper.time(), t_end, burst, dt_next));
+        }
         progress.update(stepper.time(), stepper.particle_steps(), "", true);
         if (rec.advanced()) {
             without_progress = 0;

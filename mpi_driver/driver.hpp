@@ -34,6 +34,11 @@ struct RunControl {
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Progress& progress,
                       const RunControl& control = {});
 
+/// DEM time a CPI run still needs from t_now to t_end with bursts of `burst` (> 0) and jumps
+/// of `dt`, shortened at the end as the integrators do (ProjectiveIntegrator::set_end_time):
+/// the work the progress line's estimate of the time left is based on.
+double planned_dem_time(double t_now, double t_end, double burst, double dt);
+
 /// `fallback`: the ICDF observable the run switches to when the compact observable fails
 /// (y(p) identically zero, or a fit that does not converge); ignored with cpi.observable = icdf.
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& settings,

@@ -25,9 +25,12 @@ void Progress::update(double t_sim, double particle_steps, const std::string& ex
     const double wall = elapsed_seconds();
     const double done = std::clamp((t_sim - t_start_) / (t_end_ - t_start_), 0.0, 1.0);
     const double rate = wall > 0 ? particle_steps / wall : 0.0;
-    const double eta = done > 0 ? wall * (1 - done) / done : 0.0;
+    const double work_done = expected_particle_steps_ > 0
+                                 ? std::clamp(particle_steps / expected_particle_steps_, 0.0, 1.0)
+                                 : done;
+    const double eta = work_done > 0 ? wall * (1 - work_done) / work_done : 0.0;
     log::info("t = {:9.3f} / {:g} ({:5.1f} %)  {:.3g} particle-steps/s  elapsed {}  ETA {}{}{}", t_sim,
-              t_end_, 100 * done, rate, format_duration(wall), done > 0 ? format_duration(eta) : "-",
+              t_end_, 100 * done, rate, format_duration(wall), work_done > 0 ? format_duration(eta) : "-",
               extra.empty() ? "" : "  ", extra);
 }
 

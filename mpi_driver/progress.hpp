@@ -15,11 +15,17 @@ public:
     Progress(double t_start, double t_end, double min_seconds);
     /// Prints a line if due (or `force`); `particle_steps` is the running total.
     void update(double t_sim, double particle_steps, const std::string& extra, bool force = false);
+    /// The particle-steps the whole run is expected to take, when the simulated time is not a
+    /// measure of the work (coarse projective runs: a jump advances time for free). The time
+    /// left is then estimated from the particle-steps left; 0 (the default) estimates it from
+    /// the simulated time left.
+    void set_expected_particle_steps(double total) { expected_particle_steps_ = total; }
     double elapsed_seconds() const;
 
 private:
     using Clock = std::chrono::steady_clock;
     double t_start_, t_end_, min_seconds_;
+    double expected_particle_steps_ = 0.0;
     Clock::time_point start_ = Clock::now();
     Clock::time_point last_ = Clock::time_point::min();
 };
