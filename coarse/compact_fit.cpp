@@ -149,18 +149,38 @@ LmOutcome run_lm(const FitData& data, const ParameterMask& mask, const Eigen::Ve
     return out;
 }
 
-/// Cold start (internal parameters): for each d on a grid, (a, b', c') by linear least squares
-/// on the positive nodes
-/// (the first zero only asks for f <= 0, which a linear fit cannot express), ranked by the true
-/// objective on all fitted nodes. \pre data.size() >= 3.
-Eigen::Vector4d cold_start(const FitData& data, double d_limit, int& evaluations) {
+/// The nodes a linear least-squares fit uses: the positive ones (the first zero only asks for
+/// f <= 0, which a linear fit cannot express), and the zero too if fewer than 3 remain.
+std::vector<int> linear_rows(const FitData& data) {
     std::vector<int> rows;
     for (int i = 0; i < data.size(); ++i)
         if (i != data.zero_row) rows.push_back(i);
-    if (rows.size() < 3) rows.push_back(data.zero_row);
+    if (rows.size() < 3 && data.zero_row >= 0) rows.push_back(data.zero_row);
+    return rows;
+}
+
+/// (a, b', c', d) with d given and (a, b', c') by linear least squares on `rows` (internal
+/// parameters; column-pivoting QR, so a nearly collinear e^(d u) still gives the minimum-norm
+/// solution of the dependent part). Non-finite entries if it cannot be solved.
+Eigen::Vector4d linear_fit(const FitData& data, const std::vector<int>& rows, double d) {
     const auto n = static_cast<Eigen::Index>(rows.size());
     Eigen::MatrixXd basis(n, 3);
     Eigen::VectorXd target(n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+        const auto row = static_cast<std::size_t>(rows[static_cast<std::size_t>(j)]);
+        const double u = data.p[row] - data.centre;
+        basis.row(j) << u, 1.0, std::exp(d * u);
+        target[j] = data.y[row];
+    }
+    Eigen::Vector4d q;
+    q << basis.colPivHouseholderQr().solve(target), d;
+    return q;
+}
+
+/// Cold start (internal parameters): for each d on a grid, (a, b', c') by linear least squares,
+/// ranked by the true objective on all fitted nodes. \pre data.size() >= 3.
+Eigen::Vector4d cold_start(const FitData& data, double d_limit, int& evaluations) {
+    const std::vector<int> rows = linear_rows(data);
     const ParameterMask all;
     const Residuals objective{data, all, d_limit};
     Eigen::VectorXd r(data.size());
@@ -169,14 +189,7 @@ Eigen::Vector4d cold_start(const FitData& data, double d_limit, int& evaluations
     for (int k = -80; k <= 80; ++k) {
         const double d = std::clamp(0.25 * k, -d_limit, d_limit);
         if (k == 0) continue;  // e^(0 p) = 1 duplicates the constant b
-        for (Eigen::Index j = 0; j < n; ++j) {
-            const double u =
-                data.p[static_cast<std::size_t>(rows[static_cast<std::size_t>(j)])] - data.centre;
-            basis.row(j) << u, 1.0, std::exp(d * u);
-            target[j] = data.y[static_cast<std::size_t>(rows[static_cast<std::size_t>(j)])];
-        }
-        Eigen::Vector4d q;
-        q << basis.colPivHouseholderQr().solve(target), d;
+        const Eigen::Vector4d q = linear_fit(data, rows, d);
         if (!q.allFinite()) continue;
         objective(q, r);
         ++evaluations;
@@ -330,6 +343,20 @@ CompactFit fit_compact(const Eigen::VectorXd& y, const ProbabilityGrid& grid,
         run(start);
         fit.d_held = true;
         fallback = fmt::format("d held at the previous fit's value {:.6g} (Q17)", start[3]);
+        if (!outcome.converged) {
+            // With d held the model is linear in (a, b, c) but for the clamp at the first zero
+            // node: its linear least-squares solution is the fit, whatever stopped LM (seen
+            // on nearly straight y(p), where b and c e^(dp) are almost the same column).
+            const Eigen::Vector4d q = linear_fit(data, linear_rows(data), start[3]);
+            if (q.allFinite()) {
+                fallback += fmt::format(
+                    "; with d held Levenberg-Marquardt did not converge either (MINPACK status "
+                    "{}): (a, b, c) by linear least squares",
+                    outcome.status);
+                outcome.params = q;
+                outcome.converged = true;
+            }
+        }
     } else if (!why.empty() && data.size() < 4) {
         mask.free = {true, true, false, false};
         mask.full << 0.0, 0.0, 0.0, previous ? start[3] : 0.0;

@@ -123,6 +123,23 @@ TEST_CASE("the fit reports every failure instead of returning wrong parameters",
         CHECK_FALSE(fit.usable());
         CHECK_THAT(fit.message, Catch::Contains("did not converge"));
     }
+    SECTION("budget exhausted with a previous fit: d held, (a, b, c) by linear least squares") {
+        // With d held the model is linear in (a, b, c) on the positive nodes; when LM stops
+        // anyway, the linear solution is the fit. Exact data and the previous fit's d equal to
+        // the true d: recovered to round-off (a 3-column QR of condition ~1e2: 1e-9).
+        CompactFitSettings tight;
+        tight.max_evaluations = 2;
+        const CompactParameters truth{-8, 6, 2, -3};
+        const CompactFit fit =
+            fit_compact(y_of_p(truth, kGrid), kGrid, CompactParameters{-8.5, 6.3, 1.7, -3},
+                        tight);
+        CHECK(fit.status == CompactFitStatus::ill_conditioned);
+        CHECK(fit.usable());
+        CHECK(fit.d_held);
+        CHECK((fit.parameters.vector() - truth.vector()).cwiseAbs().maxCoeff() < 1e-9);
+        CHECK(fit.rms < 1e-10);
+        CHECK_THAT(fit.message, Catch::Contains("by linear least squares"));
+    }
     SECTION("data not of the model's form: poor fit") {
         Eigen::VectorXd y(19);
         for (int i = 0; i < 19; ++i) y[i] = 5.0 + 3.0 * std::sin(12.0 * kGrid.p(i));
