@@ -66,7 +66,9 @@ def study_runs(quick):
         runs.append((f"R{r}_DT80", 0.19, "cpi", r, {"cpi.dt": 80}))
     runs.append(("compact_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "cpi.observable": "compact"}))
     runs.append(("H5W15_DT80", 0.19, "cpi", 8, {"cpi.healing": 5, "cpi.window": 15, "cpi.dt": 80}))
-    runs.append(("dt_tc10_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "dt": round(3.596e-3 / 10, 7)}))
+    # dt about t_c/10 (t_c = 3.596e-3 for kn = 2e5, e = 0.9), as a whole fraction of the sampling
+    # interval 0.5, which efdem requires: 0.5/1391 = t_c/10.004.
+    runs.append(("dt_tc10_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "dt": 0.5 / math.ceil(0.5 / (3.596e-3 / 10))}))
     runs.append(("slab2_DT80", 0.19, "cpi", 8, {"cpi.dt": 80, "gas_drag.slab_thickness": 2}))
     runs.append(("U041_DT40", 0.41, "cpi", 8, {"cpi.dt": 40}))
     runs.append(("ref_0.41", 0.41, "direct", 8, {"observe.compact": "true"}))
