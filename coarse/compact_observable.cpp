@@ -13,7 +13,10 @@ Eigen::VectorXd CompactObservable::restrict_ensemble(const Eigen::MatrixXd& icdf
     // Full demixing (y = 0) has nothing left to project with (A, B, C, D): the rule is
     // to fall back to the full ICDF with a message, as for a fit that failed.
     const bool usable = last_.status == CompactFitStatus::ok || last_.status == CompactFitStatus::ill_conditioned;
-    if (!usable) return Eigen::VectorXd::Constant(4, std::numeric_limits<double>::quiet_NaN());
+    if (!usable) {
+        last_failure_ = last_.message;
+        return Eigen::VectorXd::Constant(4, std::numeric_limits<double>::quiet_NaN());
+    }
     previous_ = last_.parameters;
     return last_.parameters.vector();
 }

@@ -27,6 +27,7 @@ public:
     Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const override;
     int status() const override { return static_cast<int>(last_.status); }
     std::string status_message() const override { return last_.message; }
+    std::string failure_message() const override { return last_failure_; }
     const CompactFit& last_fit() const { return last_; }
     /// The warm start of the next fit: (a, b, c, d) of the last usable one, or empty.
     std::vector<double> saved_state() const override;
@@ -37,6 +38,7 @@ private:
     CompactFitSettings settings_;
     std::optional<CompactParameters> previous_;
     CompactFit last_;
+    std::string last_failure_;
 };
 
 }  // namespace efdem::coarse

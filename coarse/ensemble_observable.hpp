@@ -32,6 +32,10 @@ public:
     /// 0 when the last restrict_ensemble() succeeded; a message otherwise.
     virtual int status() const { return 0; }
     virtual std::string status_message() const { return {}; }
+    /// Why the most recent restriction that failed (returned NaN) failed, kept through later
+    /// successes: a burst is rejected for its first failed sample, not its last one. Empty if
+    /// none failed.
+    virtual std::string failure_message() const { return {}; }
     /// State carried from sample to sample (a warm start), for checkpoints; empty if none.
     virtual std::vector<double> saved_state() const { return {}; }
     virtual void restore_state(const std::vector<double>& state) { (void)state; }

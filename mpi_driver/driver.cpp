@@ -175,7 +175,9 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
         if (compact && !fell_back && rec.status == coarse::StepStatus::invalid_burst) {
             // The compact fit failed (y = 0 at full demixing, or no convergence): continue with
             // the full ICDF, which is always defined.
-            const std::string why = stepper.observable().status_message();
+            // The sample that failed, not the burst's last one (which may have succeeded).
+            const std::string failed = stepper.observable().failure_message();
+            const std::string why = failed.empty() ? stepper.observable().status_message() : failed;
             log::warn("the compact (A,B,C,D) observable failed at t = {:.6g}: {} ({}); continuing "
                       "with the full ICDF as the coarse variable",
                       stepper.time(), why.empty() ? "the fit is not usable" : why, rec.message);

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "coarse/compact_fit.hpp"
+#include "coarse/compact_observable.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;
@@ -187,4 +188,20 @@ TEST_CASE("the fit reports every failure instead of returning wrong parameters",
         CHECK(fit.rms < 1e-10);  // 0.3, 0.1 and <= 0 at p = 0.15 lie on a line (slope -4)
         CHECK_THAT(fit.message, Catch::Contains("only 2 node(s)"));
     }
+}
+
+TEST_CASE("the compact observable remembers why a sample failed after later ones succeed",
+          "[unit][coarse]") {
+    // A burst is rejected for its first failed sample; the driver's warning must quote that
+    // sample's reason, not the status of the burst's last (successful) sample.
+    CompactObservable obs(kGrid);
+    const Eigen::RowVectorXd icdf = Eigen::RowVectorXd::LinSpaced(19, 1.0, 10.0);
+    const Eigen::RowVectorXd y = y_of_p({-8, 6, 2, -3}, kGrid).transpose();
+    const Eigen::MatrixXd good_top = icdf + y, zero_top = icdf;
+    CHECK(obs.restrict_ensemble(icdf, good_top).allFinite());
+    CHECK(obs.failure_message().empty());
+    CHECK_FALSE(obs.restrict_ensemble(icdf, zero_top).allFinite());  // y = 0: full demixing
+    CHECK(obs.restrict_ensemble(icdf, good_top).allFinite());
+    CHECK_THAT(obs.failure_message(), Catch::Contains("demixing is complete"));
+    CHECK_THAT(obs.status_message(), !Catch::Contains("demixing is complete"));
 }
