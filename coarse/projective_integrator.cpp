@@ -25,13 +25,17 @@ std::string_view to_string(StepStatus status) {
     return "unknown";
 }
 
-double ProjectiveIntegrator::jump_limit(double t_after_burst, double dt, double burst) const {
-    if (!std::isfinite(end_time_)) return std::numeric_limits<double>::infinity();
-    const double left = end_time_ - t_after_burst;
-    const double tol = time_tolerance(end_time_);
+double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, double burst) {
+    if (!std::isfinite(t_end)) return std::numeric_limits<double>::infinity();
+    const double left = t_end - t_after_burst;
+    const double tol = time_tolerance(t_end);
     if (left <= dt + tol) return std::max(0.0, left);
     if (left - dt < burst - tol) return std::max(0.0, left - burst);
     return std::numeric_limits<double>::infinity();
+}
+
+double ProjectiveIntegrator::jump_limit(double t_after_burst, double dt, double burst) const {
+    return end_of_run_jump_limit(t_after_burst, end_time_, dt, burst);
 }
 
 }  // namespace efdem::coarse

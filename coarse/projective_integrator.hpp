@@ -73,6 +73,12 @@ struct ProjectiveStepRecord {
     }
 };
 
+/// The rule by which a run ends at t_end: the largest DT allowed after a burst ending at
+/// `t_after_burst`, when the planned DT is `dt` and a burst lasts `burst`: the time left if it
+/// is at most dt; the time left minus one burst if a full jump would leave less than a burst;
+/// otherwise +infinity (also for an infinite t_end). Times compared to time_tolerance(t_end).
+double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, double burst);
+
 /// A macro integrator: advances a CoarseStepper by one outer step.
 class ProjectiveIntegrator {
   public:
@@ -89,9 +95,7 @@ class ProjectiveIntegrator {
     double end_time() const { return end_time_; }
 
   protected:
-    /// Largest DT allowed after a burst ending at `t_after_burst`, when the planned DT is
-    /// `dt` and a burst lasts `burst`: the time left if it is at most dt; the time left minus
-    /// one burst if a full jump would leave less than a burst; otherwise +infinity.
+    /// end_of_run_jump_limit() for this integrator's end time.
     double jump_limit(double t_after_burst, double dt, double burst) const;
 
   private:

@@ -1,5 +1,6 @@
 #include "mpi_driver/driver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -8,6 +9,7 @@
 #include "coarse/monotone_repair.hpp"
 #include "coarse/period_projective_euler.hpp"
 #include "coarse/projective_forward_euler.hpp"
+#include "coarse/projective_integrator.hpp"
 #include "core/log.hpp"
 
 namespace efdem::mpi_driver {
@@ -91,9 +93,7 @@ double planned_dem_time(double t_now, double t_end, double burst, double dt) {
     for (double t = t_now; t_end - t >= burst - tol;) {
         t += burst;
         dem += burst;
-        const double left = t_end - t;
-        if (left <= dt + tol) break;  // the jump ends the run
-        t += left - dt < burst - tol ? std::min(dt, std::max(0.0, left - burst)) : dt;
+        t += std::min(dt, coarse::end_of_run_jump_limit(t, t_end, dt, burst));
     }
     return dem;
 }

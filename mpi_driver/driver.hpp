@@ -35,7 +35,7 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Pro
                       const RunControl& control = {});
 
 /// DEM time a CPI run still needs from t_now to t_end with bursts of `burst` (> 0) and jumps
-/// of `dt`, shortened at the end as the integrators do (ProjectiveIntegrator::set_end_time):
+/// of `dt`, shortened at the end as the integrators do (coarse::end_of_run_jump_limit):
 /// the work the progress line's estimate of the time left is based on.
 double planned_dem_time(double t_now, double t_end, double burst, double dt);
 
