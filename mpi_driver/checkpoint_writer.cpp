@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
-#include "core/version.hpp"
 #include "mpi_driver/h5_file.hpp"
 
 namespace efdem::mpi_driver {
@@ -189,9 +188,7 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
 
     H5File f = H5File::open(tmp, true);
     f.attribute("/", "format_version", h.format_version);
-    f.attribute("/", "efdem_version", version());
-    f.attribute("/", "git_hash", git_hash());
-    f.attribute("/", "build", build_info());
+    f.write_build_provenance();
     f.attribute("/", "mode", h.mode);
     f.attribute("/", "realizations", std::int64_t{h.realizations});
     f.attribute("/", "sequence", std::int64_t{h.sequence});

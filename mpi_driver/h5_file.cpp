@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/version.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -96,6 +97,12 @@ void H5File::attribute(const std::string& object, const std::string& name, doubl
 void H5File::attribute(const std::string& object, const std::string& name, std::int64_t value) {
     with_attribute(*this, object, name, H5T_NATIVE_INT64,
                    [&](hid_t a) { return H5Awrite(a, H5T_NATIVE_INT64, &value); });
+}
+
+void H5File::write_build_provenance() {
+    attribute("/", "efdem_version", version());
+    attribute("/", "git_hash", git_hash());
+    attribute("/", "build", build_info());
 }
 
 void H5File::write_text(const std::string& name, const std::string& text) {

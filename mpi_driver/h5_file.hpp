@@ -66,6 +66,8 @@ public:
     void attribute(const std::string& object, const std::string& name, const std::string& value);
     void attribute(const std::string& object, const std::string& name, double value);
     void attribute(const std::string& object, const std::string& name, std::int64_t value);
+    /// The build that writes the file, as attributes of "/": efdem_version, git_hash, build.
+    void write_build_provenance();
     /// A fixed dataset of doubles with the given shape (row-major).
     void write(const std::string& name, std::span<const double> data, std::vector<hsize_t> shape);
     /// A scalar variable-length string dataset.

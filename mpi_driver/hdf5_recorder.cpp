@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 
-#include "core/version.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -31,9 +30,7 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& file, const RunProvenanc
         return;
     }
     file_.attribute("/", "format_version", kRunFileFormatVersion);
-    file_.attribute("/", "efdem_version", version());
-    file_.attribute("/", "git_hash", git_hash());
-    file_.attribute("/", "build", build_info());
+    file_.write_build_provenance();
     file_.attribute("/", "date", now_utc());
     file_.attribute("/", "mode", p.mode);
     file_.attribute("/", "ranks", std::int64_t{p.ranks});
