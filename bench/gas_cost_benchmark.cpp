@@ -19,9 +19,9 @@
 
 #include "core/param_table.hpp"
 #include "core/version.hpp"
-#include "dem/effects/gas_drag.hpp"
+#include "dem/gas/gas_drag.hpp"
 #include "dem/scene.hpp"
-#include "dem/slab_fields.hpp"
+#include "dem/gas/slab_fields.hpp"
 
 using namespace efdem;
 

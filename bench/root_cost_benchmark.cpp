@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
-#include "coarse/ensemble_observable.hpp"
+#include "coarse/demixing/ensemble_observable.hpp"
 #include "core/rng.hpp"
 #include "dem/system.hpp"
-#include "mpi_driver/dem_realization.hpp"
-#include "mpi_driver/ensemble_layout.hpp"
-#include "mpi_driver/ensemble_stepper.hpp"
+#include "mpi_driver/ensemble/dem_realization.hpp"
+#include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/ensemble/ensemble_stepper.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;

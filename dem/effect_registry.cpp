@@ -1,10 +1,10 @@
 #include "dem/effect_registry.hpp"
 
-#include "dem/effects/gas_drag.hpp"
+#include "dem/gas/gas_drag.hpp"
 #include "dem/effects/gravity.hpp"
-#include "dem/effects/pair_contact.hpp"
+#include "dem/contact/pair_contact.hpp"
 #include "dem/effects/viscous_damping.hpp"
-#include "dem/effects/wall_contact.hpp"
+#include "dem/contact/wall_contact.hpp"
 
 namespace efdem::dem {
 

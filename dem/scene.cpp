@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/log.hpp"
-#include "dem/bed_builder.hpp"
+#include "dem/beds/bed_builder.hpp"
 #include "dem/effect_registry.hpp"
 
 namespace efdem::dem {

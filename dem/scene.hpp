@@ -4,7 +4,7 @@
 /// construction of a System for one realization from it.
 ///
 /// Top-level keys read here: `dt` (required), `effects` (required; the whole list, applied in
-/// order), `domain.*`, `species.*`, `neighbor.skin` (default 0.1), `bed.*` (dem/bed_builder.hpp).
+/// order), `domain.*`, `species.*`, `neighbor.skin` (default 0.1), `bed.*` (dem/beds/bed_builder.hpp).
 
 #include <cstdint>
 #include <memory>
@@ -53,7 +53,7 @@ struct RealizationSpec {
     bool skip_settling = false;   ///< read every key but do not run the settling (efdem --check)
 };
 
-/// Builds one realization: effects, initial bed (dem/bed_builder.hpp), System. InputError for
+/// Builds one realization: effects, initial bed (dem/beds/bed_builder.hpp), System. InputError for
 /// bad input; the same keys are read for every realization.
 System build_system(const Params& root, const RealizationSpec& spec);
 

@@ -15,13 +15,13 @@
 #include <string>
 #include <vector>
 
-#include "dem/contact_history.hpp"
+#include "dem/contact/contact_history.hpp"
 #include "dem/domain.hpp"
 #include "dem/effect.hpp"
 #include "dem/integrator.hpp"
 #include "dem/neighbor_list.hpp"
 #include "dem/particles.hpp"
-#include "dem/slab_fields.hpp"
+#include "dem/gas/slab_fields.hpp"
 #include "dem/species.hpp"
 
 namespace efdem::dem {

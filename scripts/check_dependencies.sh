@@ -46,7 +46,7 @@ if [ "${1:-}" = "--self-test" ]; then
     echo '#include "dem/particles.hpp"' > "$scratch/coarse/dem_adapters/ok.cpp"
     echo '#include <mpi.h>' > "$scratch/mpi_driver/ok.cpp"
     check_tree "$scratch" > /dev/null || { echo "self-test: a clean tree was flagged"; exit 1; }
-    for bad in "dem/a.cpp:#include <mpi.h>" "dem/b.hpp:#include \"coarse/quantiles.hpp\"" \
+    for bad in "dem/a.cpp:#include <mpi.h>" "dem/b.hpp:#include \"coarse/demixing/quantiles.hpp\"" \
                "coarse/c.cpp:#include \"dem/system.hpp\"" "coarse/d.hpp:  #  include <mpi.h>" \
                "core/e.cpp:#include \"dem/particles.hpp\"" "coarse/dem_adapters/f.cpp:#include <mpi.h>"; do
         file=${bad%%:*}; line=${bad#*:}

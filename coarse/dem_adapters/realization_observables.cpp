@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "coarse/quantiles.hpp"
+#include "coarse/demixing/quantiles.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "coarse/probability_grid.hpp"
+#include "coarse/demixing/probability_grid.hpp"
 #include "dem/particles.hpp"
 
 namespace efdem::coarse {

@@ -3,7 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
-#include "dem/bed_diagnostics.hpp"
+#include "dem/beds/bed_diagnostics.hpp"
 
 namespace efdem::dem {
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// BedTimeSeries: a CSV time series of the bed diagnostics (dem/bed_diagnostics.hpp), one row
+/// BedTimeSeries: a CSV time series of the bed diagnostics (dem/beds/bed_diagnostics.hpp), one row
 /// per call, for plots of Delta P(t), H(t), the species' centre-of-mass heights and for the
 /// travelling-wave period (coarse::estimate_period on z_com).
 ///

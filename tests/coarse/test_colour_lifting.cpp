@@ -11,8 +11,8 @@
 #include <numeric>
 #include <vector>
 
-#include "coarse/colour_lifting.hpp"
-#include "coarse/quantiles.hpp"
+#include "coarse/demixing/colour_lifting.hpp"
+#include "coarse/demixing/quantiles.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <optional>
 
-#include "coarse/compact_fit.hpp"
-#include "coarse/compact_observable.hpp"
+#include "coarse/demixing/compact_fit.hpp"
+#include "coarse/demixing/compact_observable.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;

@@ -8,10 +8,10 @@
 #include <limits>
 #include <vector>
 
-#include "coarse/monotone_repair.hpp"
-#include "coarse/projective_forward_euler.hpp"
-#include "coarse/projective_jump.hpp"
-#include "coarse/projective_stability.hpp"
+#include "coarse/demixing/monotone_repair.hpp"
+#include "coarse/equation_free/projective_forward_euler.hpp"
+#include "coarse/equation_free/projective_jump.hpp"
+#include "coarse/equation_free/projective_stability.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem::coarse;

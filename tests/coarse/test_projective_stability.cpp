@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "coarse/projective_stability.hpp"
-#include "coarse/stability_monitor.hpp"
+#include "coarse/equation_free/projective_stability.hpp"
+#include "coarse/equation_free/stability_monitor.hpp"
 
 using namespace efdem::coarse;
 

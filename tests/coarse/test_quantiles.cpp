@@ -6,9 +6,9 @@
 #include <limits>
 #include <vector>
 
-#include "coarse/monotone_repair.hpp"
-#include "coarse/probability_grid.hpp"
-#include "coarse/quantiles.hpp"
+#include "coarse/demixing/monotone_repair.hpp"
+#include "coarse/demixing/probability_grid.hpp"
+#include "coarse/demixing/quantiles.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;

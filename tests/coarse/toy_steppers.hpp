@@ -1,12 +1,12 @@
 #pragma once
 // Toy coarse time-steppers for the projective-integrator tests: the integrator cannot tell them
-// from an ensemble of DEM runs (coarse/coarse_stepper.hpp).
+// from an ensemble of DEM runs (coarse/equation_free/coarse_stepper.hpp).
 #include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
 
-#include "coarse/coarse_stepper.hpp"
+#include "coarse/equation_free/coarse_stepper.hpp"
 
 namespace efdem::test {
 

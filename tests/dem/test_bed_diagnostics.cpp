@@ -6,7 +6,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "dem/bed_diagnostics.hpp"
+#include "dem/beds/bed_diagnostics.hpp"
 #include "dem/io/bed_time_series.hpp"
 #include "tests/support/dem_fixtures.hpp"
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "dem/drag_laws.hpp"
-#include "dem/effects/gas_drag.hpp"
+#include "dem/gas/drag_laws.hpp"
+#include "dem/gas/gas_drag.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/input_error.hpp"
 

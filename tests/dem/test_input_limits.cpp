@@ -8,7 +8,7 @@
 #include <fstream>
 #include <numbers>
 
-#include "dem/bed_builder.hpp"
+#include "dem/beds/bed_builder.hpp"
 #include "dem/scene.hpp"
 #include "tests/support/dem_fixtures.hpp"
 

@@ -8,7 +8,7 @@
 #include <set>
 
 #include "core/rng.hpp"
-#include "dem/contact_history.hpp"
+#include "dem/contact/contact_history.hpp"
 #include "dem/neighbor_list.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/fp_traps.hpp"

@@ -6,7 +6,7 @@
 #include <limits>
 #include <numbers>
 
-#include "dem/slab_fields.hpp"
+#include "dem/gas/slab_fields.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/fp_traps.hpp"
 
@@ -145,7 +145,7 @@ TEST_CASE("a particle far above the bed adds empty slabs and nothing else", "[un
 
 TEST_CASE("the two-slab kernel and the general split give the same fields to the bit",
           "[unit][slabs]") {
-    // Spheres no wider than a slab take the vectorized two-slab kernel (dem/slab_split.hpp);
+    // Spheres no wider than a slab take the vectorized two-slab kernel (dem/gas/slab_split.hpp);
     // a max_diameter just above dz forces the general loop on the same particles. Both compute
     // the same cap differences in the same order, so every weight and field must be equal
     // exactly (==, no tolerance): a difference would mean the kernels disagree on a slab index.

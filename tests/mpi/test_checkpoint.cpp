@@ -8,9 +8,9 @@
 #include "core/error.hpp"
 #include "core/param_table.hpp"
 #include "dem/scene.hpp"
-#include "mpi_driver/checkpoint_format.hpp"
-#include "mpi_driver/dem_realization.hpp"
-#include "mpi_driver/restart_check.hpp"
+#include "mpi_driver/checkpoint/checkpoint_format.hpp"
+#include "mpi_driver/ensemble/dem_realization.hpp"
+#include "mpi_driver/checkpoint/restart_check.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;

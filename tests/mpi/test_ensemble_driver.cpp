@@ -6,11 +6,11 @@
 
 #include <memory>
 
-#include "coarse/ensemble_observable.hpp"
-#include "coarse/projective_forward_euler.hpp"
-#include "mpi_driver/driver.hpp"
-#include "mpi_driver/ensemble_layout.hpp"
-#include "mpi_driver/ensemble_stepper.hpp"
+#include "coarse/demixing/ensemble_observable.hpp"
+#include "coarse/equation_free/projective_forward_euler.hpp"
+#include "mpi_driver/run/driver.hpp"
+#include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "tests/mpi/toy_realization.hpp"
 
 using namespace efdem;

@@ -5,7 +5,7 @@
 // lifts, scatters) with an exactly known coarse dynamics.
 #include <Eigen/Core>
 
-#include "mpi_driver/realization.hpp"
+#include "mpi_driver/ensemble/realization.hpp"
 
 namespace efdem::test {
 

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "dem/bed_diagnostics.hpp"
-#include "dem/slab_fields.hpp"
+#include "dem/beds/bed_diagnostics.hpp"
+#include "dem/gas/slab_fields.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;

@@ -12,8 +12,8 @@
 
 #include <fmt/format.h>
 
-#include "dem/bed_diagnostics.hpp"
-#include "dem/effects/gas_drag.hpp"
+#include "dem/beds/bed_diagnostics.hpp"
+#include "dem/gas/gas_drag.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/report.hpp"
 

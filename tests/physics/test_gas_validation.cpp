@@ -20,11 +20,11 @@
 
 #include <fmt/format.h>
 
-#include "coarse/period_estimator.hpp"
-#include "coarse/probability_grid.hpp"
-#include "coarse/quantiles.hpp"
-#include "dem/bed_diagnostics.hpp"
-#include "dem/slab_fields.hpp"
+#include "coarse/equation_free/period_estimator.hpp"
+#include "coarse/demixing/probability_grid.hpp"
+#include "coarse/demixing/quantiles.hpp"
+#include "dem/beds/bed_diagnostics.hpp"
+#include "dem/gas/slab_fields.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;

@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "core/param_table.hpp"
-#include "dem/contact_model.hpp"
-#include "dem/effects/gas_drag.hpp"
+#include "dem/contact/contact_model.hpp"
+#include "dem/gas/gas_drag.hpp"
 #include "dem/effects/gravity.hpp"
-#include "dem/effects/pair_contact.hpp"
-#include "dem/effects/wall_contact.hpp"
+#include "dem/contact/pair_contact.hpp"
+#include "dem/contact/wall_contact.hpp"
 #include "dem/scene.hpp"
 #include "dem/system.hpp"
 

@@ -1,0 +1,31 @@
+#include "coarse/demixing/ensemble_observable.hpp"
+
+#include "core/contracts.hpp"
+
+namespace efdem::coarse {
+
+Eigen::VectorXd ensemble_mean(const Eigen::MatrixXd& rows) {
+    EFDEM_EXPECTS(rows.rows() >= 1);
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(rows.cols());
+    for (Eigen::Index r = 0; r < rows.rows(); ++r) sum += rows.row(r).transpose();
+    return sum / static_cast<double>(rows.rows());
+}
+
+Eigen::VectorXd ensemble_variance(const Eigen::MatrixXd& rows, const Eigen::VectorXd& mean) {
+    Eigen::VectorXd var = Eigen::VectorXd::Zero(rows.cols());
+    if (rows.rows() < 2) return var;
+    for (Eigen::Index r = 0; r < rows.rows(); ++r) var += (rows.row(r).transpose() - mean).cwiseAbs2();
+    return var / static_cast<double>(rows.rows() - 1);
+}
+
+Eigen::VectorXd IcdfObservable::restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd&) {
+    EFDEM_EXPECTS(icdf.cols() == m_);
+    return ensemble_mean(icdf);
+}
+
+Eigen::VectorXd IcdfObservable::lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd&) const {
+    EFDEM_EXPECTS(x.size() == m_);
+    return x;
+}
+
+}  // namespace efdem::coarse

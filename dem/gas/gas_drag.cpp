@@ -1,0 +1,204 @@
+#include "dem/gas/gas_drag.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "core/contracts.hpp"
+#include "dem/gas/slab_fields.hpp"
+
+namespace efdem::dem {
+
+double GasProperties::drag_number() const {
+    return 18.0 * viscosity /
+           (particle_density * particle_diameter * std::sqrt(particle_diameter * gravity));
+}
+double GasProperties::velocity_unit() const {
+    return std::sqrt(gravity * particle_diameter);
+}
+double GasProperties::time_unit() const {
+    return std::sqrt(particle_diameter / gravity);
+}
+
+GasDragSpec GasDragSpec::from_params(const Params& p) {
+    GasDragSpec s;
+    const std::string law = p.get_or<std::string>("law", std::string(kDragLaws[0].name));
+    s.law = find_drag_law(law);
+    if (!s.law)
+        p.fail("law", "names an unknown drag law '" + law + "'",
+               fmt::format("known drag laws: {}", fmt::join(drag_law_names(), ", ")));
+    s.superficial_velocity = p.get<double>("superficial_velocity", Bounds::non_negative());
+    s.phi_cap = p.get_or<double>("phi_cap", 0.70, Bounds::open(0.0, 1.0));
+    s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::at_least(0.1));
+
+    static const char* const kPhysical[] = {"gas_viscosity", "particle_density",
+                                            "particle_diameter", "gravity"};
+    if (p.contains("A")) {
+        for (const char* key : kPhysical)
+            if (p.contains(key))
+                p.fail(key,
+                       fmt::format("is given together with {} (A is either given or derived "
+                                   "from the physical inputs)",
+                                   p.full_key("A")),
+                       fmt::format("either {} alone, or {}, {}, {}, {} (SI units)", p.full_key("A"),
+                                   p.full_key(kPhysical[0]), p.full_key(kPhysical[1]),
+                                   p.full_key(kPhysical[2]), p.full_key(kPhysical[3])));
+        s.A = p.get<double>("A", Bounds::positive());
+        s.physical = false;
+    } else {
+        s.gas.viscosity = p.get_or<double>("gas_viscosity", 1.8e-5, Bounds::positive());
+        s.gas.particle_density = p.get_or<double>("particle_density", 900.0, Bounds::positive());
+        s.gas.particle_diameter = p.get_or<double>("particle_diameter", 1e-4, Bounds::positive());
+        s.gas.gravity = p.get_or<double>("gravity", 9.81, Bounds::positive());
+        s.A = s.gas.drag_number();
+        s.physical = true;
+    }
+    return s;
+}
+
+namespace {
+GasDragSpec checked_spec(const EffectSetup& s) {
+    for (std::size_t k = 0; k < s.species.size(); ++k)
+        if (s.species[static_cast<SpeciesId>(k)].diameter != 1.0)
+            s.root.scope("species").fail(
+                "diameter",
+                "is not 1 for every species, but gas_drag's drag law (Eq. 2) is "
+                "written for one particle size, the unit length d_p",
+                "1 for every species when gas_drag is listed in effects");
+    return GasDragSpec::from_params(s.scope);
+}
+
+/// The per-slab terms of Eq. (1), written once: the drag per unit volume c = A r(phi_c) and
+/// the pressure-gradient velocity g = (u_s - U_s)/(1 - phi_c)^2.
+struct SlabTerms {
+    double c;
+    Vec3 g;
+};
+inline SlabTerms slab_terms(const GasDragSpec& s, double phi, const Vec3& u_s) {
+    const double phi_c = std::min(phi, s.phi_cap);
+    const double q = 1.0 / (1.0 - phi_c);
+    const Vec3 slip{u_s.x, u_s.y, u_s.z - s.superficial_velocity};
+    return {s.A * s.law->resistance(phi_c), slip * (q * q)};
+}
+}  // namespace
+
+GasDrag::GasDrag(const EffectSetup& s) : GasDrag(checked_spec(s), s.species) {}
+
+GasDrag::GasDrag(const GasDragSpec& spec, const SpeciesTable& species) : spec_(spec) {
+    for (std::size_t k = 0; k < species.size(); ++k) {
+        density_.push_back(species[static_cast<SpeciesId>(k)].density);
+        species_names_.push_back(species[static_cast<SpeciesId>(k)].name);
+    }
+}
+
+Needs GasDrag::needs() const {
+    return {.slab_fields = true, .slab_thickness = spec_.slab_thickness};
+}
+
+void GasDrag::slab_coefficients(const SlabFields& slabs) {
+    const std::size_t n = slabs.size();
+    if (c_.size() < n) {
+        c_.resize(n);
+        a_.resize(n);
+    }
+    const auto phi = slabs.phi();
+    const auto u_s = slabs.solid_velocity();
+    const auto volume = slabs.solid_volume();
+    for (std::size_t j = 0; j < n; ++j) {
+        if (volume[j] == 0.0) {  // no particle has weight here: nothing reads c_j, a_j
+            c_[j] = 0.0;
+            a_[j] = Vec3{};
+            continue;
+        }
+        const SlabTerms t = slab_terms(spec_, phi[j], u_s[j]);
+        c_[j] = t.c;
+        a_[j] = (u_s[j] - t.g) * t.c;
+    }
+}
+
+void GasDrag::add_forces(ForceContext& ctx) {
+    EFDEM_EXPECTS(ctx.slabs != nullptr);
+    const SlabFields& slabs = *ctx.slabs;
+    slab_coefficients(slabs);
+    Particles& p = ctx.particles;
+    const std::size_t n = p.size();
+    const Vec3* v = p.v().data();
+    Vec3* f = p.force().data();
+    const std::uint32_t* first = slabs.first_data();
+    const std::uint8_t* count = slabs.count_data();
+    const double* w = slabs.weight_data();
+    const std::size_t stride = static_cast<std::size_t>(slabs.max_slabs_per_particle());
+    const double* c = c_.data();
+    const Vec3* a = a_.data();
+    for (std::size_t i = 0; i < n; ++i, w += stride) {
+        const std::uint32_t j0 = first[i];
+        Vec3 fa = a[j0] * w[0];
+        double fc = c[j0] * w[0];
+        for (int k = 1; k < count[i]; ++k) {  // most spheres cut one plane: one more slab
+            fa += a[j0 + static_cast<std::uint32_t>(k)] * w[k];
+            fc += c[j0 + static_cast<std::uint32_t>(k)] * w[k];
+        }
+        f[i] += fa - v[i] * fc;
+    }
+}
+
+void GasDrag::pressure_gradient(const SlabFields& slabs, std::span<Vec3> out) const {
+    EFDEM_EXPECTS(out.size() >= slabs.size());
+    const auto phi = slabs.phi();
+    const auto u_s = slabs.solid_velocity();
+    for (std::size_t j = 0; j < slabs.size(); ++j) {
+        const SlabTerms t = slab_terms(spec_, phi[j], u_s[j]);
+        out[j] = t.g * (-phi[j] * t.c);
+    }
+}
+
+double GasDrag::pressure_drop(const SlabFields& slabs) const {
+    const auto phi = slabs.phi();
+    const auto u_s = slabs.solid_velocity();
+    double dp = 0.0;
+    for (std::size_t j = 0; j < slabs.size(); ++j) {
+        const SlabTerms t = slab_terms(spec_, phi[j], u_s[j]);
+        dp -= phi[j] * t.c * t.g.z;
+    }
+    return dp * slabs.thickness();
+}
+
+double GasDrag::minimum_fluidization_velocity(double density, double phi) const {
+    const double phi_c = std::min(phi, spec_.phi_cap);
+    return density * (1.0 - phi_c) * (1.0 - phi_c) / (spec_.A * spec_.law->resistance(phi_c));
+}
+
+void GasDrag::describe(EffectReport& r) const {
+    r.add("law", fmt::format("{}: {}", spec_.law->name, spec_.law->formula));
+    if (spec_.physical)
+        r.add("A", fmt::format("{:.6g} = 18 mu_g/(rho_s d_p^1.5 g^0.5) from mu_g = {:g} Pa s, "
+                               "rho_s = {:g} kg/m^3, d_p = {:g} m, g = {:g} m/s^2 (1/A = {:.5g})",
+                               spec_.A, spec_.gas.viscosity, spec_.gas.particle_density,
+                               spec_.gas.particle_diameter, spec_.gas.gravity, 1.0 / spec_.A));
+    else
+        r.add("A", fmt::format("{:.6g} (given; 1/A = {:.5g})", spec_.A, 1.0 / spec_.A));
+    if (spec_.physical)
+        r.add("superficial velocity U_s",
+              fmt::format("{:g} sqrt(g d_p) = {:.4g} cm/s (time unit sqrt(d_p/g) = {:.4g} ms)",
+                          spec_.superficial_velocity,
+                          100 * spec_.superficial_velocity * spec_.gas.velocity_unit(),
+                          1000 * spec_.gas.time_unit()));
+    else
+        r.add("superficial velocity U_s",
+              fmt::format("{:g} sqrt(g d_p)", spec_.superficial_velocity));
+    r.add("slabs", fmt::format("thickness {:g} d_p from the floor to the highest particle; phi "
+                               "capped at {:g} inside the (1-phi) factors",
+                               spec_.slab_thickness, spec_.phi_cap));
+    for (std::size_t k = 0; k < density_.size(); ++k) {
+        const double vt = density_[k] / spec_.A;  // Stokes: m g = V A v_t
+        r.add(fmt::format("species {}", species_names_[k]),
+              fmt::format("Stokes terminal velocity and relaxation time {:.4g}; settles at U_s - "
+                          "{:.4g} = {:.4g} when isolated; U_mf at phi = 0.6: {:.4g}",
+                          vt, vt, spec_.superficial_velocity - vt,
+                          minimum_fluidization_velocity(density_[k], 0.6)));
+    }
+}
+
+}  // namespace efdem::dem

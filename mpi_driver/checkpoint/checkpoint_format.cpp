@@ -1,0 +1,58 @@
+#include "mpi_driver/checkpoint/checkpoint_format.hpp"
+
+#include <cctype>
+
+#include <fmt/format.h>
+
+#include "mpi_driver/checkpoint/realization_state.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+template <class T>
+std::uint64_t hash_value(const T& v, std::uint64_t h) {
+    return fnv1a(&v, sizeof v, h);
+}
+std::uint64_t hash_text(const std::string& s, std::uint64_t h) {
+    h = hash_value(static_cast<std::uint64_t>(s.size()), h);
+    return fnv1a(s.data(), s.size(), h);
+}
+}  // namespace
+
+std::uint64_t CheckpointHeader::checksum() const {
+    std::uint64_t h = hash_value(format_version, 0xcbf29ce484222325ULL);
+    h = hash_text(mode, h);
+    h = hash_value(realizations, h);
+    h = hash_value(sequence, h);
+    h = hash_text(scene_text, h);
+    h = hash_text(parameters, h);
+    const StepperState& s = stepper;
+    for (double d : {s.micro_time, s.particle_steps, s.height_lo, s.height_hi}) h = hash_value(d, h);
+    h = hash_value(s.samples_taken, h);
+    h = fnv1a_array(s.lifting, h);
+    h = fnv1a_array(s.observable, h);
+    h = fnv1a_array(s.recorded, h);
+    h = hash_value(driver.t_origin, h);
+    h = hash_value(driver.coarse_steps, h);
+    h = hash_value(driver.without_progress, h);
+    h = hash_value(driver.fell_back ? 1L : 0L, h);
+    for (const auto& o : outputs) {
+        h = hash_text(o.name, h);
+        h = hash_text(o.bytes, h);
+    }
+    return h;
+}
+
+std::string checkpoint_file_name(const std::string& prefix, long sequence) {
+    return fmt::format("{}_ckpt_{:08d}.h5", prefix, sequence);
+}
+
+bool is_checkpoint_file_name(const std::string& name, const std::string& prefix) {
+    const std::string head = prefix + "_ckpt_";
+    if (name.size() != head.size() + 8 + 3 || name.rfind(head, 0) != 0 || !name.ends_with(".h5")) return false;
+    for (std::size_t k = head.size(); k < head.size() + 8; ++k)
+        if (!std::isdigit(static_cast<unsigned char>(name[k]))) return false;
+    return true;
+}
+
+}  // namespace efdem::mpi_driver

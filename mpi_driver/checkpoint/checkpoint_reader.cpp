@@ -1,0 +1,142 @@
+#include "mpi_driver/checkpoint/checkpoint_reader.hpp"
+
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "mpi_driver/output/h5_file.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+[[noreturn]] void refuse(const std::filesystem::path& path, const std::string& problem) {
+    throw InputError(SourceLocation{path.string(), 0}, "checkpoint " + problem);
+}
+
+/// What a `.tmp` is, however far its writing got before the job was killed.
+constexpr const char* kPartialWrite =
+    "is incomplete: a .tmp file left by an interrupted write (use the previous checkpoint)";
+
+/// Runs `body` on the opened file; any HDF5 failure becomes an InputError naming the file.
+template <class T>
+T with_checkpoint(const std::filesystem::path& path, const std::function<T(const H5File&)>& body) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) refuse(path, "file not found (restart=FILE names no file)");
+    try {
+        const H5File f = H5File::open(path, false);
+        return body(f);
+    } catch (const RuntimeFailure& e) {
+        if (path.extension() == ".tmp") refuse(path, kPartialWrite);
+        refuse(path, fmt::format("cannot be read: it is truncated or corrupted ({})", e.what()));
+    }
+}
+
+std::vector<Vec3> vectors(const std::vector<double>& flat) {
+    std::vector<Vec3> out(flat.size() / 3);
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
+    return out;
+}
+}  // namespace
+
+CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
+    return with_checkpoint<CheckpointHeader>(path, [&](const H5File& f) {
+        if (!f.has_attribute("/", "format_version"))
+            refuse(path, path.extension() == ".tmp" ? kPartialWrite
+                                                    : "is not an efdem checkpoint (no format_version attribute)");
+        CheckpointHeader h;
+        h.format_version = f.attribute_integer("/", "format_version");
+        if (h.format_version != kCheckpointFormatVersion)
+            refuse(path, fmt::format("has format version {}; this efdem reads version {}", h.format_version,
+                                     kCheckpointFormatVersion));
+        if (!f.has_attribute("/", "complete") || f.attribute_integer("/", "complete") != 1)
+            refuse(path, "is incomplete: its writing was interrupted (use the previous checkpoint)");
+        h.mode = f.attribute_text("/", "mode");
+        h.realizations = f.attribute_integer("/", "realizations");
+        h.sequence = f.attribute_integer("/", "sequence");
+        h.scene_text = f.read_text("/scene");
+        h.parameters = f.read_text("/parameters");
+        const auto reals = f.read_doubles("/driver/reals");
+        const auto integers = f.read_integers("/driver/integers");
+        if (reals.size() != 5 || integers.size() != 4) refuse(path, "has a malformed /driver group");
+        h.driver.t_origin = reals[0];
+        h.stepper.micro_time = reals[1];
+        h.stepper.particle_steps = reals[2];
+        h.stepper.height_lo = reals[3];
+        h.stepper.height_hi = reals[4];
+        h.stepper.samples_taken = integers[0];
+        h.driver.coarse_steps = integers[1];
+        h.driver.without_progress = integers[2];
+        h.driver.fell_back = integers[3] != 0;
+        const auto lifting = f.read_integers("/driver/lifting");
+        if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
+            refuse(path, "has a malformed /driver/lifting dataset");
+        for (std::size_t r = 0; r < lifting.size(); r += 4)
+            h.stepper.lifting.push_back({from_stored(lifting[r]), from_stored(lifting[r + 1]), from_stored(lifting[r + 2]),
+                                         from_stored(lifting[r + 3])});
+        h.stepper.observable = f.read_doubles("/driver/observable");
+        h.stepper.recorded = f.read_doubles("/driver/recorded");
+        for (const std::string& name : f.members("/output")) {
+            const auto bytes = f.read_bytes("/output/" + name);
+            h.outputs.push_back({name, std::string(bytes.begin(), bytes.end())});
+        }
+        if (!f.has_attribute("/", "header_checksum") ||
+            from_stored(f.attribute_integer("/", "header_checksum")) != h.checksum())
+            refuse(path, "is corrupted: the checksum of its root-level state does not match");
+        return h;
+    });
+}
+
+std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem::path& path, long first,
+                                                           int count) {
+    return with_checkpoint<std::vector<RealizationState>>(path, [&](const H5File& f) {
+        const auto meta = f.read_integers("/realizations/meta");
+        const auto rows = static_cast<long>(meta.size() / 6);
+        if (first + count > rows)
+            refuse(path, fmt::format("holds {} realizations; realization {} was asked for", rows, first + count - 1));
+        const auto checksum = f.read_integers("/realizations/checksum");
+        const auto time = f.read_doubles("/realizations/time");
+        hsize_t n_off = 0, p_off = 0;
+        for (long r = 0; r < first; ++r) {
+            n_off += static_cast<hsize_t>(meta[6 * r + 2]);
+            p_off += static_cast<hsize_t>(meta[6 * r + 3]);
+        }
+        std::vector<RealizationState> out;
+        for (long r = first; r < first + count; ++r) {
+            const std::int64_t* m = &meta[static_cast<std::size_t>(6 * r)];
+            const auto n = static_cast<hsize_t>(m[2]), np = static_cast<hsize_t>(m[3]);
+            RealizationState s;
+            s.index = m[0];
+            s.step = m[1];
+            s.time = time.at(static_cast<std::size_t>(r));
+            auto block = [&](const char* name) { return vectors(f.read_doubles(fmt::format("/realizations/{}", name), n_off, n)); };
+            s.x = block("x");
+            s.v = block("v");
+            s.omega = block("omega");
+            s.force = block("force");
+            s.torque = block("torque");
+            if (m[4] != 0) s.reference = block("reference");
+            if (m[5] != 0) {
+                s.wall[0] = block("wall_floor");
+                s.wall[1] = block("wall_lid");
+            }
+            const auto tags = f.read_integers("/realizations/tag", n_off, n);
+            s.tag.assign(tags.begin(), tags.end());
+            const auto species = f.read_bytes("/realizations/species", n_off, n);
+            s.species.assign(species.begin(), species.end());
+            const auto pt = f.read_integers("/realizations/pair_tags", p_off, np);
+            const auto px = f.read_doubles("/realizations/pair_xi", p_off, np);
+            if (pt.size() != 2 * np || px.size() != 3 * np || s.x.size() != n)
+                refuse(path, fmt::format("realization {} is truncated", r));
+            for (hsize_t k = 0; k < np; ++k) s.pairs.push_back({pt[2 * k], pt[2 * k + 1], {px[3 * k], px[3 * k + 1], px[3 * k + 2]}});
+            if (s.checksum() != from_stored(checksum.at(static_cast<std::size_t>(r))))
+                refuse(path, fmt::format("is corrupted: the checksum of realization {} does not match", r));
+            out.push_back(std::move(s));
+            n_off += n;
+            p_off += np;
+        }
+        return out;
+    });
+}
+
+}  // namespace efdem::mpi_driver

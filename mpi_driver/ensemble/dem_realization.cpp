@@ -1,0 +1,140 @@
+#include "mpi_driver/ensemble/dem_realization.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+#include "coarse/demixing/colour_lifting.hpp"
+#include "coarse/dem_adapters/apply_colours.hpp"
+#include "coarse/dem_adapters/realization_observables.hpp"
+#include "core/error.hpp"
+
+namespace efdem::mpi_driver {
+
+DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
+                               const RealizationOutput& output, bool restarting)
+    : system_(std::move(system)), observed_(observed), other_(other), output_(output) {
+    const std::string stem = fmt::format("{}_r{:04d}", output_.prefix, index());
+    if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
+    if (output_.thermo_every > 0) thermo_ = std::make_unique<dem::ThermoLog>(output_.directory / (stem + "_thermo.log"));
+    if (!restarting) after_sample(0);
+}
+
+Observation DemRealization::observe(const coarse::ProbabilityGrid& grid, bool top_half) const {
+    const dem::Particles& p = system_.particles();
+    Observation o;
+    o.icdf = coarse::species_icdf(p, observed_, grid);
+    if (top_half) o.top = coarse::top_half_icdf(p, grid);
+    o.com = coarse::centre_of_mass_height(p);
+    o.z_min = std::numeric_limits<double>::infinity();
+    o.z_max = -o.z_min;
+    for (const auto& x : p.x()) {
+        o.z_min = std::min(o.z_min, x.z);
+        o.z_max = std::max(o.z_max, x.z);
+    }
+    return o;
+}
+
+LiftPayload DemRealization::lift_input() const {
+    auto hc = coarse::heights_and_colours(system_.particles(), observed_);
+    return {std::move(hc.heights), std::move(hc.colours)};
+}
+
+std::pair<std::size_t, std::size_t> DemRealization::lift_output_sizes() const {
+    return {0, system_.particles().size()};
+}
+
+void DemRealization::apply_lift(const LiftPayload& lifted) {
+    coarse::apply_colours(system_, lifted.bytes, observed_, other_);
+}
+
+void DemRealization::after_sample(long samples_taken) {
+    if (vtk_ && samples_taken % output_.vtk_every == 0) vtk_->write(system_);
+    if (thermo_ && samples_taken % output_.thermo_every == 0) thermo_->write(system_);
+}
+
+RealizationState DemRealization::save_state() const {
+    const dem::Particles& p = system_.particles();
+    RealizationState s;
+    s.index = index();
+    s.time = system_.time();
+    s.step = system_.step_count();
+    s.x.assign(p.x().begin(), p.x().end());
+    s.v.assign(p.v().begin(), p.v().end());
+    s.omega.assign(p.omega().begin(), p.omega().end());
+    s.force.assign(p.force().begin(), p.force().end());
+    s.torque.assign(p.torque().begin(), p.torque().end());
+    s.tag.assign(p.tag().begin(), p.tag().end());
+    s.species.assign(p.species().begin(), p.species().end());
+    if (const dem::NeighborList* list = system_.neighbor_list()) {
+        s.reference.assign(list->reference_positions().begin(), list->reference_positions().end());
+        if (const dem::ContactHistory* h = system_.contact_history()) {
+            s.pairs = h->export_pairs(*list, p);
+            for (int w = 0; w < dem::ContactHistory::kWalls; ++w)
+                s.wall[w].assign(h->wall(w).begin(), h->wall(w).end());
+        }
+    }
+    return s;
+}
+
+void DemRealization::restore_state(const RealizationState& s) {
+    dem::Particles& p = system_.particles();
+    const std::size_t n = p.size();
+    auto refuse = [&](const std::string& what) {
+        throw RuntimeFailure(fmt::format("realization {}: {}", index(), what), index());
+    };
+    if (s.index != index()) refuse(fmt::format("the checkpoint holds realization {} here", s.index));
+    if (s.particles() != n || s.v.size() != n || s.omega.size() != n || s.force.size() != n ||
+        s.torque.size() != n || s.tag.size() != n || s.species.size() != n)
+        refuse(fmt::format("the checkpoint has {} particles, the scene builds {}", s.particles(), n));
+    // Storage order: put the particle with tag s.tag[k] at index k.
+    std::unordered_map<dem::Tag, dem::Index> where;
+    where.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) where.emplace(p.tag()[i], static_cast<dem::Index>(i));
+    std::vector<dem::Index> new_to_old(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const auto it = where.find(s.tag[k]);
+        if (it == where.end()) refuse(fmt::format("particle tag {} is not in the scene's bed", s.tag[k]));
+        new_to_old[k] = it->second;
+    }
+    p.permute(new_to_old);
+    std::copy(s.x.begin(), s.x.end(), p.x().begin());
+    std::copy(s.v.begin(), s.v.end(), p.v().begin());
+    std::copy(s.omega.begin(), s.omega.end(), p.omega().begin());
+    std::vector<dem::Index> all(n);
+    std::vector<dem::SpeciesId> species(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        all[i] = static_cast<dem::Index>(i);
+        if (s.species[i] >= system_.species().size()) refuse(fmt::format("species id {} does not exist", s.species[i]));
+        species[i] = s.species[i];
+    }
+    system_.set_species(all, species);  // radii, masses, inertia (and the effects' caches)
+    if (system_.neighbor_list()) {
+        if (s.reference.size() != n) refuse("the checkpoint has no neighbour-list reference positions");
+        system_.restore_neighbors(s.reference, s.pairs);
+    }
+    if (dem::ContactHistory* h = system_.contact_history())
+        for (int w = 0; w < dem::ContactHistory::kWalls; ++w) {
+            if (s.wall[w].size() != n) refuse("the checkpoint has no wall contact history");
+            std::copy(s.wall[w].begin(), s.wall[w].end(), h->wall(w).begin());
+        }
+    std::copy(s.force.begin(), s.force.end(), p.force().begin());
+    std::copy(s.torque.begin(), s.torque.end(), p.torque().begin());
+    system_.set_time(s.time);
+    system_.set_step_count(s.step);
+}
+
+LiftOutcome ColourLifter::lift(const Eigen::VectorXd& target, const LiftPayload& input,
+                               const coarse::ProbabilityGrid& grid, RandomStream& rng) const {
+    coarse::LiftResult r = coarse::lift_colours(target, input.reals, input.bytes, grid, rng);
+    LiftOutcome out;
+    out.changed = static_cast<long>(r.n_changed);
+    out.max_deviation = r.max_deviation;
+    out.message = r.message;
+    out.payload.bytes = std::move(r.colours);
+    return out;
+}
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// DemRealization: a dem::System as a member of the ensemble (restriction by species ICDF,
+/// lifting by relabelling), with its optional per-realization VTK and thermo output; and
+/// ColourLifter, the root's lifting by coarse::lift_colours.
+
+#include <memory>
+#include <optional>
+
+#include "dem/io/thermo_log.hpp"
+#include "dem/io/vtk_writer.hpp"
+#include "dem/system.hpp"
+#include "mpi_driver/ensemble/realization.hpp"
+
+namespace efdem::mpi_driver {
+
+/// Per-realization output settings (intervals in samples; 0 = none).
+struct RealizationOutput {
+    std::filesystem::path directory;
+    std::string prefix;
+    long vtk_every = 0;
+    long thermo_every = 0;
+};
+
+class DemRealization final : public Realization {
+public:
+    /// `observed`: the species whose heights make the ICDF (colour 1); `other`: colour 0.
+    /// `restarting`: the state will be restored from a checkpoint, so the per-realization
+    /// outputs do not record the (discarded) initial state.
+    DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
+                   const RealizationOutput& output, bool restarting = false);
+
+    long index() const override { return system_.realization(); }
+    double time() const override { return system_.time(); }
+    void set_time(double t) override { system_.set_time(t); }
+    double dt() const override { return system_.dt(); }
+    long particles() const override { return static_cast<long>(system_.particles().size()); }
+    void advance(long steps) override { system_.run(steps); }
+    Observation observe(const coarse::ProbabilityGrid& grid, bool top_half) const override;
+    LiftPayload lift_input() const override;
+    std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
+    void apply_lift(const LiftPayload& lifted) override;
+    void after_sample(long samples_taken) override;
+    RealizationState save_state() const override;
+    /// RuntimeFailure if the state does not fit this realization (particle count, tags, history).
+    void restore_state(const RealizationState& state) override;
+
+    dem::System& system() { return system_; }
+    const dem::System& system() const { return system_; }
+
+private:
+    dem::System system_;
+    dem::SpeciesId observed_, other_;
+    RealizationOutput output_;
+    std::optional<dem::VtkSeriesWriter> vtk_;
+    std::unique_ptr<dem::ThermoLog> thermo_;
+};
+
+/// Minimal-change recolouring (physics.md §9) of one realization: payload in = heights (reals)
+/// and colours (bytes), payload out = colours.
+class ColourLifter final : public Lifter {
+public:
+    LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
+                     const coarse::ProbabilityGrid& grid, RandomStream& rng) const override;
+};
+
+}  // namespace efdem::mpi_driver

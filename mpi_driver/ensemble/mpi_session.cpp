@@ -1,0 +1,54 @@
+#include "mpi_driver/ensemble/mpi_session.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace efdem::mpi_driver {
+
+MpiComm::MpiComm(MPI_Comm comm) : comm_(comm) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &size_);
+}
+
+void MpiComm::abort(const std::string& message, int exit_code) const {
+    std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", rank_, size_, message.c_str());
+    std::fflush(stderr);
+    MPI_Abort(comm_, exit_code);
+    std::exit(exit_code);  // not reached
+}
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+    MPI_Init(argc, argv);
+    // A failing MPI call ends the job (the default for MPI_COMM_WORLD, made explicit).
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_ARE_FATAL);
+    world_.emplace(MPI_COMM_WORLD);
+}
+
+MpiSession::~MpiSession() {
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (!finalized) MPI_Finalize();
+}
+
+std::string MpiSession::launcher_mismatch() const {
+    if (size() != 1) return {};
+    // Variables that launchers of several MPI implementations and Slurm set per process.
+    for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS",
+                            "SLURM_NTASKS"}) {
+        const char* value = std::getenv(var);
+        if (value && std::atoi(value) > 1)
+            return fmt::format(
+                "efdem was started as one of {} processes ({}={}) but its MPI library sees only "
+                "this one: the launcher (mpirun/srun) belongs to a different MPI than the one "
+                "efdem was built with ({}). Use that MPI's mpirun, or rebuild efdem.",
+                value, var, value, MPI_VERSION == 3 ? "MPI-3" : "MPI");
+    }
+    return {};
+}
+
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,85 @@
+#pragma once
+/// \file
+/// Realization: one member of the ensemble as the EnsembleStepper sees it, and Lifter: the
+/// root's pure function that computes a realization's lifted state from what it reported.
+///
+/// A DEM realization (DemRealization) reports particle heights and colours and receives new
+/// colours; a toy model used in tests reports and receives its state vector. The stepper moves
+/// LiftPayloads between ranks without knowing which.
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/demixing/probability_grid.hpp"
+#include "core/error.hpp"
+#include "core/rng.hpp"
+#include "mpi_driver/checkpoint/realization_state.hpp"
+
+namespace efdem::mpi_driver {
+
+/// What a realization reports at one sample (heights in d_p).
+struct Observation {
+    Eigen::VectorXd icdf;  ///< ICDF of the observed species on the p-grid
+    Eigen::VectorXd top;   ///< ICDF of the top half (only when asked for)
+    double com = 0;        ///< centre-of-mass height: the travelling-wave phase signal
+    double z_min = 0;      ///< lowest particle centre
+    double z_max = 0;      ///< highest particle centre
+};
+
+/// Data moved for a lift: reals and bytes (either may be empty).
+struct LiftPayload {
+    std::vector<double> reals;
+    std::vector<std::uint8_t> bytes;
+};
+
+/// A lift computed by the root for one realization.
+struct LiftOutcome {
+    LiftPayload payload;
+    long changed = 0;           ///< labels (or entries) changed
+    double max_deviation = 0;   ///< max |achieved - target| over the p-grid [d_p]
+    std::string message;        ///< non-empty when the target was repaired, clipped or rejected
+};
+
+class Realization {
+public:
+    virtual ~Realization() = default;
+    virtual long index() const = 0;  ///< global realization index
+    virtual double time() const = 0;
+    virtual void set_time(double t) = 0;
+    virtual double dt() const = 0;
+    virtual long particles() const = 0;
+    /// Advances `steps` micro steps; throws RuntimeFailure on a numerical failure.
+    virtual void advance(long steps) = 0;
+    virtual Observation observe(const coarse::ProbabilityGrid& grid, bool top_half) const = 0;
+    /// What the root needs to lift this realization.
+    virtual LiftPayload lift_input() const = 0;
+    /// Sizes (reals, bytes) of the payload apply_lift() expects.
+    virtual std::pair<std::size_t, std::size_t> lift_output_sizes() const = 0;
+    virtual void apply_lift(const LiftPayload& lifted) = 0;
+    /// Called after every sample with the running sample count (per-realization outputs).
+    virtual void after_sample(long samples_taken) { (void)samples_taken; }
+    /// The complete state for a checkpoint, and its exact restoration (checkpoint restart).
+    /// Realizations that cannot be checkpointed (test models) keep the defaults, which refuse.
+    virtual RealizationState save_state() const {
+        throw RuntimeFailure("this realization type cannot be checkpointed");
+    }
+    virtual void restore_state(const RealizationState& state) {
+        (void)state;
+        throw RuntimeFailure("this realization type cannot be restored from a checkpoint");
+    }
+};
+
+/// Root side of lifting: a pure function of the target, the realization's report and its
+/// lifting stream, so the root can lift realizations it does not own.
+class Lifter {
+public:
+    virtual ~Lifter() = default;
+    virtual LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
+                             const coarse::ProbabilityGrid& grid, RandomStream& rng) const = 0;
+};
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,133 @@
+#include "mpi_driver/output/hdf5_recorder.hpp"
+
+#include <chrono>
+#include <ctime>
+
+#include <fmt/format.h>
+
+
+namespace efdem::mpi_driver {
+
+namespace {
+std::string now_utc() {
+    const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buf;
+}
+std::span<const double> as_span(const Eigen::VectorXd& v) { return {v.data(), static_cast<std::size_t>(v.size())}; }
+}  // namespace
+
+Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& file, const RunProvenance& p,
+                           Eigen::Index coarse_dimension, bool resume)
+    : file_(resume ? H5File::open(file, true) : H5File::create(file)), realizations_(p.realizations),
+      m_(p.p_grid.size()), dim_(coarse_dimension) {
+    if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
+        file_.attribute("/", "ranks", std::int64_t{p.ranks});
+        file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
+        return;
+    }
+    file_.attribute("/", "format_version", kRunFileFormatVersion);
+    file_.write_build_provenance();
+    file_.attribute("/", "date", now_utc());
+    file_.attribute("/", "mode", p.mode);
+    file_.attribute("/", "ranks", std::int64_t{p.ranks});
+    file_.attribute("/", "realizations", std::int64_t{p.realizations});
+    file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
+    file_.attribute("/", "seed", static_cast<std::int64_t>(p.seed));
+    file_.attribute("/", "observed_species", p.observed_species);
+    file_.attribute("/", "scene_file", p.scene_file);
+    file_.attribute("/", "overrides", p.overrides);
+    file_.write_text("/scene", p.scene_text);
+    file_.write_text("/parameters", p.parameters);
+    file_.write("/p", as_span(p.p_grid), {static_cast<hsize_t>(m_)});
+    file_.create_group("/samples");
+    if (p.mode == "cpi") file_.create_group("/cpi");
+    file_.flush();
+}
+
+H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type) {
+    auto it = series_.find(name);
+    if (it == series_.end())
+        it = series_.emplace(name, file_.exists(name) ? H5Series::open(file_, name, type)
+                                                      : H5Series(file_, name, std::move(row_shape), type)).first;
+    return it->second;
+}
+
+void Hdf5Recorder::sample(const SampleRecord& s) {
+    using T = H5Series::Type;
+    const auto m = static_cast<hsize_t>(m_), r = static_cast<hsize_t>(realizations_);
+    series("/samples/time", {}, T::real).append(s.time);
+    series("/samples/mean", {m}, T::real).append(as_span(s.mean));
+    series("/samples/variance", {m}, T::real).append(as_span(s.variance));
+    // Row-major R x m for the file.
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> icdf = s.realizations;
+    series("/samples/icdf", {r, m}, T::real).append(std::span<const double>(icdf.data(), static_cast<std::size_t>(icdf.size())));
+    series("/samples/com", {r}, T::real).append(as_span(s.com));
+    if (s.top_mean.size() == m_) series("/samples/top_mean", {m}, T::real).append(as_span(s.top_mean));
+    if (s.compact.size() == 4) {
+        series("/samples/compact", {4}, T::real).append(as_span(s.compact));
+        series("/samples/compact_status", {}, T::integer).append_integer(s.compact_status);
+    }
+    file_.flush();
+}
+
+void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const LiftRecord& lift) {
+    using T = H5Series::Type;
+    const auto d = static_cast<hsize_t>(dim_), r = static_cast<hsize_t>(realizations_);
+    auto scalar = [&](const char* name, double v) { series(fmt::format("/cpi/{}", name), {}, T::real).append(v); };
+    auto integer = [&](const char* name, std::int64_t v) { series(fmt::format("/cpi/{}", name), {}, T::integer).append_integer(v); };
+    scalar("t_start", rec.t_start);
+    scalar("burst_length", rec.burst_length);
+    scalar("healing", rec.healing);
+    scalar("window", rec.window);
+    scalar("dt_requested", rec.dt_requested);
+    scalar("dt", rec.dt);
+    scalar("period", rec.period);
+    integer("periods", rec.periods_per_step);
+    scalar("t_end", rec.t_end);
+    series("/cpi/status", {}, T::text).append_text(std::string(coarse::to_string(rec.status)));
+    series("/cpi/message", {}, T::text).append_text(rec.message);
+    auto vec = [&](const char* name, const Eigen::VectorXd& v) {
+        Eigen::VectorXd row = v.size() == dim_ ? v : Eigen::VectorXd::Constant(dim_, std::numeric_limits<double>::quiet_NaN());
+        series(fmt::format("/cpi/{}", name), {d}, T::real).append(as_span(row));
+    };
+    vec("slope", rec.slope);
+    vec("x_end", rec.x_end);
+    vec("x_projected", rec.x_projected);
+    scalar("repair_max_adjustment", rec.repair.max_adjustment);
+    integer("repair_clipped", rec.repair.n_clipped);
+    integer("repair_non_monotone", rec.repair.non_monotone ? 1 : 0);
+    integer("stability_assessed", rec.stability.assessed ? 1 : 0);
+    integer("stability_stable", rec.stability.stable ? 1 : 0);
+    scalar("stability_rate", rec.stability.rate);
+    scalar("stability_amplification", rec.stability.amplification);
+    std::vector<std::int64_t> changed(static_cast<std::size_t>(realizations_), 0);
+    std::vector<double> deviation(static_cast<std::size_t>(realizations_), std::numeric_limits<double>::quiet_NaN());
+    std::string messages;
+    for (std::size_t k = 0; k < lift.changed.size() && k < changed.size(); ++k) {
+        changed[k] = lift.changed[k];
+        deviation[k] = lift.max_deviation[k];
+        if (!lift.messages[k].empty()) messages += fmt::format("realization {}: {}\n", k, lift.messages[k]);
+    }
+    series("/cpi/lift_changed", {r}, T::integer).append(std::span<const std::int64_t>(changed));
+    series("/cpi/lift_max_deviation", {r}, T::real).append(std::span<const double>(deviation));
+    series("/cpi/lift_message", {}, T::text).append_text(messages);
+    file_.flush();
+}
+
+void Hdf5Recorder::finish(const RunSummary& s) {
+    file_.attribute("/", "end_status", s.end_status);
+    file_.attribute("/", "simulated_time", s.simulated_time);
+    file_.attribute("/", "dem_time", s.dem_time);
+    file_.attribute("/", "wall_seconds", s.wall_seconds);
+    file_.attribute("/", "particle_steps", s.particle_steps);
+    file_.attribute("/", "coarse_steps", std::int64_t{s.coarse_steps});
+    file_.attribute("/", "restrict_seconds", s.restrict_seconds);
+    file_.attribute("/", "lift_seconds", s.lift_seconds);
+    file_.flush();
+}
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,30 @@
+#pragma once
+/// \file
+/// RecorderList: forwards every record to several recorders (HDF5 and CSV).
+
+#include <memory>
+#include <vector>
+
+#include "mpi_driver/output/run_recorder.hpp"
+
+namespace efdem::mpi_driver {
+
+class RecorderList final : public RunRecorder {
+public:
+    explicit RecorderList(std::vector<std::unique_ptr<RunRecorder>> recorders)
+        : recorders_(std::move(recorders)) {}
+    void sample(const SampleRecord& s) override {
+        for (auto& r : recorders_) r->sample(s);
+    }
+    void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override {
+        for (auto& r : recorders_) r->coarse_step(step, lift);
+    }
+    void finish(const RunSummary& summary) override {
+        for (auto& r : recorders_) r->finish(summary);
+    }
+
+private:
+    std::vector<std::unique_ptr<RunRecorder>> recorders_;
+};
+
+}  // namespace efdem::mpi_driver

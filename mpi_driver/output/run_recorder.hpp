@@ -1,0 +1,71 @@
+#pragma once
+/// \file
+/// What the root records during a run, and where: RunRecorder is the interface the driver
+/// calls; HDF5 (one file per run, the complete record) and CSV (the mean ICDF and the coarse
+/// steps, for quick scripting) implement it.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/projective_integrator.hpp"
+
+namespace efdem::mpi_driver {
+
+/// One ensemble sample, as the root sees it. Heights in d_p, time in sqrt(d_p/g).
+struct SampleRecord {
+    double time = 0;
+    Eigen::VectorXd mean;          ///< ensemble-mean ICDF of the observed species (m)
+    Eigen::VectorXd variance;      ///< unbiased ensemble variance per node (zeros when R = 1)
+    Eigen::MatrixXd realizations;  ///< R x m: each realization's ICDF
+    Eigen::VectorXd com;           ///< R: centre-of-mass height of each realization
+    Eigen::VectorXd top_mean;      ///< ensemble-mean ICDF of the N/2 highest particles, when gathered
+    Eigen::VectorXd compact;       ///< (A, B, C, D) of the mean y(p), when used (else empty)
+    int compact_status = 0;        ///< 0 ok; otherwise the fit's status code
+};
+
+/// What lifting did to each realization at one coarse step.
+struct LiftRecord {
+    std::vector<long> changed;        ///< labels changed, per realization
+    std::vector<double> max_deviation;  ///< max |Q_L,lifted - target| per realization [d_p]
+    std::vector<std::string> messages;  ///< non-empty where a target was repaired or clipped
+};
+
+/// Totals at the end of a run.
+struct RunSummary {
+    double simulated_time = 0;   ///< time covered by the ensemble
+    double dem_time = 0;         ///< time actually simulated by the DEM (per realization)
+    double wall_seconds = 0;
+    double particle_steps = 0;   ///< summed over all realizations
+    long coarse_steps = 0;
+    std::string end_status;      ///< "completed", or why the run stopped
+    double restrict_seconds = 0; ///< root wall time in restriction (observe, gather, average, record)
+    double lift_seconds = 0;     ///< root wall time in lifting (gather, compute, scatter, apply)
+};
+
+class RunRecorder {
+public:
+    virtual ~RunRecorder() = default;
+    virtual void sample(const SampleRecord& s) = 0;
+    virtual void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) = 0;
+    virtual void finish(const RunSummary& summary) = 0;
+};
+
+/// Provenance stored with every run.
+struct RunProvenance {
+    std::string scene_file;
+    std::string scene_text;
+    std::string overrides;     ///< the command-line overrides, space-separated
+    std::string parameters;    ///< every parameter as "key = value   [origin]" lines
+    std::string mode;
+    int ranks = 1;
+    int realizations = 1;
+    int realizations_per_rank = 1;
+    std::uint64_t seed = 1;
+    Eigen::VectorXd p_grid;
+    std::string observed_species;
+};
+
+}  // namespace efdem::mpi_driver
