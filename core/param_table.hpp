@@ -13,6 +13,10 @@
 /// * After set-up, `check_all_used()` fails on the first key nothing read, naming it and
 ///   suggesting what was probably meant.
 /// * A key defined twice in the file is an error (overrides are the only way to redefine).
+///
+/// The reader's jobs, a file pair each: core/scene_lexer.hpp (text to `key = value` with file:line,
+/// and the one syntax check that scene lines and command-line overrides share),
+/// core/param_value.hpp (value tokens to typed values, Bounds checked) and this file (lookup).
 
 #include <cstdint>
 #include <filesystem>
