@@ -12,7 +12,7 @@
 
 #include "core/param_table.hpp"
 #include "core/version.hpp"
-#include "dem/scene.hpp"
+#include "dem/realization_builder.hpp"
 
 int main(int argc, char** argv) {
     if (argc < 2) {

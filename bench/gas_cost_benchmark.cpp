@@ -20,7 +20,7 @@
 #include "core/param_table.hpp"
 #include "core/version.hpp"
 #include "dem/gas/gas_drag.hpp"
-#include "dem/scene.hpp"
+#include "dem/realization_builder.hpp"
 #include "dem/gas/slab_fields.hpp"
 
 using namespace efdem;

@@ -4,8 +4,6 @@
 
 #include <fmt/format.h>
 
-#include "core/log.hpp"
-#include "dem/beds/bed_builder.hpp"
 #include "dem/effect_registry.hpp"
 
 namespace efdem::dem {
@@ -80,49 +78,6 @@ std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::stri
     for (const auto& n : effect_names)
         if (n == scope) return {};
     return fmt::format("is '{}' listed in 'effects'?", scope);
-}
-
-namespace {
-/// Refuses an initial bed that the first health check of the run would stop (System::run checks
-/// every SystemOptions::health_check_every steps): better at set-up, where nothing is lost, than
-/// after the first thousand steps. Lattice beds cannot overlap (bed.jitter is bounded); a LAMMPS
-/// data file can.
-void check_initial_state(const System& sys, const BedSpec& bed, const Params& bed_scope,
-                         const SystemOptions& options) {
-    const char* key = bed.source == BedSpec::Source::lammps_data ? "file" : "source";
-    const ThermoStats s = sys.thermo_stats();
-    if (s.max_overlap > options.max_overlap_fraction)
-        bed_scope.fail(
-            key,
-            fmt::format("starts with an overlap of {:.3g} diameters, beyond the limit of {:g} at "
-                        "which the health check stops a run",
-                        s.max_overlap, options.max_overlap_fraction),
-            fmt::format("initial overlaps up to {:g} of the pair's diameter (or of the diameter, "
-                        "at a wall): a looser packing",
-                        options.max_overlap_fraction));
-    if (const auto problem = sys.health_problem())
-        bed_scope.fail(key, "gives an initial state the run would stop at: " + *problem);
-}
-}  // namespace
-
-System build_system(const Params& root, const RealizationSpec& spec) {
-    DemScene scene = DemScene::from_params(root);
-    auto effects = make_effects(scene, root);
-    const std::string warning = check_time_step(scene, root, effects);
-    if (!warning.empty() && spec.realization == 0) log::warn("{}", warning);
-    const BedSpec bed = BedSpec::from_params(root.scope("bed"), scene);
-    Particles particles = build_bed(bed, scene, root, spec);
-    SystemOptions options;
-    options.dt = scene.dt;
-    options.skin = scene.skin;
-    options.realization = spec.realization;
-    // The numerical watchdog (System::health_problem): how often, and the largest overlap.
-    const Params watchdog = root.scope("watchdog");
-    options.health_check_every = watchdog.get_or<long>("check_every", 1000, Bounds::closed(0, 1000000000));
-    options.max_overlap_fraction = watchdog.get_or<double>("max_overlap", 0.1, Bounds::open_closed(0.0, 1.0));
-    System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
-    check_initial_state(sys, bed, root.scope("bed"), options);
-    return sys;
 }
 
 }  // namespace efdem::dem

@@ -1,10 +1,12 @@
 #pragma once
 /// \file
-/// DemScene: the DEM part of a scene file (time step, box, species, effect list) and the
-/// construction of a System for one realization from it.
+/// DemScene: the DEM part of a scene file (time step, box, species, effect list), the effects
+/// it lists and the time-step check against them. One realization is built from it by
+/// dem/realization_builder.hpp.
 ///
 /// Top-level keys read here: `dt` (required), `effects` (required; the whole list, applied in
-/// order), `domain.*`, `species.*`, `neighbor.skin` (default 0.1), `bed.*` (dem/beds/bed_builder.hpp).
+/// order), `domain.*`, `species.*`, `neighbor.skin` (default 0.1); `bed.*` is read by
+/// dem/beds/bed_builder.hpp.
 
 #include <cstdint>
 #include <memory>
@@ -15,7 +17,6 @@
 #include "dem/domain.hpp"
 #include "dem/effect.hpp"
 #include "dem/species.hpp"
-#include "dem/system.hpp"
 
 namespace efdem::dem {
 
@@ -46,15 +47,11 @@ std::string check_time_step(const DemScene& scene, const Params& root,
 /// to a known effect that is not listed, else "".
 std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::string>& effect_names);
 
-/// Everything needed to build one realization.
+/// Everything needed to build one realization (dem/realization_builder.hpp).
 struct RealizationSpec {
     std::uint64_t seed = 1;       ///< master seed
     long realization = 0;         ///< global realization index
     bool skip_settling = false;   ///< read every key but do not run the settling (efdem --check)
 };
-
-/// Builds one realization: effects, initial bed (dem/beds/bed_builder.hpp), System. InputError for
-/// bad input; the same keys are read for every realization.
-System build_system(const Params& root, const RealizationSpec& spec);
 
 }  // namespace efdem::dem

@@ -17,7 +17,7 @@
 #include "core/log.hpp"
 #include "core/version.hpp"
 #include "dem/effect_registry.hpp"
-#include "dem/scene.hpp"
+#include "dem/realization_builder.hpp"
 #include "mpi_driver/run/check_report.hpp"
 #include "mpi_driver/output/csv_recorder.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"

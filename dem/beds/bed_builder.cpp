@@ -6,11 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "core/log.hpp"
 #include "core/rng.hpp"
-#include "dem/effect_registry.hpp"
-#include "dem/effects/viscous_damping.hpp"
-#include "dem/io/lammps_data.hpp"
 
 namespace efdem::dem {
 
@@ -37,12 +33,11 @@ double lattice_top(const BedSpec& bed, const DemScene& scene) {
     const long layers = (g.n + g.nx * g.ny - 1) / (g.nx * g.ny);
     return g.z0 + static_cast<double>(layers - 1) * g.az + bed.jitter + 0.5 * scene.species.max_diameter();
 }
-/// Duration of the free-fall stage of settling: the top of a lattice `top` high falls onto
-/// the bed (g = 1), plus one time unit.
-double free_fall_time(double top) {
+}  // namespace
+
+double settle_free_fall_time(double top) {
     return std::sqrt(2.0 * top) + 1.0;
 }
-}  // namespace
 
 namespace {
 /// Reads bed.count: one whole number per species, at least one particle, at most
@@ -120,7 +115,7 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
         if (b.settle) {
             // Each settling stage is a bounded number of steps, checked here so that
             // `efdem --check` reports it without settling.
-            check_settle_steps(p, "count", free_fall_time(top), scene.dt);
+            check_settle_steps(p, "count", settle_free_fall_time(top), scene.dt);
             check_settle_steps(s, "damped_time", b.settle_damped_time, scene.dt);
             check_settle_steps(s, "max_time", b.settle_max_time, scene.dt);
         }
@@ -168,78 +163,10 @@ Particles lattice_bed(const BedSpec& bed, const DemScene& scene, const Realizati
     return p;
 }
 
-Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& scene,
-                     const Params& root, const RealizationSpec& spec) {
-    for (const char* needed : {"pair_contact", "wall_contact"}) {
-        bool listed = false;
-        for (const auto& n : scene.effect_names) listed |= n == needed;
-        if (!listed)
-            root.scope("bed").fail("settle", fmt::format("needs '{}' in 'effects' to settle the bed", needed),
-                                   "false, or list pair_contact and wall_contact in effects");
-    }
-    // The settling run uses the scene's own contact laws and gravity, plus a damping stage.
-    const std::vector<std::string> names{"gravity", "pair_contact", "wall_contact"};
-    std::vector<std::unique_ptr<Effect>> effects;
-    for (const auto& name : names)
-        effects.push_back(effect_registry().find(name)->make(
-            EffectSetup{root.scope(name), root, scene.species, scene.domain, scene.effect_names}));
-    auto damping_owner = std::make_unique<ViscousDamping>(0.0);
-    ViscousDamping* damping = damping_owner.get();
-    effects.push_back(std::move(damping_owner));
-
-    double top = 0;
-    for (const auto& x : particles.x()) top = std::max(top, x.z);
-    SystemOptions options;
-    options.dt = scene.dt;
-    options.skin = scene.skin;
-    options.realization = spec.realization;
-    System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
-    const auto steps = [&](double t) { return static_cast<long>(std::ceil(t / scene.dt)); };
-
-    sys.run(steps(free_fall_time(top)));  // the top layer reaches the bed
-    damping->set_gamma(bed.settle_damping);
-    sys.run(steps(bed.settle_damped_time));
-    damping->set_gamma(0.0);
-    const double threshold = bed.settle_ke_threshold * scene.species.min_mass();
-    const long chunk = std::max(1L, steps(0.5));
-    const double t_start = sys.time();
-    double ke = 0;
-    while (true) {
-        ke = sys.translational_kinetic_energy() / static_cast<double>(sys.particles().size());
-        if (ke < threshold || sys.time() - t_start >= bed.settle_max_time) break;
-        sys.run(chunk);
-    }
-    if (ke >= threshold)
-        log::warn("realization {}: settling stopped after {:.4g} time units with kinetic energy {:.3g} "
-                  "per particle, above bed.settle.ke_threshold x m_min g d = {:.3g}",
-                  spec.realization, sys.time(), ke, threshold);
-    Particles settled = sys.particles();
-    for (auto& v : settled.v()) v = Vec3{};  // the packed bed starts at rest
-    for (auto& w : settled.omega()) w = Vec3{};
-    return settled;
-}
-
 void permute_species(Particles& p, const SpeciesTable& species, RandomStream& rng) {
     std::vector<SpeciesId> labels(p.species().begin(), p.species().end());
     rng.shuffle(labels.begin(), labels.end());
     for (std::size_t i = 0; i < labels.size(); ++i) p.set_species(static_cast<Index>(i), labels[i], species);
-}
-
-Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& root,
-                    const RealizationSpec& spec) {
-    Particles p;
-    if (bed.source == BedSpec::Source::lattice) {
-        p = lattice_bed(bed, scene, spec);
-        if (bed.settle && !spec.skip_settling) p = settle_bed(std::move(p), bed, scene, root, spec);
-    } else {
-        p = read_lammps_data(bed.file, scene.species, scene.domain);
-    }
-    if (bed.permute_species) {
-        // A separate stream, so that permuting never shifts the lattice's packing draws.
-        RandomStream rng(spec.seed, static_cast<std::uint64_t>(spec.realization), "species_permutation");
-        permute_species(p, scene.species, rng);
-    }
-    return p;
 }
 
 }  // namespace efdem::dem

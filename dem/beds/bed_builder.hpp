@@ -3,6 +3,9 @@
 /// Initial beds (physics.md §5.4): a jittered simple-cubic lattice with exact species counts
 /// assigned by random permutation, random velocities, then settling under gravity until the
 /// kinetic energy per particle is below a threshold; or a LAMMPS `write_data` sphere file.
+/// This file reads the bed's keys (the settling protocol's too) and builds the lattice; the
+/// settling runs in dem/settling/settling.hpp, and dem/realization_builder.hpp puts the steps
+/// together (build_bed).
 ///
 /// Scene keys (scope `bed`):
 ///
@@ -42,6 +45,10 @@ namespace efdem::dem {
 /// Most time steps of one settling stage (free fall, damped, undamped up to settle.max_time).
 inline constexpr long kMaxSettleSteps = 1'000'000'000;
 
+/// Duration of the free-fall stage of settling: the top of a bed `top` high falls onto the bed
+/// (g = 1), plus one time unit. Checked against kMaxSettleSteps when the bed is read.
+double settle_free_fall_time(double top);
+
 struct BedSpec {
     enum class Source { lattice, lammps_data } source = Source::lattice;
     std::vector<long> count;
@@ -62,15 +69,6 @@ struct BedSpec {
 
 /// The jittered lattice with exact species counts and random velocities (not settled).
 Particles lattice_bed(const BedSpec& bed, const DemScene& scene, const RealizationSpec& spec);
-
-/// Settles `particles` with the scene's gravity, pair_contact and wall_contact (InputError if the
-/// scene lacks the contact effects). Returns the settled particles.
-Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& scene,
-                     const Params& root, const RealizationSpec& spec);
-
-/// The initial particles of one realization according to `bed`.
-Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& root,
-                    const RealizationSpec& spec);
 
 /// Reassigns species by a random permutation of the current labels (counts stay exact).
 void permute_species(Particles& p, const SpeciesTable& species, RandomStream& rng);

@@ -6,6 +6,7 @@
 
 #include "dem/gas/drag_laws.hpp"
 #include "dem/gas/gas_drag.hpp"
+#include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/input_error.hpp"
 

@@ -8,8 +8,7 @@
 #include <fstream>
 #include <numbers>
 
-#include "dem/beds/bed_builder.hpp"
-#include "dem/scene.hpp"
+#include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "dem/effect_registry.hpp"
+#include "dem/realization_builder.hpp"
 #include "dem/scene.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/input_error.hpp"

@@ -8,6 +8,7 @@
 
 #include "dem/beds/bed_diagnostics.hpp"
 #include "dem/gas/slab_fields.hpp"
+#include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;

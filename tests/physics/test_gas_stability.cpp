@@ -14,6 +14,7 @@
 
 #include "dem/beds/bed_diagnostics.hpp"
 #include "dem/gas/gas_drag.hpp"
+#include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/report.hpp"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "dem/beds/bed_builder.hpp"
+#include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;

@@ -16,7 +16,7 @@
 #include <fmt/format.h>
 
 #include "core/rng.hpp"
-#include "dem/beds/bed_builder.hpp"
+#include "dem/realization_builder.hpp"
 #include "dem/io/lammps_data.hpp"
 #include "tests/support/collisions.hpp"
 #include "tests/support/dem_fixtures.hpp"

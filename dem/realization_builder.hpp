@@ -1,0 +1,29 @@
+#pragma once
+/// \file
+/// Building one DEM realization from a scene: the effects (dem/scene.hpp), the initial bed
+/// (dem/beds/bed_builder.hpp, settled by dem/settling/settling.hpp) and the System that runs
+/// them. The one file of dem/ that puts beds and settling together.
+///
+/// Keys read here besides those of DemScene and BedSpec (scope `watchdog`): `check_every`
+/// (steps between health checks, default 1000, 0 = never) and `max_overlap` (largest overlap,
+/// as a fraction of the pair's diameter, before a run is stopped, default 0.1).
+
+#include "core/param_table.hpp"
+#include "dem/beds/bed_builder.hpp"
+#include "dem/particles.hpp"
+#include "dem/scene.hpp"
+#include "dem/system.hpp"
+
+namespace efdem::dem {
+
+/// The initial particles of one realization according to `bed`: the lattice, settled unless
+/// bed.settle = false or spec.skip_settling, or the LAMMPS data file; then the species
+/// permutation when bed.permute_species is set.
+Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& root,
+                    const RealizationSpec& spec);
+
+/// Builds one realization: effects, initial bed (build_bed), System. InputError for bad input;
+/// the same keys are read for every realization.
+System build_system(const Params& root, const RealizationSpec& spec);
+
+}  // namespace efdem::dem
