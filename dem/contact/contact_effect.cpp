@@ -10,7 +10,8 @@ void ContactEffect::describe(EffectReport& r) const {
                           : s.damping == DampingModel::gamma     ? "gamma (one gamma_n, LAMMPS)"
                                                                  : "none";
     r.add("model", fmt::format("normal {}, damping {}, tangential {}",
-                               s.normal == NormalModel::hooke ? "hooke" : "hertz", damping,
+                               with_normal_law(s.normal, [](auto n) { return decltype(n)::kName; }),
+                               damping,
                                has_history() ? "history" : "none"));
     r.add("kn", fmt::format("{:g}", s.kn));
     if (has_history())

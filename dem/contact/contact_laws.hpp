@@ -74,6 +74,17 @@ struct ContactForce {
 };
 
 /**
+ * \brief Adds the elastic energy stored in one contact to `e`: the normal spring
+ *        Normal::energy, then, when the contact has a history spring `xi`, the tangential
+ *        spring 0.5 s_e k_t |xi|^2 (two additions, in that order).
+ */
+template <class Normal>
+inline void add_contact_energy(double& e, double delta, const ContactCoeffs& c, const Vec3* xi) {
+    e += Normal::energy(c.kn, delta, c.r_eff);
+    if (xi) e += 0.5 * Normal::elastic_scale(delta, c.r_eff) * c.kt * norm2(*xi);
+}
+
+/**
  * \brief One contact: forces on i from the kernel equations in the file header.
  * \param n       unit normal from j to i
  * \param delta   overlap (> 0)

@@ -112,17 +112,27 @@ private:
     std::vector<PairTypeInfo> info_;
 };
 
-/// Calls f(Normal{}, Tangential{}) with the kernel types of the spec's sub-models: the one
-/// place where the run-time choice becomes compile-time types (one dispatch per loop, never per
-/// pair). \code with_contact_kernels(spec, [&](auto n, auto t) { loop<decltype(n), decltype(t)>(); }); \endcode
+/// Calls f(Normal{}) with the kernel type of the normal law (HookeNormal, HertzNormal) and
+/// returns what f returns: the one place where the run-time NormalModel becomes a compile-time
+/// type. Force loops (with_contact_kernels), contact energies and reports all go through it;
+/// call it once per loop, never per pair.
+/// \code double e = with_normal_law(spec.normal, [&](auto n) { return decltype(n)::energy(kn, delta, r); }); \endcode
+template <class F>
+decltype(auto) with_normal_law(NormalModel normal, F&& f) {
+    if (normal == NormalModel::hertz) return f(HertzNormal{});
+    return f(HookeNormal{});
+}
+
+/// Calls f(Normal{}, Tangential{}) with the kernel types of the spec's sub-models (the normal
+/// law through with_normal_law): one dispatch per loop, never per pair.
+/// \code with_contact_kernels(spec, [&](auto n, auto t) { loop<decltype(n), decltype(t)>(); }); \endcode
 template <class F>
 void with_contact_kernels(const ContactSpec& spec, F&& f) {
-    const bool hertz = spec.normal == NormalModel::hertz;
     const bool history = spec.tangential == TangentialModel::history;
-    if (!hertz && history) f(HookeNormal{}, HistoryTangential{});
-    else if (!hertz) f(HookeNormal{}, NoTangential{});
-    else if (history) f(HertzNormal{}, HistoryTangential{});
-    else f(HertzNormal{}, NoTangential{});
+    with_normal_law(spec.normal, [&](auto normal) {
+        if (history) f(normal, HistoryTangential{});
+        else f(normal, NoTangential{});
+    });
 }
 
 }  // namespace efdem::dem

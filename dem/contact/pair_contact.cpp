@@ -154,20 +154,15 @@ static void for_each_touching(const ForceContext& ctx, F&& f) {
 }
 
 double PairContact::potential_energy(const ForceContext& ctx) const {
-    const ContactSpec& s = table_.spec();
     const auto sp = ctx.particles.species();
-    double e = 0;
-    for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t k, const Vec3& d, double radsum) {
-        const ContactCoeffs& c = table_(sp[i], sp[j]);
-        const double delta = radsum - norm(d);
-        const bool hertz = s.normal == NormalModel::hertz;
-        e += hertz ? HertzNormal::energy(c.kn, delta, c.r_eff) : HookeNormal::energy(c.kn, delta, c.r_eff);
-        if (ctx.history) {
-            const double scale = hertz ? HertzNormal::elastic_scale(delta, c.r_eff) : 1.0;
-            e += 0.5 * scale * c.kt * norm2(ctx.history->pairs()[k]);
-        }
+    return with_normal_law(table_.spec().normal, [&](auto normal) {
+        double e = 0;
+        for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t k, const Vec3& d, double radsum) {
+            add_contact_energy<decltype(normal)>(e, radsum - norm(d), table_(sp[i], sp[j]),
+                                                 ctx.history ? &ctx.history->pairs()[k] : nullptr);
+        });
+        return e;
     });
-    return e;
 }
 
 void PairContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const {

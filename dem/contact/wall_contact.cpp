@@ -62,22 +62,20 @@ double WallContact::potential_energy(const ForceContext& ctx) const {
     const auto x = ctx.particles.x();
     const auto rad = ctx.particles.radius();
     const auto sp = ctx.particles.species();
-    const bool hertz = table_.spec().normal == NormalModel::hertz;
-    double e = 0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        const ContactCoeffs& c = table_.wall(sp[i]);
-        auto add = [&](double delta, int wall) {
-            if (delta <= 0) return;
-            e += hertz ? HertzNormal::energy(c.kn, delta, c.r_eff) : HookeNormal::energy(c.kn, delta, c.r_eff);
-            if (ctx.history) {
-                const double scale = hertz ? HertzNormal::elastic_scale(delta, c.r_eff) : 1.0;
-                e += 0.5 * scale * c.kt * norm2(ctx.history->wall(wall)[i]);
-            }
-        };
-        add(rad[i] - x[i].z, ContactHistory::kFloor);
-        if (ctx.domain.has_lid()) add(rad[i] - (ctx.domain.lid_height - x[i].z), ContactHistory::kLid);
-    }
-    return e;
+    return with_normal_law(table_.spec().normal, [&](auto normal) {
+        double e = 0;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+            const ContactCoeffs& c = table_.wall(sp[i]);
+            auto add = [&](double delta, int wall) {
+                if (delta <= 0) return;
+                add_contact_energy<decltype(normal)>(e, delta, c,
+                                                     ctx.history ? &ctx.history->wall(wall)[i] : nullptr);
+            };
+            add(rad[i] - x[i].z, ContactHistory::kFloor);
+            if (ctx.domain.has_lid()) add(rad[i] - (ctx.domain.lid_height - x[i].z), ContactHistory::kLid);
+        }
+        return e;
+    });
 }
 
 void WallContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const {

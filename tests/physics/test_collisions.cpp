@@ -128,3 +128,29 @@ TEST_CASE("the contact table reports the eta_n of physics.md §12.2", "[unit][co
     // gamma_t = gamma_n / 2 by default, i.e. eta_t = eta_n / 2.
     CHECK(t(0, 1).eta_t == Approx(0.5 * t(0, 1).eta_n));
 }
+
+TEST_CASE("contact energy of pairs and the floor follows the normal law the forces use",
+          "[unit][contact]") {
+    // Two touching spheres overlapping by dp (R_eff = 1/4) high above the floor, and a third
+    // pressed dw into the floor (R_eff = its radius, 1/2); no tangential spring.
+    const double dp = 1e-3, dw = 2e-3, kn = 2e5;
+    const SpeciesTable species = binary_species();
+    for (const NormalModel law : {NormalModel::hooke, NormalModel::hertz}) {
+        ContactSpec spec = paper_contact(DampingModel::restitution, TangentialModel::none);
+        spec.normal = law;
+        spec.kn = kn;
+        Particles p;
+        p.add(1, {1.0, 2.0, 3.0}, {}, 0, species);
+        p.add(2, {2.0 - dp, 2.0, 3.0}, {}, 1, species);
+        p.add(3, {3.0, 2.0, 0.5 - dw}, {}, 0, species);
+        System s = test::make_system(species, Domain{5.0, 5.0}, std::move(p),
+                                     std::move(test::EffectList{}.pair(spec, species).wall(spec, species)),
+                                     1e-5);
+        const double pair = law == NormalModel::hooke ? 0.5 * kn * dp * dp
+                                                      : 0.4 * kn * std::sqrt(0.25 * dp) * dp * dp;
+        const double wall = law == NormalModel::hooke ? 0.5 * kn * dw * dw
+                                                      : 0.4 * kn * std::sqrt(0.5 * dw) * dw * dw;
+        INFO((law == NormalModel::hooke ? "hooke" : "hertz"));
+        CHECK(s.potential_energy() == Approx(pair + wall).epsilon(1e-9));
+    }
+}
