@@ -7,6 +7,23 @@
 #   coarse/dem_adapters  -> coarse, dem, core       (no MPI)
 #   mpi_driver           -> everything
 #
+# and, between the rooms of dem/ (one target; dem/CMakeLists.txt):
+#
+#   contact/ <-/-> gas/                  the two physics rooms know nothing of each other
+#   contact/, gas/, effects/             -> no beds/, settling/, io/, realization builder
+#                                           (forces come before preparing beds and writing)
+#   io/                                  -> no contact/, gas/, effects/, settling/, effect
+#                                           registry, realization builder (it reads a System)
+#   top level (scene, System, ...)       -> no beds/, settling/, io/: only realization_builder
+#                                           puts them together (no scene <-> beds cycle)
+#   settling/                            <- realization_builder.cpp only
+#   realization_builder.hpp              <- nothing in dem/ (it is the top)
+#   effect headers (effects/, contact/{pair,wall}_contact.hpp, gas/gas_drag.hpp)
+#                                        <- effect_registry.cpp, settling/ (its damping stage),
+#                                           beds/bed_diagnostics.cpp (GasDrag::pressure_drop)
+#
+# A file including its own header never counts.
+#
 # The CMake targets enforce the same rule at link time (target_link_libraries); this script
 # catches an #include that slips through a transitive include path.
 #
@@ -16,39 +33,97 @@ set -euo pipefail
 
 check_tree() {
     local root=$1 status=0
-    # forbid FOLDER PATTERN DESCRIPTION [EXCLUDE_SUBDIR]
-    forbid() {
-        local folder=$1 pattern=$2 what=$3 exclude=${4:-}
+    # forbid_files FOLDER FILES PATTERN DESCRIPTION [ALLOWED]: no file under FOLDER whose path
+    # from the root (dem/scene.cpp) matches the ERE FILES (empty: all) and not the ERE ALLOWED
+    # may #include a path matching PATTERN; a file's #include of its own header is skipped.
+    forbid_files() {
+        local folder=$1 files=$2 pattern=$3 what=$4 allowed=${5:-}
         [ -d "$root/$folder" ] || return 0
         local hits
         hits=$(grep -rnE --include='*.hpp' --include='*.cpp' --include='*.h' \
                  "^[[:space:]]*#[[:space:]]*include[[:space:]]*[<\"]($pattern)" "$root/$folder" \
-                 | { if [ -n "$exclude" ]; then grep -v "^$root/$folder/$exclude/" || true; else cat; fi; } \
-                 || true)
+                 | sed "s|^$root/||" \
+                 | awk -v files="$files" -v allowed="$allowed" '{
+                       path = substr($0, 1, index($0, ":") - 1)
+                       if (path !~ files || (allowed != "" && path ~ allowed)) next
+                       own = path; sub(/\.[^.\/]*$/, "", own)
+                       if (index($0, "\"" own ".hpp\"") || index($0, "\"" own ".h\"")) next
+                       print
+                   }' || true)
         if [ -n "$hits" ]; then
-            echo "dependency rule violated: $folder must not include $what:"
-            echo "$hits" | sed "s|^$root/|  |"
+            echo "dependency rule violated: $what:"
+            echo "$hits" | sed "s|^|  |"
             status=1
         fi
+    }
+    # forbid FOLDER PATTERN DESCRIPTION [EXCLUDE_SUBDIR]: no file under FOLDER (except under
+    # FOLDER/EXCLUDE_SUBDIR) may #include a path matching PATTERN.
+    forbid() {
+        local folder=$1 exclude=${4:-}
+        forbid_files "$folder" '' "$2" "$folder must not include $3" "${exclude:+^$folder/$exclude/}"
     }
     forbid core 'dem/|coarse/|mpi_driver/|mpi\.h|hdf5\.h' "dem/, coarse/, mpi_driver/, MPI or HDF5"
     forbid dem 'coarse/|mpi_driver/|mpi\.h' "coarse/, mpi_driver/ or MPI"
     forbid coarse 'dem/|mpi_driver/|mpi\.h' "dem/, mpi_driver/ or MPI (only coarse/dem_adapters may see dem/)" dem_adapters
     forbid coarse/dem_adapters 'mpi_driver/|mpi\.h' "mpi_driver/ or MPI"
+    # The rooms of dem/ (the table at the top).
+    forbid dem/contact 'dem/gas/' "dem/gas/ (contact and gas know nothing of each other)"
+    forbid dem/gas 'dem/contact/' "dem/contact/ (contact and gas know nothing of each other)"
+    local late='dem/(beds|settling|io)/|dem/realization_builder\.hpp'
+    forbid dem/contact "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
+    forbid dem/gas "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
+    forbid dem/effects "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
+    forbid dem/io 'dem/(contact|gas|effects|settling)/|dem/effect_registry\.hpp|dem/realization_builder\.hpp' \
+        "dem/contact/, dem/gas/, dem/effects/, dem/settling/, the effect registry or the realization builder"
+    forbid_files dem '^dem/[^/]+$' 'dem/(beds|settling|io)/' \
+        "the top level of dem/ must not include dem/beds/, dem/settling/ or dem/io/ (only dem/realization_builder.* puts them together)" \
+        '^dem/realization_builder\.(hpp|cpp)$'
+    forbid_files dem '^dem/' 'dem/settling/' \
+        "dem/settling/ is included by dem/realization_builder.cpp only" '^dem/(realization_builder\.cpp|settling/)'
+    forbid_files dem '^dem/' 'dem/realization_builder\.hpp' \
+        "nothing in dem/ includes dem/realization_builder.hpp (it is the top of dem/)"
+    forbid_files dem '^dem/' 'dem/(effects/|contact/(pair|wall)_contact\.hpp|gas/gas_drag\.hpp)' \
+        "effect headers are included by dem/effect_registry.cpp, dem/settling/ and dem/beds/bed_diagnostics.cpp only (effects are made by name)" \
+        '^dem/(effect_registry\.cpp|beds/bed_diagnostics\.cpp)$|^dem/settling/'
     return $status
 }
 
 if [ "${1:-}" = "--self-test" ]; then
     scratch=$(mktemp -d)
     trap 'rm -rf "$scratch"' EXIT
-    mkdir -p "$scratch"/{core,dem,coarse/dem_adapters,mpi_driver}
+    mkdir -p "$scratch"/{core,dem/{contact,gas,effects,beds,settling,io},coarse/dem_adapters,mpi_driver}
     echo '#include "core/vec3.hpp"' > "$scratch/dem/ok.cpp"
+    # What the rooms of dem/ may include (the exceptions of the rules must not be flagged).
+    printf '#include "dem/%s"\n' realization_builder.hpp settling/settling.hpp beds/bed_builder.hpp \
+        io/lammps_data.hpp > "$scratch/dem/realization_builder.cpp"
+    printf '#include "dem/%s"\n' settling/settling.hpp beds/bed_builder.hpp effects/viscous_damping.hpp \
+        effect_registry.hpp > "$scratch/dem/settling/settling.cpp"
+    printf '#include "dem/%s"\n' effects/gravity.hpp contact/pair_contact.hpp gas/gas_drag.hpp \
+        > "$scratch/dem/effect_registry.cpp"
+    printf '#include "dem/%s"\n' beds/bed_diagnostics.hpp gas/gas_drag.hpp gas/slab_fields.hpp \
+        > "$scratch/dem/beds/bed_diagnostics.cpp"
+    printf '#include "dem/%s"\n' effects/gravity.hpp effect.hpp > "$scratch/dem/effects/gravity.cpp"
+    printf '#include "dem/%s"\n' contact/pair_contact.hpp contact/contact_history.hpp neighbor_list.hpp \
+        > "$scratch/dem/contact/pair_contact.cpp"
+    printf '#include "dem/%s"\n' io/bed_time_series.hpp beds/bed_diagnostics.hpp system.hpp \
+        > "$scratch/dem/io/bed_time_series.cpp"
+    printf '#include "dem/%s"\n' contact/contact_history.hpp gas/slab_fields.hpp > "$scratch/dem/system.hpp"
     echo '#include "dem/particles.hpp"' > "$scratch/coarse/dem_adapters/ok.cpp"
     echo '#include <mpi.h>' > "$scratch/mpi_driver/ok.cpp"
     check_tree "$scratch" > /dev/null || { echo "self-test: a clean tree was flagged"; exit 1; }
     for bad in "dem/a.cpp:#include <mpi.h>" "dem/b.hpp:#include \"coarse/demixing/quantiles.hpp\"" \
                "coarse/c.cpp:#include \"dem/system.hpp\"" "coarse/d.hpp:  #  include <mpi.h>" \
-               "core/e.cpp:#include \"dem/particles.hpp\"" "coarse/dem_adapters/f.cpp:#include <mpi.h>"; do
+               "core/e.cpp:#include \"dem/particles.hpp\"" "coarse/dem_adapters/f.cpp:#include <mpi.h>" \
+               "dem/contact/g.cpp:#include \"dem/gas/slab_fields.hpp\"" \
+               "dem/gas/h.hpp:#include \"dem/contact/contact_laws.hpp\"" \
+               "dem/effects/i.cpp:#include \"dem/beds/bed_builder.hpp\"" \
+               "dem/io/j.cpp:#include \"dem/contact/contact_history.hpp\"" \
+               "dem/scene.cpp:#include \"dem/beds/bed_builder.hpp\"" \
+               "dem/beds/k.cpp:#include \"dem/settling/settling.hpp\"" \
+               "dem/io/l.cpp:#include \"dem/realization_builder.hpp\"" \
+               "dem/scene.hpp:#include \"dem/realization_builder.hpp\"" \
+               "dem/system.cpp:#include \"dem/contact/pair_contact.hpp\"" \
+               "dem/beds/bed_builder.cpp:#include \"dem/effects/viscous_damping.hpp\""; do
         file=${bad%%:*}; line=${bad#*:}
         echo "$line" > "$scratch/$file"
         if check_tree "$scratch" > /dev/null; then
