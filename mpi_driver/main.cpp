@@ -10,8 +10,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "coarse/demixing/compact_observable.hpp"
-#include "coarse/demixing/ensemble_observable.hpp"
 #include "coarse/demixing/probability_grid.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -34,6 +32,7 @@
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/checkpoint/restart_loader.hpp"
 #include "mpi_driver/run/run_options.hpp"
+#include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 #include "mpi_driver/ensemble/scene_input.hpp"
 
@@ -48,7 +47,7 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
     p.scene_text = table.text();
     p.overrides = fmt::format("{}", fmt::join(table.overrides(), " "));
     for (const auto& r : table.resolved()) p.parameters += fmt::format("{} = {}   [{}]\n", r.key, r.value, r.origin);
-    p.mode = s.mode == RunSettings::Mode::cpi ? "cpi" : "direct";
+    p.mode = s.mode_name();
     p.ranks = mpi.size();
     p.realizations_per_rank = s.realizations_per_rank;
     p.realizations = mpi.size() * s.realizations_per_rank;
@@ -61,18 +60,10 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
 /// Runs the scene: the root drives (direct or cpi loop) and records; the other ranks serve.
 /// `restart`: the checkpoint to continue from (null: a new run).
 int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
-        std::vector<dem::System> systems, InjectedFailure injected, const RestartData* restart) {
+        std::vector<dem::System> systems, const RestartData* restart) {
     const RunProvenance prov = provenance(mpi, table, s, systems.front());
     const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
-    const bool cpi = s.mode == RunSettings::Mode::cpi;
-    coarse::IcdfObservable icdf(s.observe.quantiles);
-    std::unique_ptr<coarse::EnsembleObservable> compact;
-    if (cpi && s.cpi.observable == CpiSettings::Observable::compact)
-        compact = std::make_unique<coarse::CompactObservable>(coarse::ProbabilityGrid(s.observe.quantiles));
-    coarse::EnsembleObservable& observable = compact ? *compact : icdf;
-    std::unique_ptr<coarse::EnsembleObservable> recorded;
-    if (s.observe.compact && !compact)
-        recorded = std::make_unique<coarse::CompactObservable>(coarse::ProbabilityGrid(s.observe.quantiles));
+    RunObservables observables = RunObservables::from_settings(s);
 
     std::unique_ptr<RecorderList> recorders;
     std::vector<std::unique_ptr<Realization>> local;
@@ -82,8 +73,8 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
             if (resume) restore_outputs(restart->header, s.output.directory, s.output.prefix);
             std::vector<std::unique_ptr<RunRecorder>> owned;
 #if EFDEM_HAVE_HDF5
-            owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory / (s.output.prefix + ".h5"), prov,
-                                                           observable.dimension(), resume));
+            owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory, s.output.prefix, prov,
+                                                           observables.primary->dimension(), resume));
 #endif
             owned.push_back(std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov, resume));
             recorders = std::make_unique<RecorderList>(std::move(owned));
@@ -123,13 +114,13 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.steps_per_sample = s.observe.steps_per_sample;
     ss.quantiles = s.observe.quantiles;
     ss.seed = s.seed;
-    ss.failure = injected;
-    ss.recorded = recorded.get();
+    ss.failure = s.injected_failure;
+    ss.recorded = observables.recorded.get();
     // The run's start (progress counts from there; on the non-root ranks it is not used).
     const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
     const ColourLifter lifter;
-    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, recorders.get(),
+    EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter, recorders.get(),
                             mpi.is_root() ? &progress : nullptr);
     RunControl control;
     if (resume) {
@@ -144,12 +135,9 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         identity.realizations = prov.realizations;
         identity.scene_text = table.text();
         identity.parameters = parameter_lines(table);
-        const auto& dir = s.output.directory;
-        const auto& prefix = s.output.prefix;
-        writer = std::make_unique<CheckpointWriter>(
-            layout, s.checkpoint, prefix, std::move(identity),
-            std::vector<std::filesystem::path>{dir / (prefix + ".h5"), dir / (prefix + "_mean_icdf.csv"),
-                                               dir / (prefix + "_cpi_steps.csv")});
+        // The recorders (root only) name the files they write; the checkpoint stores them whole.
+        writer = std::make_unique<CheckpointWriter>(layout, s.checkpoint, s.output.prefix, std::move(identity),
+                                                    recorders ? recorders->files() : std::vector<std::filesystem::path>{});
         stepper.set_checkpoint_writer(writer.get());
         control.checkpoint_interval = s.checkpoint.interval;
     }
@@ -160,8 +148,8 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     }
     RunSummary summary;
     try {
-        summary = cpi ? run_cpi(stepper, s, icdf, recorders.get(), progress, control)
-                      : run_direct(stepper, s, progress, control);
+        summary = s.is_cpi() ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(), progress, control)
+                             : run_direct(stepper, s, progress, control);
         recorders->finish(summary);
     } catch (const std::exception& e) {
         mpi.abort(e.what(), kExitRuntimeFailure);
@@ -219,15 +207,11 @@ int main(int argc, char** argv) {
     std::optional<ParamTable> table;
     std::optional<RunSettings> settings;
     std::vector<dem::System> systems;
-    InjectedFailure injected;
     try {
         table.emplace(read_scene(mpi, options.scene, options.overrides));
         Params root = table->root();
         const dem::DemScene scene = dem::DemScene::from_params(root);
         settings = RunSettings::from_params(root, scene);
-        const Params debug = root.scope("debug");
-        injected.realization = debug.get_or<long>("fail_realization", -1);
-        injected.time = debug.get_or<double>("fail_time", 0.0);
         const int k = check ? 1 : settings->realizations_per_rank;
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;
@@ -280,5 +264,5 @@ int main(int argc, char** argv) {
             return loaded.exit_code;
         }
     }
-    return run(mpi, *table, *settings, std::move(systems), injected, restart ? &*restart : nullptr);
+    return run(mpi, *table, *settings, std::move(systems), restart ? &*restart : nullptr);
 }

@@ -7,7 +7,7 @@
 /// Lifting: each realization's target is Q_L*(p) = Q_top,r(p) - y(p; X), with Q_top,r from
 /// that realization's own (reused) positions (§9). A sample whose fit is not usable (y = 0 at
 /// full demixing, no convergence, a poor fit) yields a vector of NaN and a status: the
-/// integrator then rejects the burst and the driver falls back to the full ICDF.
+/// integrator then rejects the burst and the run loop falls back to the full ICDF.
 
 #include <optional>
 
@@ -21,6 +21,7 @@ public:
     explicit CompactObservable(ProbabilityGrid grid, CompactFitSettings settings = {})
         : grid_(grid), settings_(settings) {}
     std::string_view name() const override { return "compact"; }
+    std::string_view label() const override { return "compact (A,B,C,D)"; }
     Eigen::Index dimension() const override { return 4; }
     bool needs_top_half() const override { return true; }
     Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) override;

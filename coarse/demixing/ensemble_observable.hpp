@@ -8,18 +8,25 @@
 /// `icdf` of the observed species (Q_L) and, when needs_top_half(), `top` of the N/2 highest
 /// particles (Q_top, physics.md §8). Heights in d_p. Generic: no DEM, no MPI.
 
+#include <functional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "coarse/equation_free/projective_integrator.hpp"
 
 namespace efdem::coarse {
 
 class EnsembleObservable {
 public:
     virtual ~EnsembleObservable() = default;
+    /// The name a scene gives it (cpi.observable), e.g. "icdf".
     virtual std::string_view name() const = 0;
+    /// What it is, for messages, e.g. "full ICDF".
+    virtual std::string_view label() const = 0;
     virtual Eigen::Index dimension() const = 0;
     virtual bool needs_top_half() const = 0;
     /// X of one sample. May carry state (e.g. a warm start); call once per sample, in time order.
@@ -36,6 +43,17 @@ public:
     /// successes: a burst is rejected for its first failed sample, not its last one. Empty if
     /// none failed.
     virtual std::string failure_message() const { return {}; }
+    /// Why the last rejected burst's restriction failed: failure_message(), else
+    /// status_message(), else a generic text. For the log line of a fallback.
+    std::string failure_reason() const;
+    /// The lowest and highest height a lifting target may use [d_p], asked for when a
+    /// projected vector is repaired (the heights the particles occupy at the last sample).
+    using FeasibleRange = std::function<std::pair<double, double>()>;
+    /// What makes a projected X liftable (empty: X needs no repair).
+    virtual RepairHook repair_hook(FeasibleRange range) const {
+        (void)range;
+        return {};
+    }
     /// State carried from sample to sample (a warm start), for checkpoints; empty if none.
     virtual std::vector<double> saved_state() const { return {}; }
     virtual void restore_state(const std::vector<double>& state) { (void)state; }
@@ -47,10 +65,14 @@ class IcdfObservable final : public EnsembleObservable {
 public:
     explicit IcdfObservable(Eigen::Index m) : m_(m) {}
     std::string_view name() const override { return "icdf"; }
+    std::string_view label() const override { return "full ICDF"; }
     Eigen::Index dimension() const override { return m_; }
     bool needs_top_half() const override { return false; }
     Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) override;
     Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const override;
+    /// Projected ICDFs are made non-decreasing and clipped into the feasible range before
+    /// lifting (physics.md §9 step 1; coarse/demixing/monotone_repair.hpp).
+    RepairHook repair_hook(FeasibleRange range) const override;
 
 private:
     Eigen::Index m_;

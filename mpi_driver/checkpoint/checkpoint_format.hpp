@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "coarse/equation_free/projective_run.hpp"
 #include "core/rng.hpp"
 
 namespace efdem::mpi_driver {
@@ -42,13 +43,9 @@ struct StepperState {
     std::vector<double> recorded;              ///< warm start of the recorded-only observable
 };
 
-/// The run loop's state (driver.cpp).
-struct DriverState {
-    double t_origin = std::numeric_limits<double>::quiet_NaN();  ///< time the run started at
-    long coarse_steps = 0;
-    long without_progress = 0;
-    bool fell_back = false;  ///< the compact observable failed; the run continues on the ICDF
-};
+/// The run loop's state: coarse::ProjectiveRunState (t_origin, coarse_steps, without_progress,
+/// fell_back); a direct run uses t_origin only.
+using DriverState = coarse::ProjectiveRunState;
 
 /// One of the run's output files, saved whole.
 struct OutputBlob {

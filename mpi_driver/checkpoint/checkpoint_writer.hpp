@@ -21,7 +21,7 @@
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/checkpoint/realization_state.hpp"
-#include "mpi_driver/run/run_settings.hpp"
+#include "mpi_driver/checkpoint/checkpoint_settings.hpp"
 
 namespace efdem::mpi_driver {
 

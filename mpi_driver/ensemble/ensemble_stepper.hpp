@@ -28,17 +28,12 @@
 #include "core/rng.hpp"
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/ensemble/injected_failure.hpp"
 #include "mpi_driver/output/progress.hpp"
 #include "mpi_driver/ensemble/realization.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
 
 namespace efdem::mpi_driver {
-
-/// A test-only fault: realization `realization` fails at the first sample at or after `time`.
-struct InjectedFailure {
-    long realization = -1;
-    double time = 0;
-};
 
 struct StepperSettings {
     double sample_interval = 0.5;     ///< time between samples [sqrt(d_p/g)]
@@ -93,6 +88,7 @@ public:
     void set_observable(coarse::EnsembleObservable& observable) { observable_ = &observable; }
     /// Root: the coarse observable in use (its status_message() says why a sample failed).
     const coarse::EnsembleObservable& observable() const { return *observable_; }
+    coarse::EnsembleObservable& observable() { return *observable_; }
     /// Root: whether samples need the top-half ICDF (for the integrator's or the recorded
     /// observable).
     bool needs_top_half() const;

@@ -17,7 +17,9 @@ std::FILE* open_or_fail(const std::filesystem::path& p, bool append = false) {
 
 CsvRecorder::CsvRecorder(const std::filesystem::path& dir, const std::string& prefix,
                          const RunProvenance& prov, bool resume)
-    : steps_path_(dir / (prefix + "_cpi_steps.csv")), icdf_(open_or_fail(dir / (prefix + "_mean_icdf.csv"), resume)) {
+    : icdf_path_(dir / (prefix + "_mean_icdf.csv")),
+      steps_path_(dir / (prefix + "_cpi_steps.csv")),
+      icdf_(open_or_fail(icdf_path_, resume)) {
     if (resume) {
         if (prov.mode == "cpi") steps_ = open_or_fail(steps_path_, true);
         return;
@@ -65,6 +67,11 @@ void CsvRecorder::finish(const RunSummary& s) {
     fmt::print(icdf_, "# end: {}; simulated time {:.6g}, DEM time {:.6g}, wall {:.3f} s, {:.4e} particle-steps\n",
                s.end_status, s.simulated_time, s.dem_time, s.wall_seconds, s.particle_steps);
     std::fflush(icdf_);
+}
+
+std::vector<std::filesystem::path> CsvRecorder::files() const {
+    if (!steps_) return {icdf_path_};
+    return {icdf_path_, steps_path_};
 }
 
 }  // namespace efdem::mpi_driver

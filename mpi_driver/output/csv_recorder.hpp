@@ -22,8 +22,11 @@ public:
     void sample(const SampleRecord& s) override;
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;
+    /// `<prefix>_mean_icdf.csv`, and `<prefix>_cpi_steps.csv` in cpi mode.
+    std::vector<std::filesystem::path> files() const override;
 
 private:
+    std::filesystem::path icdf_path_;
     std::filesystem::path steps_path_;
     std::FILE* icdf_ = nullptr;
     std::FILE* steps_ = nullptr;

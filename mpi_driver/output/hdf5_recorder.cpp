@@ -20,9 +20,11 @@ std::string now_utc() {
 std::span<const double> as_span(const Eigen::VectorXd& v) { return {v.data(), static_cast<std::size_t>(v.size())}; }
 }  // namespace
 
-Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& file, const RunProvenance& p,
-                           Eigen::Index coarse_dimension, bool resume)
-    : file_(resume ? H5File::open(file, true) : H5File::create(file)), realizations_(p.realizations),
+Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::string& prefix,
+                           const RunProvenance& p, Eigen::Index coarse_dimension, bool resume)
+    : path_(directory / (prefix + ".h5")),
+      file_(resume ? H5File::open(path_, true) : H5File::create(path_)),
+      realizations_(p.realizations),
       m_(p.p_grid.size()), dim_(coarse_dimension) {
     if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
         file_.attribute("/", "ranks", std::int64_t{p.ranks});

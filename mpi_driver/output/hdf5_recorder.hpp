@@ -32,16 +32,19 @@ inline constexpr std::int64_t kRunFileFormatVersion = 1;
 
 class Hdf5Recorder final : public RunRecorder {
 public:
-    /// `resume`: continue the existing file (put back by a restart) instead of creating one.
-    Hdf5Recorder(const std::filesystem::path& file, const RunProvenance& provenance,
-                 Eigen::Index coarse_dimension, bool resume = false);
+    /// Writes `<directory>/<prefix>.h5`. `resume`: continue the existing file (put back by a
+    /// restart) instead of creating one.
+    Hdf5Recorder(const std::filesystem::path& directory, const std::string& prefix,
+                 const RunProvenance& provenance, Eigen::Index coarse_dimension, bool resume = false);
     void sample(const SampleRecord& s) override;
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;
+    std::vector<std::filesystem::path> files() const override { return {path_}; }
 
 private:
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
 
+    std::filesystem::path path_;
     H5File file_;
     int realizations_;
     Eigen::Index m_;

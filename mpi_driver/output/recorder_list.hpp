@@ -22,6 +22,12 @@ public:
     void finish(const RunSummary& summary) override {
         for (auto& r : recorders_) r->finish(summary);
     }
+    std::vector<std::filesystem::path> files() const override {
+        std::vector<std::filesystem::path> out;
+        for (const auto& r : recorders_)
+            for (auto& f : r->files()) out.push_back(std::move(f));
+        return out;
+    }
 
 private:
     std::vector<std::unique_ptr<RunRecorder>> recorders_;

@@ -4,6 +4,7 @@
 /// calls; HDF5 (one file per run, the complete record) and CSV (the mean ICDF and the coarse
 /// steps, for quick scripting) implement it.
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,6 +52,8 @@ public:
     virtual void sample(const SampleRecord& s) = 0;
     virtual void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) = 0;
     virtual void finish(const RunSummary& summary) = 0;
+    /// The files this recorder writes (a checkpoint stores them whole, a restart puts them back).
+    virtual std::vector<std::filesystem::path> files() const = 0;
 };
 
 /// Provenance stored with every run.

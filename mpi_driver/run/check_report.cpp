@@ -18,7 +18,7 @@ std::string check_report(const ParamTable& table, const RunSettings& settings,
     auto line = [&out](const std::string& s) { out += s + "\n"; };
     line(fmt::format("efdem {} ({}) --check {}", version(), git_hash(), table.file()));
     line(fmt::format("mode: {}; ensemble: R = {} ranks x {} per rank = {} realizations; seed {}",
-                     settings.mode == RunSettings::Mode::cpi ? "cpi" : "direct", n_ranks,
+                     settings.mode_name(), n_ranks,
                      settings.realizations_per_rank, n_ranks * settings.realizations_per_rank,
                      settings.seed));
     const auto& p = sys.particles();

@@ -1,10 +1,11 @@
 #pragma once
 /// \file
-/// The two run loops, executed by the root (the other ranks serve the EnsembleStepper):
+/// The two run modes, executed by the root (the other ranks serve the EnsembleStepper):
 ///
 /// * direct: every realization runs the DEM for run.duration; samples are recorded as they come;
-/// * cpi: repeat { burst -> slope -> projective forward Euler jump -> lift } until run.duration
-///   is reached (DT fixed, or DT = k T with travelling waves).
+/// * cpi: the coarse run loop coarse::ProjectiveRun (warm-up, bursts, jumps, lifts, end-of-run
+///   rule, stop conditions, observable fallback) on the EnsembleStepper, with the observers that
+///   record each step, print progress and write checkpoints plugged in.
 ///
 /// Both end with EnsembleStepper::finish() so that the other ranks leave serve(). Both write a
 /// checkpoint every RunControl::checkpoint_interval coarse steps / samples (a whole-ensemble
@@ -34,15 +35,10 @@ struct RunControl {
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Progress& progress,
                       const RunControl& control = {});
 
-/// DEM time a CPI run still needs from t_now to t_end with bursts of `burst` (> 0) and jumps
-/// of `dt`, shortened at the end as the integrators do (coarse::end_of_run_jump_limit):
-/// the work the progress line's estimate of the time left is based on.
-double planned_dem_time(double t_now, double t_end, double burst, double dt);
-
-/// `fallback`: the ICDF observable the run switches to when the compact observable fails
-/// (y(p) identically zero, or a fit that does not converge); ignored with cpi.observable = icdf.
+/// The stepper restricts to its observable (the coarse variable); `fallback`: the observable the
+/// run switches to when that one fails (null: none, e.g. when it is the ICDF already).
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& settings,
-                   coarse::EnsembleObservable& fallback, RunRecorder* recorder, Progress& progress,
+                   coarse::EnsembleObservable* fallback, RunRecorder* recorder, Progress& progress,
                    const RunControl& control = {});
 
 }  // namespace efdem::mpi_driver

@@ -1,19 +1,11 @@
 #include "mpi_driver/run/run_settings.hpp"
 
-#include <cmath>
-
 #include <fmt/format.h>
 
-namespace efdem::mpi_driver {
+#include "coarse/demixing/observable_table.hpp"
+#include "core/whole_multiple.hpp"
 
-long whole_multiple(const Params& scope, const char* key, double duration, double dt,
-                    const std::string& dt_name) {
-    const double n = std::round(duration / dt);
-    if (std::abs(n * dt - duration) > 1e-9 * std::max(duration, dt))
-        scope.fail(key, fmt::format("is not a whole multiple of {} = {:g}", dt_name, dt),
-                   fmt::format("a multiple of {:g}, e.g. {:g}", dt, std::max(1.0, n) * dt));
-    return static_cast<long>(n);
-}
+namespace efdem::mpi_driver {
 
 RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& scene) {
     RunSettings s;
@@ -40,32 +32,10 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // The cpi block is read and checked in both modes: a direct run of a cpi scene is the
     // reference that the cpi run is compared with (and its cpi.* keys are not "unused").
     const Params cpi = root.scope("cpi");
-    s.cpi.observable = cpi.get_or_choice("observable", "icdf", {"icdf", "compact"}) == "compact"
-                           ? CpiSettings::Observable::compact
-                           : CpiSettings::Observable::icdf;
-    s.cpi.projection = cpi.get_or_choice("projection", "fixed", {"fixed", "periods"}) == "periods"
-                           ? CpiSettings::Projection::periods
-                           : CpiSettings::Projection::fixed;
-    s.cpi.warmup = cpi.get_or<double>("warmup", 0.0, Bounds::non_negative());
-    whole_multiple(cpi, "warmup", s.cpi.warmup, s.observe.interval, "observe.interval");
-    s.cpi.healing = cpi.get_or<double>("healing", 10.0, Bounds::non_negative());
-    whole_multiple(cpi, "healing", s.cpi.healing, s.observe.interval, "observe.interval");
-    s.cpi.window = cpi.get_or<double>("window", 10.0, Bounds::positive());
-    const long window_samples = whole_multiple(cpi, "window", s.cpi.window, s.observe.interval, "observe.interval");
-    if (window_samples < 3)
-        cpi.fail("window", fmt::format("holds {} samples; a slope needs at least 3", window_samples),
-                 fmt::format(">= 3 x observe.interval = {:g}", 3 * s.observe.interval));
-    // Both projections' keys are read, so switching cpi.projection on the command line works
-    // on a scene written for the other one.
-    s.cpi.dt = cpi.get_or<double>("dt", 80.0, Bounds::non_negative());
-    s.cpi.periods = cpi.get_or<int>("periods", 2, Bounds::closed(0, 1000));
-    s.cpi.max_extension = cpi.get_or<double>("max_extension", 30.0, Bounds::non_negative());
-    whole_multiple(cpi, "max_extension", s.cpi.max_extension, s.observe.interval, "observe.interval");
-    const std::string policy = cpi.get_or_choice("stability", "warn", {"warn", "halve", "stop"});
-    s.cpi.stability = policy == "halve"  ? coarse::StabilityPolicy::halve_step
-                      : policy == "stop" ? coarse::StabilityPolicy::stop
-                                         : coarse::StabilityPolicy::warn;
-    if (s.mode == Mode::cpi) {
+    const auto observables = coarse::observable_table().names();
+    s.observable = cpi.get_or_choice("observable", observables.front(), observables);
+    s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval);
+    if (s.is_cpi()) {
         if (scene.species.size() != 2)
             root.fail("mode", fmt::format("cpi lifts by swapping the labels of two species, but "
                                           "species.names lists {}", scene.species.size()),
@@ -89,14 +59,10 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     if (s.output.thermo_interval > 0)
         whole_multiple(output, "thermo_interval", s.output.thermo_interval, s.observe.interval, "observe.interval");
 
-    // Read in every run (get_or), so that a scene with a checkpoint block is valid whether or
-    // not it checkpoints, and a restart may change these keys freely.
-    const Params checkpoint = root.scope("checkpoint");
-    s.checkpoint.interval = checkpoint.get_or<long>("interval", 0, Bounds::closed(0, 1000000000));
-    s.checkpoint.keep = checkpoint.get_or<int>("keep", 2, Bounds::closed(1, 1000));
-    s.checkpoint.directory = checkpoint.get_or_path("directory", s.output.directory);
-    s.checkpoint.allow_physics_change = root.scope("restart").get_or<bool>("allow_physics_change", false);
-    s.checkpoint.debug_delay = root.scope("debug").get_or<double>("checkpoint_delay", 0.0, Bounds::closed(0, 3600));
+    s.checkpoint = CheckpointSettings::from_params(root, s.output.directory);
+    const Params debug = root.scope("debug");
+    s.injected_failure.realization = debug.get_or<long>("fail_realization", -1);
+    s.injected_failure.time = debug.get_or<double>("fail_time", 0.0);
     return s;
 }
 

@@ -1,8 +1,12 @@
 #pragma once
 /// \file
 /// RunSettings: the run-level keys of a scene (everything that is not one realization's DEM).
-/// Times are in sqrt(d_p/g); every time is checked against the time step it must be a multiple
-/// of, so that samples fall exactly on DEM steps.
+/// Each room reads its own keys and RunSettings gathers them: the coarse layer its cpi.* keys
+/// (coarse/equation_free/coarse_run_settings.hpp; cpi.observable from the table of
+/// coarse/demixing/observable_table.hpp), the checkpoint room checkpoint.* and restart.*
+/// (mpi_driver/checkpoint/checkpoint_settings.hpp). Times are in sqrt(d_p/g); every time is
+/// checked against the time step it must be a multiple of, so that samples fall exactly on
+/// DEM steps.
 ///
 /// | key                            | meaning                                             | default |
 /// |--------------------------------|-----------------------------------------------------|---------|
@@ -15,36 +19,27 @@
 /// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19      |
 /// | observe.compact                | also record (A,B,C,D) of y = Q_top - Q_L at every   | false   |
 /// |                                | sample (a direct reference for a compact CPI run)   |         |
-/// | cpi.observable                 | `icdf` (the ICDF nodes) or `compact` ((A,B,C,D))    | icdf    |
-/// | cpi.projection                 | `fixed` (DT = cpi.dt) or `periods` (DT = k T)       | fixed   |
-/// | cpi.warmup                     | direct simulation before the first coarse step (the | 0       |
-/// |                                | packed start is not on the slow manifold)           |         |
-/// | cpi.healing                    | start of each burst left out of the slope           | 10      |
-/// | cpi.window                     | estimation window after healing                     | 10      |
-/// | cpi.dt                         | projective step DT (projection = fixed)             | 80      |
-/// | cpi.periods                    | k in DT = k T (projection = periods)                | 2       |
-/// | cpi.max_extension              | most a burst may be lengthened to see 2 periods     | 30      |
-/// | cpi.stability                  | `warn`, `halve` or `stop` when DT is flagged        | warn    |
+/// | cpi.observable                 | the coarse variable: `icdf` (the ICDF nodes) or     | icdf    |
+/// |                                | `compact` ((A,B,C,D)); coarse/demixing/observable_table |     |
+/// | cpi.*                          | the coarse run loop: coarse_run_settings.hpp        |         |
 /// | output.directory               | where the run writes (relative: to the scene's      | .       |
 /// |                                | folder; on the command line: to the working dir)    |         |
 /// | output.prefix                  | file stem of the run's files                        | efdem   |
 /// | output.vtk_interval            | time between VTK snapshots per realization (0: none)| 0       |
 /// | output.thermo_interval         | time between thermo lines per realization (0: none) | 0       |
-/// | checkpoint.interval            | checkpoint every N coarse steps (cpi) or N samples  | 0 (off) |
-/// |                                | (direct: N x observe.interval of DEM time)          |         |
-/// | checkpoint.keep                | K: how many of the newest checkpoints are kept      | 2       |
-/// | checkpoint.directory           | where checkpoints are written                       | output.directory |
-/// | restart.allow_physics_change   | accept a restart whose scene changes physics keys   | false   |
-/// | debug.checkpoint_delay         | test only: seconds to sleep inside every checkpoint | 0       |
-/// |                                | write (between the collective part and the marker)  |         |
+/// | checkpoint.*, restart.*        | checkpoint/checkpoint_settings.hpp                  |         |
+/// | debug.fail_realization         | test only: this realization fails ...               | -1      |
+/// | debug.fail_time                | ... at the first sample at or after this time       | 0       |
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
 
-#include "coarse/equation_free/stability_monitor.hpp"
+#include "coarse/equation_free/coarse_run_settings.hpp"
 #include "core/param_table.hpp"
 #include "dem/scene.hpp"
+#include "mpi_driver/checkpoint/checkpoint_settings.hpp"
+#include "mpi_driver/ensemble/injected_failure.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -57,33 +52,11 @@ struct ObserveSettings {
     dem::SpeciesId other = 1;    ///< the other species (colour 0), binary mixtures
 };
 
-struct CpiSettings {
-    enum class Observable { icdf, compact } observable = Observable::icdf;
-    enum class Projection { fixed, periods } projection = Projection::fixed;
-    double warmup = 0.0;
-    double healing = 10.0;
-    double window = 10.0;
-    double dt = 80.0;
-    int periods = 2;
-    double max_extension = 30.0;
-    coarse::StabilityPolicy stability = coarse::StabilityPolicy::warn;
-};
-
 struct OutputSettings {
     std::filesystem::path directory = ".";
     std::string prefix = "efdem";
     double vtk_interval = 0;
     double thermo_interval = 0;
-};
-
-/// Whole-ensemble checkpoints (mpi_driver/checkpoint/checkpoint_writer.hpp). interval = 0: none.
-struct CheckpointSettings {
-    long interval = 0;            ///< coarse steps (cpi) or samples (direct) between checkpoints
-    int keep = 2;                 ///< newest checkpoints kept on disk
-    std::filesystem::path directory;
-    bool allow_physics_change = false;  ///< restart.allow_physics_change
-    double debug_delay = 0;       ///< seconds slept inside each write (kill tests)
-    bool enabled() const { return interval > 0; }
 };
 
 struct RunSettings {
@@ -92,17 +65,21 @@ struct RunSettings {
     int realizations_per_rank = 1;
     double duration = 0;
     ObserveSettings observe;
-    CpiSettings cpi;
+    /// cpi.observable: a row of coarse::observable_table().
+    std::string observable = "icdf";
+    /// The other cpi.* keys, read by the coarse layer.
+    coarse::CoarseRunSettings cpi;
     OutputSettings output;
     CheckpointSettings checkpoint;
+    /// debug.fail_*: a test-only injected failure.
+    InjectedFailure injected_failure;
+
+    bool is_cpi() const { return mode == Mode::cpi; }
+    /// "cpi" or "direct".
+    const char* mode_name() const { return is_cpi() ? "cpi" : "direct"; }
 
     /// Reads and cross-checks the run keys (dt and species come from the DEM scene).
     static RunSettings from_params(const Params& root, const dem::DemScene& scene);
 };
-
-/// The number of steps of size `dt` in `duration`, or an InputError on `key` if `duration` is
-/// not a whole multiple of `dt` (to 1e-9 relative).
-long whole_multiple(const Params& scope, const char* key, double duration, double dt,
-                    const std::string& dt_name);
 
 }  // namespace efdem::mpi_driver

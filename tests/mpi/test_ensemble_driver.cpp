@@ -179,16 +179,3 @@ TEST_CASE("CPI of a linear toy model through EnsembleStepper equals the serial i
     const double exact = 1.15 * std::exp(-0.1 * last.t.back());
     CHECK(last.x.back()[0] == Approx(exact).epsilon(0.15));
 }
-
-TEST_CASE("the planned DEM time of a CPI run follows the shortened last jumps", "[mpi][driver]") {
-    using efdem::mpi_driver::planned_dem_time;
-    // Bursts of 20, DT 80 (the cases of the integrator's end-time test): from 10 to 200 two
-    // bursts (jumps 80, 70); to 225 three (80, 75, burst only); to 210 two (80, 80). DT = 0 is
-    // a direct run in bursts: all of the time left. Less than a burst left: nothing. Sums of
-    // a few multiples of 20: exact to 1e-9.
-    CHECK(planned_dem_time(10, 200, 20, 80) == Approx(40).margin(1e-9));
-    CHECK(planned_dem_time(10, 225, 20, 80) == Approx(60).margin(1e-9));
-    CHECK(planned_dem_time(10, 210, 20, 80) == Approx(40).margin(1e-9));
-    CHECK(planned_dem_time(0, 100, 20, 0) == Approx(100).margin(1e-9));
-    CHECK(planned_dem_time(190, 200, 20, 80) == 0.0);
-}

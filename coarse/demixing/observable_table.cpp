@@ -1,0 +1,31 @@
+#include "coarse/demixing/observable_table.hpp"
+
+#include <memory>
+
+#include "coarse/demixing/compact_observable.hpp"
+
+namespace efdem::coarse {
+
+namespace {
+std::unique_ptr<EnsembleObservable> make_icdf(const ProbabilityGrid& grid) {
+    return std::make_unique<IcdfObservable>(grid.size());
+}
+std::unique_ptr<EnsembleObservable> make_compact(const ProbabilityGrid& grid) {
+    return std::make_unique<CompactObservable>(grid);
+}
+
+// THE table of coarse observables. One row each: name (as written in `cpi.observable = ...`),
+// factory, one-line summary.
+const ObservableTable::Entry kObservables[] = {
+    {"icdf", &make_icdf, "the ensemble-mean ICDF of the observed species on the p-grid (m nodes)"},
+    {"compact", &make_compact,
+     "(A, B, C, D) of y = Q_top - Q_L ~ max[A p + B + C e^(D p), 0] (paper Eq. 3), fitted per sample"},
+};
+}  // namespace
+
+const ObservableTable& observable_table() {
+    static const ObservableTable table{kObservables};
+    return table;
+}
+
+}  // namespace efdem::coarse

@@ -1,0 +1,52 @@
+#pragma once
+/// \file
+/// CoarseRunSettings: the scene's `cpi.*` keys that the coarse run loop (projective_run.hpp)
+/// and its integrator read, filled straight into the integrators' own settings (no copy of
+/// them is kept anywhere else). `cpi.observable` names the coarse variable and is read by the
+/// demixing room (coarse/demixing/observable_table.hpp). Times in sqrt(d_p/g).
+///
+/// | key               | meaning                                                       | default |
+/// |-------------------|---------------------------------------------------------------|---------|
+/// | cpi.projection    | `fixed` (DT = cpi.dt) or `periods` (DT = k T)                 | fixed   |
+/// | cpi.warmup        | direct simulation before the first coarse step                | 0       |
+/// | cpi.healing       | start of each burst left out of the slope                     | 10      |
+/// | cpi.window        | estimation window after healing (>= 3 samples)                | 10      |
+/// | cpi.dt            | projective step DT (projection = fixed)                       | 80      |
+/// | cpi.periods       | k in DT = k T (projection = periods)                          | 2       |
+/// | cpi.max_extension | most a burst may be lengthened to see 2 periods               | 30      |
+/// | cpi.stability     | `warn`, `halve` or `stop` when DT is flagged                  | warn    |
+///
+/// warmup, healing, window and max_extension must be whole multiples of the sampling interval.
+
+#include <memory>
+
+#include "coarse/equation_free/period_projective_euler.hpp"
+#include "coarse/equation_free/projective_forward_euler.hpp"
+#include "coarse/equation_free/projective_integrator.hpp"
+#include "core/param_table.hpp"
+
+namespace efdem::coarse {
+
+struct CoarseRunSettings {
+    enum class Projection { fixed, periods } projection = Projection::fixed;
+    /// Direct simulation before the first coarse step (the packed start is not on the slow
+    /// manifold).
+    double warmup = 0.0;
+    /// Projection = fixed: healing, window, DT, stability policy.
+    ProjectiveEulerSettings fixed;
+    /// Projection = periods: healing, window, k, burst extension, stability policy.
+    PeriodProjectiveEulerSettings periods;
+
+    /// Reads the keys above from the `cpi` scope (in the order of the table). Both
+    /// projections' keys are read, so that switching cpi.projection on the command line works on
+    /// a scene written for the other one. `sample_interval`: the stepper's sampling interval,
+    /// which the times must be whole multiples of (its key is `observe.interval`).
+    static CoarseRunSettings from_params(const Params& cpi, double sample_interval);
+
+    /// healing + window of the selected projection: the length of an unextended burst.
+    double burst() const;
+    /// The integrator these settings select, with `repair` applied to every projected vector.
+    std::unique_ptr<ProjectiveIntegrator> make_integrator(RepairHook repair) const;
+};
+
+}  // namespace efdem::coarse

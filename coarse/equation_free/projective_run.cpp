@@ -1,0 +1,105 @@
+#include "coarse/equation_free/projective_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "coarse/equation_free/slope_estimators.hpp"
+#include "core/contracts.hpp"
+#include "core/log.hpp"
+
+namespace efdem::coarse {
+
+ProjectiveRun::ProjectiveRun(const CoarseRunSettings& settings, CoarseStepper& stepper, CoarseVariable primary,
+                             std::optional<CoarseVariable> fallback)
+    : settings_(settings), stepper_(stepper), primary_(std::move(primary)), fallback_(std::move(fallback)) {
+    EFDEM_EXPECTS(settings_.burst() > 0.0);
+}
+
+void ProjectiveRun::use(const CoarseVariable& variable) {
+    if (variable.select) variable.select();
+    integrator_ = settings_.make_integrator(variable.repair);
+    integrator_->set_end_time(t_end_);
+}
+
+double ProjectiveRun::planned_micro_time(double dt) const {
+    return coarse::planned_micro_time(stepper_.time(), t_end_, settings_.burst(), dt);
+}
+
+ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<ProjectiveRunState>& resume) {
+    state_ = resume.value_or(ProjectiveRunState{stepper_.time()});
+    t_end_ = state_.t_origin + duration;
+    const double tol = time_tolerance(t_end_);
+    const double burst = settings_.burst();
+    // From here on the fallback is the coarse variable when the primary one failed, now or
+    // before the checkpoint this run resumed from.
+    use(state_.fell_back && fallback_ ? *fallback_ : primary_);
+    ProjectiveRunOutcome out;
+    out.end_status = "completed";
+    if (settings_.warmup > 0 && !resume) {
+        // The initial state (a packed bed at rest) is far from the slow manifold: run it
+        // directly until the fast transients are gone before the first projection.
+        BurstSamples warmup;
+        stepper_.run(std::min(settings_.warmup, duration), warmup);
+        log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step", settings_.warmup);
+        for (auto* o : observers_) o->warmup_done(*this);
+    }
+    while (stepper_.time() < t_end_ - tol) {
+        for (auto* o : observers_) o->between_steps(*this);
+        // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
+        // plus one burst (or one whose period bursts were extended) can be left with less.
+        if (t_end_ - stepper_.time() < burst - tol) {
+            log::info("stopping at t = {:.6g}: the {:.4g} time units left are less than one "
+                      "burst ({:.4g})", stepper_.time(), t_end_ - stepper_.time(), burst);
+            break;
+        }
+        const ProjectiveStepRecord rec = integrator_->step(stepper_);
+        ++state_.coarse_steps;
+        for (auto* o : observers_) o->step_done(*this, rec);
+        if (rec.advanced()) {
+            state_.without_progress = 0;
+            continue;
+        }
+        if (fallback_ && !state_.fell_back && rec.status == StepStatus::invalid_burst) {
+            // The primary variable could not be formed (e.g. the compact fit failed): continue
+            // with the fallback, which is always defined.
+            std::string why = primary_.failure ? primary_.failure() : std::string{};
+            if (why.empty()) why = "its restriction failed";
+            log::warn("the {} observable failed at t = {:.6g}: {} ({}); continuing with the {} as the "
+                      "coarse variable", primary_.description, stepper_.time(), why, rec.message,
+                      fallback_->description);
+            state_.fell_back = true;
+            use(*fallback_);
+            continue;
+        }
+        if (rec.status == StepStatus::stopped_unstable || ++state_.without_progress >= kMaxStepsWithoutProgress) {
+            out.end_status = fmt::format("stopped at t = {:.6g}: {} ({})", stepper_.time(), to_string(rec.status),
+                                         rec.message);
+            log::warn("cpi run {}", out.end_status);
+            break;
+        }
+    }
+    out.coarse_steps = state_.coarse_steps;
+    out.simulated_time = stepper_.time() - state_.t_origin;
+    out.fell_back = state_.fell_back;
+    if (out.fell_back && out.end_status == "completed")
+        out.end_status = fmt::format("completed ({} observable fell back to {})", primary_.name,
+                                     fallback_ ? fallback_->name : std::string{"?"});
+    return out;
+}
+
+double planned_micro_time(double t_now, double t_end, double burst, double dt) {
+    EFDEM_EXPECTS(burst > 0.0);
+    const double tol = time_tolerance(t_end);
+    double micro = 0.0;
+    for (double t = t_now; t_end - t >= burst - tol;) {
+        t += burst;
+        micro += burst;
+        t += std::min(dt, end_of_run_jump_limit(t, t_end, dt, burst));
+    }
+    return micro;
+}
+
+}  // namespace efdem::coarse

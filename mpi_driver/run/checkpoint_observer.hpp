@@ -1,0 +1,26 @@
+#pragma once
+/// \file
+/// CheckpointObserver: the checkpoint cadence of a cpi run: a whole-ensemble checkpoint every
+/// `interval` coarse steps, written between two steps (nothing of a burst is pending there),
+/// with the run loop's state so that a restart continues the run exactly.
+
+#include "coarse/equation_free/projective_run.hpp"
+#include "mpi_driver/ensemble/ensemble_stepper.hpp"
+
+namespace efdem::mpi_driver {
+
+class CheckpointObserver final : public coarse::ProjectiveRunObserver {
+public:
+    /// `interval` > 0 coarse steps; `last`: the coarse step the newest checkpoint was written
+    /// after (that of the checkpoint a restarted run resumed from, so it is not written again).
+    CheckpointObserver(EnsembleStepper& stepper, long interval, long last)
+        : stepper_(stepper), interval_(interval), last_(last) {}
+    void between_steps(const coarse::ProjectiveRun& run) override;
+
+private:
+    EnsembleStepper& stepper_;
+    long interval_;
+    long last_;
+};
+
+}  // namespace efdem::mpi_driver

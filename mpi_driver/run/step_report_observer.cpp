@@ -1,0 +1,29 @@
+#include "mpi_driver/run/step_report_observer.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/log.hpp"
+
+namespace efdem::mpi_driver {
+
+std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const LiftRecord& lift) {
+    long changed = 0;
+    for (long c : lift.changed) changed += c;
+    std::string s = fmt::format("coarse step {}: burst {:.4g}..{:.4g}", n, r.t_start, r.t_start + r.burst_length);
+    if (std::isfinite(r.period)) s += fmt::format(", period T = {:.4g}", r.period);
+    s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
+    if (r.lifted) s += fmt::format(", {} labels changed", changed);
+    if (r.repair.changed()) s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
+    if (!r.message.empty()) s += " [" + r.message + "]";
+    return s;
+}
+
+void StepReportObserver::step_done(const coarse::ProjectiveRun& run, const coarse::ProjectiveStepRecord& rec) {
+    const LiftRecord lift = rec.lifted ? stepper_.last_lift() : LiftRecord{};
+    if (recorder_) recorder_->coarse_step(rec, lift);
+    log::info("{}", describe_step(run.state().coarse_steps, rec, lift));
+}
+
+}  // namespace efdem::mpi_driver

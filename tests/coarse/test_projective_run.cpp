@@ -1,0 +1,260 @@
+// The coarse run loop (coarse/equation_free/projective_run.hpp) on toy steppers, without MPI or
+// DEM: the end-of-run rule, the observable fallback, the no-progress and instability stops,
+// the observers' calls, and a resumed run that continues the uninterrupted one bit for bit.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/coarse_run_settings.hpp"
+#include "coarse/equation_free/projective_run.hpp"
+#include "core/param_table.hpp"
+#include "tests/coarse/toy_steppers.hpp"
+#include "tests/support/input_error.hpp"
+
+using namespace efdem;
+using namespace efdem::coarse;
+
+namespace {
+constexpr double kH = 0.1;  // sampling interval of the toys
+
+/// Two slow decaying modes (P = I + h A + (h A)^2/2): DT = 8 is well inside the stable range.
+test::LinearToyStepper slow_toy() {
+    Eigen::MatrixXd a(2, 2);
+    a << -0.05, 0.01, 0.0, -0.02;
+    const Eigen::MatrixXd p = (Eigen::MatrixXd::Identity(2, 2) + kH * a + 0.5 * kH * kH * a * a);
+    return test::LinearToyStepper(p, kH, Eigen::Vector2d(3.0, 1.0));
+}
+
+/// Bursts of 1 + 1, DT = 8: a cycle of 10 time units.
+CoarseRunSettings fixed_settings(double warmup = 0.0) {
+    CoarseRunSettings s;
+    s.warmup = warmup;
+    s.fixed.healing = 1.0;
+    s.fixed.window = 1.0;
+    s.fixed.dt = 8.0;
+    return s;
+}
+
+CoarseVariable variable(std::string name, int* repairs = nullptr) {
+    CoarseVariable v;
+    v.name = name;
+    v.description = name + " variable";
+    if (repairs)
+        v.repair = [repairs](Eigen::VectorXd&) {
+            ++*repairs;
+            return RepairReport{};
+        };
+    return v;
+}
+
+/// Counts the callbacks and keeps a copy of the stepper and loop state before step `at`.
+template <class Stepper>
+struct Recorder final : ProjectiveRunObserver {
+    const Stepper* stepper = nullptr;
+    long at = -1;
+    long first = 0;  ///< coarse steps done before this run (a resumed run)
+    int warmups = 0, betweens = 0, steps = 0;
+    std::optional<Stepper> snapshot;
+    std::optional<ProjectiveRunState> snapshot_state;
+    void warmup_done(const ProjectiveRun&) override { ++warmups; }
+    void between_steps(const ProjectiveRun& run) override {
+        ++betweens;
+        if (run.state().coarse_steps == at) {
+            snapshot.emplace(*stepper);
+            snapshot_state = run.state();
+        }
+    }
+    void step_done(const ProjectiveRun& run, const ProjectiveStepRecord&) override {
+        ++steps;
+        CHECK(run.state().coarse_steps == first + steps);
+    }
+};
+
+/// A linear toy whose primary restriction fails (NaN samples) from t_fail on; selecting the
+/// fallback variable switches to the exact samples. Copyable, like LinearToyStepper.
+class FailingPrimaryStepper final : public CoarseStepper {
+  public:
+    FailingPrimaryStepper(test::LinearToyStepper toy, double t_fail) : toy_(std::move(toy)), t_fail_(t_fail) {}
+    double time() const override { return toy_.time(); }
+    void run(double duration, BurstSamples& out) override {
+        const std::size_t first = out.size();
+        toy_.run(duration, out);
+        if (!use_primary) return;
+        for (std::size_t k = first; k < out.size(); ++k)
+            if (out.t[k] >= t_fail_) out.x[k].setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
+    void lift(const Eigen::VectorXd& target, double new_time) override { toy_.lift(target, new_time); }
+    const Eigen::VectorXd& state() const { return toy_.state(); }
+    bool use_primary = true;
+    int selects = 0;
+
+  private:
+    test::LinearToyStepper toy_;
+    double t_fail_;
+};
+}  // namespace
+
+TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the warm-up first", "[unit][coarse][run]") {
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
+    Recorder<test::LinearToyStepper> seen;
+    seen.stepper = &toy;
+    run.add_observer(seen);
+    // Warm-up to 2, nine cycles of 10 to 92, a burst to 94 and the jump shortened to 6: the
+    // run ends at 100 after 10 coarse steps. Sums of multiples of 0.1: exact to 1e-9.
+    const double planned = planned_micro_time(2.0, 100.0, 2.0, 8.0);
+    CHECK(planned == Approx(20.0).margin(1e-9));
+    const ProjectiveRunOutcome out = run.run(100.0);
+    CHECK(out.end_status == "completed");
+    CHECK(out.coarse_steps == 10);
+    CHECK(toy.time() == Approx(100.0).margin(1e-9));
+    CHECK(out.simulated_time == Approx(100.0).margin(1e-9));
+    CHECK_FALSE(out.fell_back);
+    CHECK(toy.lifts == 10);
+    CHECK(seen.warmups == 1);
+    CHECK(seen.betweens == 10);
+    CHECK(seen.steps == 10);
+    CHECK(run.end_time() == 100.0);
+}
+
+TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step", "[unit][coarse][run]") {
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(10.0), toy, variable("x"));
+    const ProjectiveRunOutcome out = run.run(11.0);  // 1 time unit left after warm-up < burst 2
+    CHECK(out.coarse_steps == 0);
+    CHECK(toy.time() == Approx(10.0).margin(1e-9));
+    CHECK(out.end_status == "completed");
+}
+
+TEST_CASE("the planned micro time of a run follows the shortened last jumps", "[unit][coarse][run]") {
+    // Bursts of 20, DT 80: from 10 to 200 two bursts (jumps 80, 70); to 225 three (80, 75,
+    // burst only); to 210 two (80, 80). DT = 0 is a direct run in bursts: all of the time left.
+    // Less than a burst left: nothing. Sums of a few multiples of 20: exact to 1e-9.
+    CHECK(planned_micro_time(10, 200, 20, 80) == Approx(40).margin(1e-9));
+    CHECK(planned_micro_time(10, 225, 20, 80) == Approx(60).margin(1e-9));
+    CHECK(planned_micro_time(10, 210, 20, 80) == Approx(40).margin(1e-9));
+    CHECK(planned_micro_time(0, 100, 20, 0) == Approx(100).margin(1e-9));
+    CHECK(planned_micro_time(190, 200, 20, 80) == 0.0);
+}
+
+TEST_CASE("a failing coarse variable falls back once and the run completes on the fallback", "[unit][coarse][run]") {
+    FailingPrimaryStepper stepper(slow_toy(), 25.0);
+    int primary_repairs = 0, fallback_repairs = 0;
+    CoarseVariable fallback = variable("b", &fallback_repairs);
+    fallback.select = [&stepper] {
+        stepper.use_primary = false;
+        ++stepper.selects;
+    };
+    CoarseVariable primary = variable("a", &primary_repairs);
+    primary.failure = [] { return std::string("the toy restriction failed"); };
+    ProjectiveRun run(fixed_settings(), stepper, primary, fallback);
+    Recorder<FailingPrimaryStepper> seen;
+    seen.stepper = &stepper;
+    seen.at = 5;
+    run.add_observer(seen);
+    const ProjectiveRunOutcome out = run.run(100.0);
+    // Cycles start at 0, 10, 20: the third burst (20..22) is clean, its jump lands at 30, so
+    // the fourth burst (30..32) is the first with NaN samples: rejected, no jump; the fallback
+    // takes over at t = 32 and the run still ends at 100.
+    CHECK(out.end_status == "completed (a observable fell back to b)");
+    CHECK(out.fell_back);
+    CHECK(stepper.selects == 1);
+    CHECK(primary_repairs == 3);
+    CHECK(fallback_repairs == out.coarse_steps - 4);
+    CHECK(stepper.time() == Approx(100.0).margin(1e-9));
+
+    SECTION("a resumed run continues on the fallback and ends in the same state, bit for bit") {
+        REQUIRE(seen.snapshot);
+        REQUIRE(seen.snapshot_state->fell_back);
+        FailingPrimaryStepper resumed_stepper = *seen.snapshot;
+        resumed_stepper.use_primary = true;  // a restarted process starts on the primary
+        CoarseVariable fb = fallback;
+        fb.select = [&resumed_stepper] {
+            resumed_stepper.use_primary = false;
+            ++resumed_stepper.selects;
+        };
+        ProjectiveRun again(fixed_settings(), resumed_stepper, primary, fb);
+        const ProjectiveRunOutcome out2 = again.run(100.0, seen.snapshot_state);
+        CHECK(out2.end_status == out.end_status);
+        CHECK(out2.coarse_steps == out.coarse_steps);
+        CHECK(resumed_stepper.time() == stepper.time());
+        CHECK(resumed_stepper.state() == stepper.state());
+    }
+}
+
+TEST_CASE("without a fallback, three steps without a jump stop the run", "[unit][coarse][run]") {
+    FailingPrimaryStepper stepper(slow_toy(), 25.0);
+    ProjectiveRun run(fixed_settings(), stepper, variable("a"));
+    const ProjectiveRunOutcome out = run.run(100.0);
+    // Three clean steps (to t = 30), then three rejected bursts (30..32, 32..34, 34..36).
+    CHECK(out.coarse_steps == 3 + kMaxStepsWithoutProgress);
+    CHECK_THAT(out.end_status, Catch::StartsWith("stopped at t = 36: invalid_burst"));
+    CHECK(stepper.time() == Approx(36.0).margin(1e-9));
+}
+
+TEST_CASE("StabilityPolicy::stop ends the run at the first flagged step", "[unit][coarse][run]") {
+    // A fast mode lambda = -2 seen in the window: |G| of forward Euler with DT = 8 is about
+    // |1 - 16| >> 1, so the monitor flags the first step and the stop policy takes no jump.
+    test::LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, std::exp(-2.0 * kH)), kH, Eigen::VectorXd::Constant(1, 5.0));
+    CoarseRunSettings s = fixed_settings();
+    s.fixed.healing = 0.0;
+    s.fixed.window = 2.0;
+    s.fixed.stability_policy = StabilityPolicy::stop;
+    ProjectiveRun run(s, toy, variable("x"));
+    const ProjectiveRunOutcome out = run.run(100.0);
+    CHECK(out.coarse_steps == 1);
+    CHECK_THAT(out.end_status, Catch::StartsWith("stopped at t = 2: stopped_unstable"));
+    CHECK(toy.lifts == 0);
+}
+
+TEST_CASE("a resumed run equals the uninterrupted one bit for bit", "[unit][coarse][run]") {
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
+    Recorder<test::LinearToyStepper> seen;
+    seen.stepper = &toy;
+    seen.at = 4;
+    run.add_observer(seen);
+    const ProjectiveRunOutcome whole = run.run(100.0);
+    REQUIRE(seen.snapshot);
+    CHECK(seen.snapshot_state->coarse_steps == 4);
+    CHECK(seen.snapshot_state->t_origin == 0.0);
+
+    test::LinearToyStepper copy = *seen.snapshot;
+    ProjectiveRun resumed(fixed_settings(2.0), copy, variable("x"));
+    Recorder<test::LinearToyStepper> seen2;
+    seen2.stepper = &copy;
+    seen2.first = 4;
+    resumed.add_observer(seen2);
+    const ProjectiveRunOutcome rest = resumed.run(100.0, seen.snapshot_state);
+    CHECK(seen2.warmups == 0);  // no second warm-up
+    CHECK(rest.coarse_steps == whole.coarse_steps);
+    CHECK(rest.end_status == whole.end_status);
+    CHECK(copy.time() == toy.time());
+    CHECK(copy.state() == toy.state());
+}
+
+TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings", "[unit][coarse][run]") {
+    ParamTable table = ParamTable::from_text(
+        "cpi.projection = periods\ncpi.healing = 4\ncpi.window = 6\ncpi.periods = 3\ncpi.stability = halve\n",
+        "scene.cfg", "/scenes");
+    const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.5);
+    CHECK(s.projection == CoarseRunSettings::Projection::periods);
+    CHECK(s.periods.healing == 4.0);
+    CHECK(s.periods.window == 6.0);
+    CHECK(s.periods.periods_per_step == 3);
+    CHECK(s.periods.extension_step == 5.0);  // 5 time units on the 0.5 sample grid
+    CHECK(s.fixed.dt == 80.0);               // read for both projections
+    CHECK(s.fixed.stability_policy == StabilityPolicy::halve_step);
+    CHECK(s.burst() == 10.0);
+    CHECK(s.make_integrator({})->name() == "period_projective_euler");
+
+    ParamTable bad = ParamTable::from_text("cpi.window = 1\n", "scene.cfg", "/scenes");
+    const std::string e = test::input_error([&] { CoarseRunSettings::from_params(bad.root().scope("cpi"), 0.5); }).what();
+    CHECK_THAT(e, Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.window") &&
+                      Catch::Contains("holds 2 samples; a slope needs at least 3"));
+}
