@@ -4,8 +4,16 @@
 #   core                 -> (nothing of efdem; no MPI, no HDF5)
 #   dem                  -> core                    (no MPI)
 #   coarse (generic)     -> core                    (no DEM, no MPI)
+#     equation_free/     -> no coarse/demixing/, coarse/dem_adapters/ (generic numerics)
+#     demixing/          -> no coarse/dem_adapters/
 #   coarse/dem_adapters  -> coarse, dem, core       (no MPI)
-#   mpi_driver           -> everything
+#   mpi_driver           -> everything, in rooms:
+#     output/            -> no ensemble/, checkpoint/, run/; no mpi.h (HDF5 brings it)
+#     ensemble/          -> no run/; of checkpoint/ only the format headers
+#                           (checkpoint_format.hpp, realization_state.hpp); no HDF5
+#     checkpoint/        -> no run/; its format files (checkpoint_format, realization_state,
+#                           checkpoint_settings) no HDF5, no MPI, no output/, ensemble/
+#     run/, main.cpp     -> no HDF5 header of their own (HDF5 only in output/, checkpoint/)
 #
 # and, between the rooms of dem/ (one target; dem/CMakeLists.txt):
 #
@@ -85,13 +93,28 @@ check_tree() {
     forbid_files dem '^dem/' 'dem/(effects/|contact/(pair|wall)_contact\.hpp|gas/gas_drag\.hpp)' \
         "effect headers are included by dem/effect_registry.cpp, dem/settling/ and dem/beds/bed_diagnostics.cpp only (effects are made by name)" \
         '^dem/(effect_registry\.cpp|beds/bed_diagnostics\.cpp)$|^dem/settling/'
+    # The rooms of coarse/ and mpi_driver/ (the table at the top).
+    forbid coarse/equation_free 'coarse/(demixing|dem_adapters)/' \
+        "coarse/demixing/ or coarse/dem_adapters/ (generic equation-free numerics know no demixing)"
+    forbid coarse/demixing 'coarse/dem_adapters/' "coarse/dem_adapters/"
+    forbid mpi_driver/output 'mpi_driver/(ensemble|checkpoint|run)/|mpi\.h' \
+        "mpi_driver/ensemble/, checkpoint/, run/ or MPI (recorders only record)"
+    forbid mpi_driver/ensemble 'mpi_driver/run/|mpi_driver/checkpoint/(checkpoint_writer|checkpoint_reader|checkpoint_settings|restart_check|restart_loader)|hdf5\.h|H5[A-Za-z_]*\.h' \
+        "mpi_driver/run/, HDF5 or the checkpoint I/O (only checkpoint_format.hpp and realization_state.hpp)"
+    forbid mpi_driver/checkpoint 'mpi_driver/run/' "mpi_driver/run/"
+    forbid_files mpi_driver '^mpi_driver/checkpoint/(checkpoint_format|realization_state|checkpoint_settings)\.' \
+        'hdf5\.h|H5[A-Za-z_]*\.h|mpi\.h|mpi_driver/(ensemble|output|run)/' \
+        "the checkpoint format files (checkpoint_format, realization_state, checkpoint_settings) are data only: no HDF5, MPI, ensemble/, output/ or run/"
+    forbid_files mpi_driver '^mpi_driver/(run/|main\.cpp$)' 'hdf5\.h|H5[A-Za-z_]*\.h' \
+        "mpi_driver/run/ and main.cpp include no HDF5 header (HDF5 only in output/ and checkpoint/)"
     return $status
 }
 
 if [ "${1:-}" = "--self-test" ]; then
     scratch=$(mktemp -d)
     trap 'rm -rf "$scratch"' EXIT
-    mkdir -p "$scratch"/{core,dem/{contact,gas,effects,beds,settling,io},coarse/dem_adapters,mpi_driver}
+    mkdir -p "$scratch"/{core,dem/{contact,gas,effects,beds,settling,io},coarse/{dem_adapters,equation_free,demixing}} \
+             "$scratch"/mpi_driver/{output,ensemble,checkpoint,run}
     echo '#include "core/vec3.hpp"' > "$scratch/dem/ok.cpp"
     # What the rooms of dem/ may include (the exceptions of the rules must not be flagged).
     printf '#include "dem/%s"\n' realization_builder.hpp settling/settling.hpp beds/bed_builder.hpp \
@@ -110,6 +133,14 @@ if [ "${1:-}" = "--self-test" ]; then
     printf '#include "dem/%s"\n' contact/contact_history.hpp gas/slab_fields.hpp > "$scratch/dem/system.hpp"
     echo '#include "dem/particles.hpp"' > "$scratch/coarse/dem_adapters/ok.cpp"
     echo '#include <mpi.h>' > "$scratch/mpi_driver/ok.cpp"
+    echo '#include "coarse/equation_free/coarse_stepper.hpp"' > "$scratch/coarse/demixing/ok.cpp"
+    printf '#include "%s"\n' mpi_driver/checkpoint/checkpoint_format.hpp mpi_driver/checkpoint/realization_state.hpp \
+        mpi_driver/output/run_recorder.hpp '<mpi.h>' > "$scratch/mpi_driver/ensemble/ok.cpp"
+    printf '#include %s\n' '<hdf5.h>' '"mpi_driver/ensemble/ensemble_layout.hpp"' '"mpi_driver/output/h5_file.hpp"' \
+        > "$scratch/mpi_driver/checkpoint/checkpoint_writer.cpp"
+    echo '#include <hdf5.h>' > "$scratch/mpi_driver/output/h5_file.hpp"
+    printf '#include "%s"\n' mpi_driver/checkpoint/checkpoint_writer.hpp mpi_driver/ensemble/ensemble_stepper.hpp \
+        > "$scratch/mpi_driver/run/driver.cpp"
     check_tree "$scratch" > /dev/null || { echo "self-test: a clean tree was flagged"; exit 1; }
     for bad in "dem/a.cpp:#include <mpi.h>" "dem/b.hpp:#include \"coarse/demixing/quantiles.hpp\"" \
                "coarse/c.cpp:#include \"dem/system.hpp\"" "coarse/d.hpp:  #  include <mpi.h>" \
@@ -123,7 +154,19 @@ if [ "${1:-}" = "--self-test" ]; then
                "dem/io/l.cpp:#include \"dem/realization_builder.hpp\"" \
                "dem/scene.hpp:#include \"dem/realization_builder.hpp\"" \
                "dem/system.cpp:#include \"dem/contact/pair_contact.hpp\"" \
-               "dem/beds/bed_builder.cpp:#include \"dem/effects/viscous_damping.hpp\""; do
+               "dem/beds/bed_builder.cpp:#include \"dem/effects/viscous_damping.hpp\"" \
+               "coarse/equation_free/m.cpp:#include \"coarse/demixing/quantiles.hpp\"" \
+               "coarse/demixing/n.hpp:#include \"coarse/dem_adapters/apply_colours.hpp\"" \
+               "mpi_driver/output/o.cpp:#include \"mpi_driver/ensemble/ensemble_stepper.hpp\"" \
+               "mpi_driver/output/p.cpp:#include <mpi.h>" \
+               "mpi_driver/ensemble/q.cpp:#include <hdf5.h>" \
+               "mpi_driver/ensemble/r.cpp:#include \"mpi_driver/checkpoint/checkpoint_writer.hpp\"" \
+               "mpi_driver/ensemble/s.cpp:#include \"mpi_driver/run/run_settings.hpp\"" \
+               "mpi_driver/checkpoint/t.cpp:#include \"mpi_driver/run/driver.hpp\"" \
+               "mpi_driver/checkpoint/checkpoint_format.cpp:#include <H5Fpublic.h>" \
+               "mpi_driver/checkpoint/realization_state.hpp:#include \"mpi_driver/ensemble/realization.hpp\"" \
+               "mpi_driver/run/u.cpp:#include <hdf5.h>" \
+               "mpi_driver/main.cpp:#include <hdf5.h>"; do
         file=${bad%%:*}; line=${bad#*:}
         echo "$line" > "$scratch/$file"
         if check_tree "$scratch" > /dev/null; then
