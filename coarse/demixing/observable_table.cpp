@@ -16,16 +16,14 @@ std::unique_ptr<EnsembleObservable> make_compact(const ProbabilityGrid& grid) {
 
 // THE table of coarse observables. One row each: name (as written in `cpi.observable = ...`),
 // factory, one-line summary.
-const ObservableTable::Entry kObservables[] = {
+constexpr ObservableTable::Entry kObservables[] = {
     {"icdf", &make_icdf, "the ensemble-mean ICDF of the observed species on the p-grid (m nodes)"},
     {"compact", &make_compact,
      "(A, B, C, D) of y = Q_top - Q_L ~ max[A p + B + C e^(D p), 0] (paper Eq. 3), fitted per sample"},
 };
+constexpr ObservableTable kTable{kObservables};
 }  // namespace
 
-const ObservableTable& observable_table() {
-    static const ObservableTable table{kObservables};
-    return table;
-}
+const ObservableTable& observable_table() { return kTable; }
 
 }  // namespace efdem::coarse
