@@ -22,6 +22,11 @@ struct BurstSamples {
     /// A scalar that shows the travelling-wave phase at each time (e.g. the centre-of-mass
     /// height [d_p]). Needed by the DT = k T integrator; may stay empty otherwise.
     std::vector<double> phase_signal;
+    /// The members' own coarse vectors at each time (R x dim, row r = realization r, in
+    /// realization order), whose mean is x: what the statistical error of the ensemble slope
+    /// is measured from (member_slope_standard_error()). Either empty (the stepper has no
+    /// members, or cannot restrict one on its own) or one matrix per sample.
+    std::vector<Eigen::MatrixXd> members;
 
     std::size_t size() const { return t.size(); }
 };

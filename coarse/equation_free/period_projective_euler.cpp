@@ -81,6 +81,13 @@ ProjectiveStepRecord PeriodProjectiveEuler::step(CoarseStepper& stepper) {
         return rec;
     }
     rec.slope = slope.slope;
+    // Each member's own period means over the ensemble-mean period T: the same linear
+    // estimator as the ensemble slope, so the members' slopes average to it.
+    if (rec.burst.members.size() == rec.burst.t.size()) {
+        const auto members = std::span<const Eigen::MatrixXd>(rec.burst.members).subspan(first);
+        rec.slope_standard_error =
+            slope_standard_error(member_period_mean_slopes(t, members, rec.period, rec.t_end));
+    }
     rec.window = 2.0 * rec.period;
 
     JumpPlan plan;

@@ -59,6 +59,10 @@ struct ProjectiveStepRecord {
     int periods_per_step = 0;  ///< k taken (DT = k T); 0 for the fixed-DT integrator
 
     Eigen::VectorXd slope;          ///< coarse slope s [unit of X per sqrt(d_p/g)]
+    /// Standard error of `slope` per component, from the spread of the members' own slopes
+    /// over the same window (slope_standard_error(); same unit as slope); DT times it is the
+    /// projection noise. Empty when the burst has no members or fewer than two.
+    Eigen::VectorXd slope_standard_error;
     double t_end = 0.0;             ///< time of the last burst sample
     Eigen::VectorXd x_end;          ///< X(t_end), the raw last sample
     Eigen::VectorXd x_projected;    ///< X(t_end) + DT s after the repair hook (= x_end if no jump)
@@ -66,6 +70,12 @@ struct ProjectiveStepRecord {
     StabilityAssessment stability;  ///< the monitor's verdict on the planned DT
     bool lifted = false;            ///< the stepper's lift() was called
     BurstSamples burst;             ///< the samples of this step's burst
+
+    /// The largest slope_standard_error over the components; NaN when there is none.
+    double max_slope_standard_error() const {
+        return slope_standard_error.size() == 0 ? std::numeric_limits<double>::quiet_NaN()
+                                                : slope_standard_error.maxCoeff<Eigen::PropagateNaN>();
+    }
 
     /// The step ended in a state from which the next step can go on as planned.
     bool advanced() const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -76,6 +77,27 @@ V interval_integral(std::span<const double> t, std::span<const V> x, double a, d
     for (std::size_t j = ja + 1; j < jb; ++j) sum += (0.5 * (t[j + 1] - t[j])) * (x[j] + x[j + 1]);
     sum += (0.5 * (b - t[jb])) * (x[jb] + value_at(jb, b));
     return sum;
+}
+
+/// Applies a vector-series slope estimator to each member's own series (see
+/// member_least_squares_slopes()); empty if the members are missing or of mixed shape, or the
+/// estimator finds no slope.
+template <class Estimator>
+Eigen::MatrixXd slopes_per_member(std::span<const double> t, std::span<const Eigen::MatrixXd> members,
+                                  Estimator estimate) {
+    if (members.empty() || members.size() != t.size()) return {};
+    const Eigen::Index n_members = members.front().rows(), dim = members.front().cols();
+    for (const Eigen::MatrixXd& m : members)
+        if (m.rows() != n_members || m.cols() != dim) return {};
+    Eigen::MatrixXd slopes(n_members, dim);
+    std::vector<Eigen::VectorXd> series(members.size());
+    for (Eigen::Index r = 0; r < n_members; ++r) {
+        for (std::size_t k = 0; k < members.size(); ++k) series[k] = members[k].row(r).transpose();
+        const SlopeEstimate est = estimate(std::span<const Eigen::VectorXd>(series));
+        if (!est.ok) return {};
+        slopes.row(r) = est.slope.transpose();
+    }
+    return slopes;
 }
 
 }  // namespace
@@ -153,6 +175,38 @@ SlopeEstimate period_mean_slope(std::span<const double> t, std::span<const Eigen
     est.t_last = t_end;
     est.ok = true;
     return est;
+}
+
+Eigen::MatrixXd member_least_squares_slopes(std::span<const double> t,
+                                            std::span<const Eigen::MatrixXd> members,
+                                            double t_start) {
+    return slopes_per_member(t, members, [&](std::span<const Eigen::VectorXd> x) {
+        return least_squares_slope(t, x, t_start);
+    });
+}
+
+Eigen::MatrixXd member_period_mean_slopes(std::span<const double> t,
+                                          std::span<const Eigen::MatrixXd> members, double period,
+                                          double t_end) {
+    return slopes_per_member(t, members, [&](std::span<const Eigen::VectorXd> x) {
+        return period_mean_slope(t, x, period, t_end);
+    });
+}
+
+Eigen::VectorXd slope_standard_error(const Eigen::MatrixXd& member_slopes) {
+    const Eigen::Index n = member_slopes.rows();
+    if (n < 2) return {};
+    const Eigen::VectorXd mean = member_slopes.colwise().mean().transpose();
+    const Eigen::VectorXd sum_sq =
+        (member_slopes.rowwise() - mean.transpose()).colwise().squaredNorm().transpose();
+    // Var(mean) = Var(s_r) / R with the unbiased Var(s_r) = sum_sq / (R - 1).
+    return (sum_sq / static_cast<double>((n - 1) * n)).cwiseSqrt();
+}
+
+Eigen::VectorXd member_slope_standard_error(std::span<const double> t,
+                                            std::span<const Eigen::MatrixXd> members,
+                                            double t_start) {
+    return slope_standard_error(member_least_squares_slopes(t, members, t_start));
 }
 
 }  // namespace efdem::coarse

@@ -89,4 +89,43 @@ double interval_mean(std::span<const double> t, std::span<const double> y, doubl
 SlopeEstimate period_mean_slope(std::span<const double> t, std::span<const Eigen::VectorXd> x,
                                 double period, double t_end);
 
+/**
+ * \brief Every member's own least-squares slope over the same window as
+ *        least_squares_slope(t, x, t_start), from the members' coarse vectors
+ *        (BurstSamples::members: one R x dim matrix per sample, row r = member r).
+ *
+ * Returns R x dim (row r = member r's slope); empty when there are no members (members empty,
+ * or not one matrix per sample), when the matrices differ in shape, or when the window holds
+ * fewer than two samples. The mean of the rows is the slope of the members' mean (least
+ * squares is linear in X).
+ * \pre t strictly increasing.
+ */
+Eigen::MatrixXd member_least_squares_slopes(std::span<const double> t,
+                                            std::span<const Eigen::MatrixXd> members,
+                                            double t_start);
+
+/// Every member's own period_mean_slope(t, x, period, t_end) (the same period T for all, each
+/// member's own period means), R x dim; empty as for member_least_squares_slopes() or when the
+/// samples do not cover two periods.
+Eigen::MatrixXd member_period_mean_slopes(std::span<const double> t,
+                                          std::span<const Eigen::MatrixXd> members, double period,
+                                          double t_end);
+
+/**
+ * \brief Standard error of the ensemble slope from the members' own slopes (R x dim):
+ *        SE_i = std_r(s_{r,i}) / sqrt(R), with the unbiased std (divisor R - 1).
+ *
+ * The members are independent realizations, so this holds whatever the noise's correlation
+ * in time; the white-noise formula of least_squares_slope() applied to the residuals of one
+ * fit underestimates it when the noise is correlated over the window. DT SE is the
+ * statistical (projection-noise) part of the error of a coarse step. Empty when R < 2.
+ */
+Eigen::VectorXd slope_standard_error(const Eigen::MatrixXd& member_slopes);
+
+/// slope_standard_error(member_least_squares_slopes(t, members, t_start)): the standard error
+/// of the slope the fixed-DT integrator projects with; empty when it cannot be measured.
+Eigen::VectorXd member_slope_standard_error(std::span<const double> t,
+                                            std::span<const Eigen::MatrixXd> members,
+                                            double t_start);
+
 }  // namespace efdem::coarse

@@ -11,6 +11,7 @@
 #include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem::coarse;
+using efdem::test::MemberTrendStepper;
 using efdem::test::SineTrendStepper;
 
 namespace {
@@ -134,4 +135,24 @@ TEST_CASE("DT = k T: k = 0, a missing phase signal, and the stability monitor", 
         CHECK(rec.stability.stable);
         CHECK(std::abs(rec.stability.rate) < 1e-9);
     }
+}
+
+TEST_CASE("DT = k T records the s.e. of the period-mean slope from the members' own",
+          "[unit][coarse]") {
+    // Each member's period means over the common T: the shared oscillation and trend cancel in
+    // the spread, which is that of the members' own trends d (node 1 has none). Round-off of
+    // slopes O(0.1): 1e-9 relative.
+    Eigen::MatrixXd d(4, 2);
+    d << 0.02, 0.0, -0.01, 0.0, 0.0, 0.0, 0.03, 0.0;
+    const double mean = d.col(0).mean();
+    const double se0 = std::sqrt((d.col(0).array() - mean).square().sum() / 3.0 / 4.0);
+    MemberTrendStepper toy(SineTrendStepper(Eigen::Vector2d(3.0, -1.0), Eigen::Vector2d(0.05, -0.2),
+                                            Eigen::Vector2d(0.3, 1.0), 1.0, 10.0, 0.1),
+                           d);
+    PeriodProjectiveEuler cpi({.healing = 10, .window = 32, .periods_per_step = 2});
+    const ProjectiveStepRecord rec = cpi.step(toy);
+    REQUIRE(rec.status == StepStatus::projected);
+    REQUIRE(rec.slope_standard_error.size() == 2);
+    CHECK(rec.slope_standard_error[0] == Approx(se0).epsilon(1e-9));
+    CHECK(rec.slope_standard_error[1] < 1e-12);
 }

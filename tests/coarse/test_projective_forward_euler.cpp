@@ -16,6 +16,8 @@
 
 using namespace efdem::coarse;
 using efdem::test::LinearToyStepper;
+using efdem::test::MemberTrendStepper;
+using efdem::test::SineTrendStepper;
 
 namespace {
 /// One outer step of PFE with K forward-Euler inner steps of h = 1 on dx/dt = lambda x
@@ -310,4 +312,50 @@ TEST_CASE("with an end time the jumps are shortened so that the run ends there e
         pfe.step(toy);
         CHECK(toy.time() == Approx(210).margin(1e-9));
     }
+}
+
+namespace {
+/// Five members with their own extra trends d (R x 3; node 2 has none), and the slope s.e.
+/// they imply, std_r(d_r,i) / sqrt(R) with the unbiased std, written out independently.
+Eigen::MatrixXd member_trends() {
+    Eigen::MatrixXd d(5, 3);
+    d << 0.01, -0.02, 0.0, 0.03, 0.0, 0.0, -0.01, 0.01, 0.0, 0.02, 0.05, 0.0, 0.0, -0.04, 0.0;
+    return d;
+}
+double unbiased_std_over_sqrt_r(const Eigen::VectorXd& d) {
+    const double mean = d.mean();
+    double ss = 0.0;
+    for (double v : d) ss += (v - mean) * (v - mean);
+    return std::sqrt(ss / static_cast<double>(d.size() - 1) / static_cast<double>(d.size()));
+}
+}  // namespace
+
+TEST_CASE("PFE records the slope's standard error from the members' own slopes",
+          "[unit][coarse]") {
+    // Members share a trend and an oscillation (which biases every member's least-squares slope
+    // alike) and differ by their own trends d_r: the s.e. is std_r(d_r)/sqrt(R) up to round-off
+    // of slopes O(0.1) (1e-9 relative leaves room for the sums over 100 samples).
+    const Eigen::MatrixXd d = member_trends();
+    MemberTrendStepper toy(SineTrendStepper(Eigen::Vector3d(3.0, -1.0, 20.0),
+                                            Eigen::Vector3d(0.05, -0.2, 0.01),
+                                            Eigen::Vector3d(0.0, 1.0, 2.0), 0.5, 10.0, 0.1),
+                           d);
+    ProjectiveForwardEuler pfe({.healing = 5, .window = 10, .dt = 20});
+    for (int step = 0; step < 2; ++step) {  // and again after a lift
+        const ProjectiveStepRecord rec = pfe.step(toy);
+        REQUIRE(rec.status == StepStatus::projected);
+        REQUIRE(rec.burst.members.size() == rec.burst.t.size());
+        REQUIRE(rec.slope_standard_error.size() == 3);
+        for (int i = 0; i < 2; ++i)
+            CHECK(rec.slope_standard_error[i] ==
+                  Approx(unbiased_std_over_sqrt_r(d.col(i))).epsilon(1e-9));
+        CHECK(rec.slope_standard_error[2] < 1e-12);  // no spread in node 2
+        CHECK(rec.max_slope_standard_error() == rec.slope_standard_error.maxCoeff());
+    }
+    // A stepper without members: no s.e., and the slope is what it was.
+    LinearToyStepper plain(Eigen::MatrixXd::Constant(1, 1, 0.99), 0.1, Eigen::VectorXd::Ones(1));
+    const ProjectiveStepRecord rec = ProjectiveForwardEuler({.healing = 1, .window = 1, .dt = 2}).step(plain);
+    REQUIRE(rec.status == StepStatus::projected);
+    CHECK(rec.slope_standard_error.size() == 0);
+    CHECK(std::isnan(rec.max_slope_standard_error()));
 }

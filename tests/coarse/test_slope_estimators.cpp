@@ -152,3 +152,133 @@ TEST_CASE("period-mean slope reports samples that do not cover two periods", "[u
     CHECK_FALSE(est.ok);
     CHECK_THAT(est.message, Catch::Contains("two periods"));
 }
+
+namespace {
+/// The members of one synthetic burst: member r, node i at sample k is beta_i t_k + noise
+/// (independent between members and nodes). Before t_window the noise is 100 times larger,
+/// so an estimate that used the healing samples would be far off.
+struct NoisyMembers {
+    std::vector<double> t;
+    std::vector<Eigen::MatrixXd> members;
+    std::vector<Eigen::VectorXd> mean;
+};
+
+/// rho = 0: white noise of std sigma; 0 < rho < 1: a stationary AR(1) series per member and
+/// node, e_k = rho e_(k-1) + sqrt(1 - rho^2) sigma eta_k (std sigma, correlation rho^lag).
+NoisyMembers noisy_members(efdem::RandomStream& rng, int n_members, int dim,
+                           const std::vector<double>& t, double t_window, double sigma,
+                           double rho) {
+    NoisyMembers b;
+    b.t = t;
+    Eigen::MatrixXd e(n_members, dim);
+    for (Eigen::Index j = 0; j < e.size(); ++j) e.data()[j] = sigma * rng.normal();
+    for (double tk : t) {
+        for (Eigen::Index j = 0; j < e.size(); ++j)
+            e.data()[j] = rho * e.data()[j] + std::sqrt(1.0 - rho * rho) * sigma * rng.normal();
+        Eigen::MatrixXd x(n_members, dim);
+        for (int i = 0; i < dim; ++i)
+            x.col(i) = Eigen::VectorXd::Constant(n_members, (0.1 + 0.05 * i) * tk) +
+                       (tk < t_window ? 100.0 : 1.0) * e.col(i);
+        b.members.push_back(x);
+        b.mean.push_back(x.colwise().mean().transpose());
+    }
+    return b;
+}
+
+double sum_sq_time_deviation(std::span<const double> t) {
+    double mean = 0.0, s = 0.0;
+    for (double v : t) mean += v / static_cast<double>(t.size());
+    for (double v : t) s += (v - mean) * (v - mean);
+    return s;
+}
+}  // namespace
+
+TEST_CASE("members' slopes: their mean is the ensemble slope, their spread / sqrt(R) its s.e.",
+          "[unit][coarse]") {
+    // R = 8 members, 4 nodes, white noise sigma = 0.3; window of 21 samples after 10 healing
+    // samples. The closed form: SE^2 = sigma^2 / (R sum_k (t_k - tbar)^2) over the window.
+    constexpr int kMembers = 8, kDim = 4, kTrials = 2000;
+    constexpr double kSigma = 0.3;
+    const auto t = sample_times(50.0, 0.5, 31);
+    const double t_window = t[10];
+    const double stt = sum_sq_time_deviation(std::span<const double>(t).subspan(10));
+    const double expected_se2 = kSigma * kSigma / (stt * kMembers);
+    efdem::RandomStream rng(16, 0, "test-member-slopes");
+    double mean_se2 = 0.0;
+    for (int trial = 0; trial < kTrials; ++trial) {
+        const NoisyMembers b = noisy_members(rng, kMembers, kDim, t, t_window, kSigma, 0.0);
+        const Eigen::MatrixXd slopes = member_least_squares_slopes(b.t, b.members, t_window);
+        REQUIRE(slopes.rows() == kMembers);
+        REQUIRE(slopes.cols() == kDim);
+        if (trial == 0) {  // least squares is linear in X: the mean of the slopes is the slope
+            const SlopeEstimate ensemble = least_squares_slope(b.t, b.mean, t_window);
+            const Eigen::VectorXd mean_slope = slopes.colwise().mean().transpose();
+            CHECK((mean_slope - ensemble.slope).cwiseAbs().maxCoeff() < 1e-12);
+        }
+        const Eigen::VectorXd se = member_slope_standard_error(b.t, b.members, t_window);
+        REQUIRE(se.size() == kDim);
+        mean_se2 += se.squaredNorm() / (kDim * kTrials);
+    }
+    // Squares are compared: SE^2 is unbiased, SE itself is low by c4(8) = 0.965 on average.
+    // SE^2 estimated with R - 1 = 7 degrees of freedom has relative std sqrt(2/7); averaged over
+    // 2000 trials x 4 independent nodes, the mean's relative std is sqrt(2/7/8000) = 0.6 %.
+    // 3 % is 5 of those: a wrong divisor (R instead of R - 1: -12.5 %, or no sqrt(R): x8) or
+    // healing samples in the window (noise x100) cannot pass.
+    CHECK(mean_se2 == Approx(expected_se2).epsilon(0.03));
+}
+
+TEST_CASE("with noise correlated in time the members' s.e. is the slope's real error; the "
+          "white-noise formula on the mean's residuals is several times too small",
+          "[unit][coarse]") {
+    // AR(1) noise with rho = 0.9 (correlation time ~10 samples) over a 41-sample window.
+    constexpr int kMembers = 8, kDim = 4, kTrials = 2000;
+    constexpr double kSigma = 0.3, kRho = 0.9;
+    const auto t = sample_times(0.0, 0.5, 51);
+    const double t_window = t[10];
+    const auto tw = std::span<const double>(t).subspan(10);
+    const double stt = sum_sq_time_deviation(tw);
+    efdem::RandomStream rng(17, 0, "test-member-slopes-ar1");
+    double member_se2 = 0.0, white_se2 = 0.0, actual_err2 = 0.0;
+    for (int trial = 0; trial < kTrials; ++trial) {
+        const NoisyMembers b = noisy_members(rng, kMembers, kDim, t, t_window, kSigma, kRho);
+        member_se2 += member_slope_standard_error(b.t, b.members, t_window).squaredNorm();
+        const SlopeEstimate s = least_squares_slope(b.t, b.mean, t_window);
+        const auto xw = std::span<const Eigen::VectorXd>(b.mean).subspan(10);
+        for (int i = 0; i < kDim; ++i) {
+            const double true_slope = 0.1 + 0.05 * i;
+            actual_err2 += (s.slope[i] - true_slope) * (s.slope[i] - true_slope);
+            // physics.md §10's white-noise s.e. from the residuals of the one fit to the mean.
+            std::vector<double> y;
+            for (const auto& x : xw) y.push_back(x[i]);
+            const LineFit line = fit_line(tw, y);
+            double rss = 0.0;
+            for (std::size_t k = 0; k < y.size(); ++k) rss += std::pow(y[k] - line.at(tw[k]), 2);
+            white_se2 += rss / static_cast<double>(y.size() - 2) / stt;
+        }
+    }
+    // The members' SE^2 has a relative std of 0.6 % over the 8000 node-trials (as above), the
+    // squared actual error sqrt(2/8000) = 1.6 %: 8 % is about 5 combined standard deviations.
+    CHECK(member_se2 == Approx(actual_err2).epsilon(0.08));
+    // For rho = 0.9 and this window the true SE is about 4.2 times the white-noise one
+    // (variance x18, measured in a separate simulation); requiring x3 (variance x9) leaves a
+    // wide margin, while a method that measured white noise (ratio 1) fails.
+    CHECK(member_se2 > 9.0 * white_se2);
+}
+
+TEST_CASE("the members' s.e. needs two members, members for every sample, and a window",
+          "[unit][coarse]") {
+    efdem::RandomStream rng(18, 0, "test-member-slopes-edge");
+    const auto t = sample_times(0.0, 0.5, 11);
+    const NoisyMembers one = noisy_members(rng, 1, 3, t, 0.0, 0.3, 0.0);
+    CHECK(member_least_squares_slopes(one.t, one.members, 0.0).rows() == 1);
+    CHECK(member_slope_standard_error(one.t, one.members, 0.0).size() == 0);  // R = 1: no spread
+    CHECK(member_slope_standard_error(t, {}, 0.0).size() == 0);              // no members
+    const NoisyMembers two = noisy_members(rng, 2, 3, t, 0.0, 0.3, 0.0);
+    CHECK(member_slope_standard_error(two.t, two.members, 0.0).size() == 3);
+    CHECK(member_slope_standard_error(two.t, two.members, t.back()).size() == 0);  // 1 sample
+    auto partial = std::span<const Eigen::MatrixXd>(two.members).first(5);
+    CHECK(member_slope_standard_error(two.t, partial, 0.0).size() == 0);  // not one per sample
+    auto mixed = two.members;
+    mixed[3] = Eigen::MatrixXd::Zero(3, 3);
+    CHECK(member_slope_standard_error(two.t, mixed, 0.0).size() == 0);  // shapes differ
+}

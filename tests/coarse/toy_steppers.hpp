@@ -2,6 +2,7 @@
 // Toy coarse time-steppers for the projective-integrator tests: the integrator cannot tell them
 // from an ensemble of DEM runs (coarse/equation_free/coarse_stepper.hpp).
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -88,6 +89,41 @@ class SineTrendStepper final : public coarse::CoarseStepper {
     Eigen::VectorXd c_, beta_, phi_;
     double a_, period_, h_;
     double t_ = 0.0;
+};
+
+/// R members that share a SineTrendStepper's trend and oscillation, each with its own extra
+/// trend: member r is X_r(t) = X_common(t) + d_r t (d = R x dim). X is the members' mean and
+/// every sample carries the members (BurstSamples::members, row r = member r). The common part
+/// is the same in every member, so the spread of any linear slope estimator's member slopes is
+/// that of d: the slope's standard error is std_r(d_r)/sqrt(R) exactly. Lifting moves the common
+/// offset so that the members' mean meets the target.
+class MemberTrendStepper final : public coarse::CoarseStepper {
+  public:
+    MemberTrendStepper(SineTrendStepper common, Eigen::MatrixXd member_trends)
+        : common_(std::move(common)),
+          d_(std::move(member_trends)),
+          d_mean_(d_.colwise().mean().transpose()) {}
+
+    double time() const override { return common_.time(); }
+    void run(double duration, coarse::BurstSamples& out) override {
+        const std::size_t first = out.t.size();
+        common_.run(duration, out);
+        for (std::size_t k = first; k < out.t.size(); ++k) {
+            Eigen::MatrixXd members = d_ * out.t[k];
+            members.rowwise() += out.x[k].transpose();
+            out.x[k] += d_mean_ * out.t[k];
+            out.members.push_back(std::move(members));
+        }
+    }
+    void lift(const Eigen::VectorXd& target, double new_time) override {
+        common_.lift(target - d_mean_ * new_time, new_time);
+    }
+    SineTrendStepper& common() { return common_; }
+
+  private:
+    SineTrendStepper common_;
+    Eigen::MatrixXd d_;
+    Eigen::VectorXd d_mean_;
 };
 
 }  // namespace efdem::test
