@@ -8,6 +8,11 @@
 /// that realization's own (reused) positions (§9). A sample whose fit is not usable (y = 0 at
 /// full demixing, no convergence, a poor fit) yields a vector of NaN and a status: the
 /// integrator then rejects the burst and the run loop falls back to the full ICDF.
+///
+/// No per-realization X (restricts_members() is false, so a compact step records no slope
+/// standard error): that would take one Levenberg-Marquardt fit per realization per sample on
+/// the root, R times the restriction's cost, and the fit of the mean is not the mean of the
+/// members' fits (the fit is nonlinear), so their spread would not be that of the slope used.
 
 #include <optional>
 

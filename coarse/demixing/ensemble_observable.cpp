@@ -32,6 +32,11 @@ Eigen::VectorXd IcdfObservable::restrict_ensemble(const Eigen::MatrixXd& icdf, c
     return ensemble_mean(icdf);
 }
 
+Eigen::MatrixXd IcdfObservable::restrict_members(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd&) const {
+    EFDEM_EXPECTS(icdf.cols() == m_);
+    return icdf;
+}
+
 Eigen::VectorXd IcdfObservable::lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd&) const {
     EFDEM_EXPECTS(x.size() == m_);
     return x;

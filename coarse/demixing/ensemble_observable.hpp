@@ -33,6 +33,16 @@ public:
     /// Returns a vector of NaN when X cannot be formed (the integrator then rejects the burst);
     /// status() says why.
     virtual Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) = 0;
+    /// Whether restrict_members() forms each realization's own X (default: no).
+    virtual bool restricts_members() const { return false; }
+    /// Each realization's own X (R x dimension(), row r = realization r), whose column means
+    /// are restrict_ensemble()'s X: what the statistical error of the slope is measured from.
+    /// Empty when !restricts_members(). Keeps no state (a warm start belongs to the mean).
+    virtual Eigen::MatrixXd restrict_members(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) const {
+        (void)icdf;
+        (void)top;
+        return {};
+    }
     /// The observed-species ICDF target for one realization, from the projected X and that
     /// realization's own top-half ICDF (ignored when !needs_top_half()).
     virtual Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const = 0;
@@ -70,6 +80,9 @@ public:
     bool needs_top_half() const override { return false; }
     Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) override;
     Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const override;
+    /// Each realization's X is its own ICDF: the rows of `icdf` themselves.
+    bool restricts_members() const override { return true; }
+    Eigen::MatrixXd restrict_members(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) const override;
     /// Projected ICDFs are made non-decreasing and clipped into the feasible range before
     /// lifting (physics.md §9 step 1; coarse/demixing/monotone_repair.hpp).
     RepairHook repair_hook(FeasibleRange range) const override;

@@ -186,6 +186,9 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         out->t.push_back(rec.time);
         out->x.push_back(x);
         out->phase_signal.push_back(coarse::ensemble_mean(all_scalars)[0]);
+        // Rows in global realization order, as gathered: independent of the layout.
+        if (observable_->restricts_members())
+            out->members.push_back(observable_->restrict_members(all_icdf, all_top));
     }
     if (recorder_) recorder_->sample(rec);
     overhead_.restrict_seconds += MPI_Wtime() - start;

@@ -1,7 +1,7 @@
 // The ensemble driver over MPI, run at 1, 2 and 4 ranks with the same R = 4 realizations:
 // gathers and averages equal the serial computation, scatters reach the right realization, and
 // a coarse projective run of a linear toy model through EnsembleStepper reproduces the serial
-// projective integrator bit for bit.
+// projective integrator bit for bit, members (each realization's coarse vector) included.
 #include <catch2/catch.hpp>
 
 #include <memory>
@@ -117,6 +117,7 @@ public:
             out.t.push_back(time());
             out.x.push_back(coarse::ensemble_mean(all));
             out.phase_signal.push_back(coarse::ensemble_mean(all)[0]);
+            out.members.push_back(all);
         }
     }
     void lift(const Eigen::VectorXd& target, double new_time) override {
@@ -169,6 +170,18 @@ TEST_CASE("CPI of a linear toy model through EnsembleStepper equals the serial i
         CHECK(a.x_end == b.x_end);
         CHECK(a.x_projected == b.x_projected);
         CHECK(a.burst.t == b.burst.t);
+        // The members arrive in realization order whatever the layout (the serial stepper
+        // lists them in that order), and so give the same slope s.e.
+        REQUIRE(a.burst.members.size() == a.burst.t.size());
+        for (std::size_t k = 0; k < a.burst.t.size(); ++k) CHECK(a.burst.members[k] == b.burst.members[k]);
+        CHECK(a.slope_standard_error == b.slope_standard_error);
+        REQUIRE(a.slope_standard_error.size() == 3);
+        if (step == 0) {
+            // Before the first lift the realizations differ (x0 = 1 + 0.1 r, decaying alike):
+            // row r is realization r, and the slopes spread.
+            for (long r = 1; r < kRealizations; ++r) CHECK(a.burst.members[0](r, 0) > a.burst.members[0](r - 1, 0));
+            CHECK(a.slope_standard_error[0] > 0.0);
+        }
     }
     CHECK(stepper.time() == Approx(15.0).margin(1e-9));  // 5 cycles of burst 1 + DT 2
     // And the slow mode was followed: x0 = 1.15 e^(-0.1 t) exactly. Projective forward Euler
