@@ -97,6 +97,7 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
         series(fmt::format("/cpi/{}", name), {d}, T::real).append(as_span(row));
     };
     vec("slope", rec.slope);
+    vec("slope_standard_error", rec.slope_standard_error);
     vec("x_end", rec.x_end);
     vec("x_projected", rec.x_projected);
     scalar("repair_max_adjustment", rec.repair.max_adjustment);

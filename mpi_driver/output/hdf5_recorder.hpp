@@ -16,6 +16,10 @@
 ///                         [cpi.observable = compact or observe.compact = true]
 ///   /cpi/t_start, burst_length, healing, window, dt_requested, dt, period, periods, t_end (n)
 ///   /cpi/status (text), message (text), slope, x_end, x_projected (n x dim)
+///   /cpi/slope_standard_error (n x dim): SE_i = std_r(s_r,i) / sqrt(R) of the slope, from
+///                         each realization's own slope over the same window [d_p per
+///                         sqrt(d_p/g)]; NaN where unavailable (R = 1, compact observable,
+///                         no slope)
 ///   /cpi/repair_max_adjustment, repair_clipped, repair_non_monotone (n)
 ///   /cpi/stability_assessed, stability_stable, stability_rate, stability_amplification (n)
 ///   /cpi/lift_changed (n x R), lift_max_deviation (n x R), lift_message (text, per step)

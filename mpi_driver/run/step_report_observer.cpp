@@ -16,6 +16,7 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
     s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
     if (r.lifted) s += fmt::format(", {} labels changed", changed);
     if (r.repair.changed()) s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
+    if (r.slope_standard_error.size() > 0) s += fmt::format(", slope s.e. max {:.3g}", r.max_slope_standard_error());
     if (!r.message.empty()) s += " [" + r.message + "]";
     return s;
 }

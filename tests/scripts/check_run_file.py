@@ -59,6 +59,9 @@ def main(argv=None):
             check(int(f.attrs["coarse_steps"]) == k, "coarse_steps attribute does not match the records")
             for name in ("burst_length", "dt", "t_end", "slope", "x_projected", "lift_changed"):
                 check(len(c[name]) == k, f"/cpi/{name} has {len(c[name])} rows, expected {k}")
+            se = c["slope_standard_error"]
+            check(se.shape == c["slope"].shape, f"/cpi/slope_standard_error shape {se.shape} != /cpi/slope {c['slope'].shape}")
+            check(not np.any(se[:] < 0), "negative slope standard error")
             check(np.all(c["lift_changed"][:] >= 0), "negative label counts")
             check(np.all(np.diff(c["t_start"][:]) > 0), "coarse steps not in time order")
     if errors:
