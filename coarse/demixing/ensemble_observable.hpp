@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "coarse/equation_free/ensemble_statistics.hpp"  // ensemble_mean, ensemble_variance
 #include "coarse/equation_free/projective_integrator.hpp"
 
 namespace efdem::coarse {
@@ -90,11 +91,5 @@ public:
 private:
     Eigen::Index m_;
 };
-
-/// Column means of an R x m matrix, summed in realization order (so the result does not depend
-/// on how the rows were produced). \pre R >= 1.
-Eigen::VectorXd ensemble_mean(const Eigen::MatrixXd& rows);
-/// Unbiased column variances (divisor R - 1; zeros when R = 1).
-Eigen::VectorXd ensemble_variance(const Eigen::MatrixXd& rows, const Eigen::VectorXd& mean);
 
 }  // namespace efdem::coarse

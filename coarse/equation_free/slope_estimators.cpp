@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/equation_free/ensemble_statistics.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {
@@ -196,11 +197,9 @@ Eigen::MatrixXd member_period_mean_slopes(std::span<const double> t,
 Eigen::VectorXd slope_standard_error(const Eigen::MatrixXd& member_slopes) {
     const Eigen::Index n = member_slopes.rows();
     if (n < 2) return {};
-    const Eigen::VectorXd mean = member_slopes.colwise().mean().transpose();
-    const Eigen::VectorXd sum_sq =
-        (member_slopes.rowwise() - mean.transpose()).colwise().squaredNorm().transpose();
-    // Var(mean) = Var(s_r) / R with the unbiased Var(s_r) = sum_sq / (R - 1).
-    return (sum_sq / static_cast<double>((n - 1) * n)).cwiseSqrt();
+    // Var(mean) = Var(s_r) / R with the unbiased Var(s_r) (divisor R - 1).
+    const Eigen::VectorXd var = ensemble_variance(member_slopes, ensemble_mean(member_slopes));
+    return (var / static_cast<double>(n)).cwiseSqrt();
 }
 
 Eigen::VectorXd member_slope_standard_error(std::span<const double> t,
