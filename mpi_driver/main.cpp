@@ -212,6 +212,7 @@ int main(int argc, char** argv) {
         Params root = table->root();
         const dem::DemScene scene = dem::DemScene::from_params(root);
         settings = RunSettings::from_params(root, scene);
+        settings->check_ensemble(root, mpi.size() * settings->realizations_per_rank);
         const int k = check ? 1 : settings->realizations_per_rank;
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;

@@ -7,7 +7,8 @@
 ///
 /// | key               | meaning                                                       | default |
 /// |-------------------|---------------------------------------------------------------|---------|
-/// | cpi.projection    | `fixed` (DT = cpi.dt) or `periods` (DT = k T)                 | fixed   |
+/// | cpi.projection    | `fixed` (DT = cpi.dt), `periods` (DT = k T) or `adaptive`     | fixed   |
+/// | cpi.integrator    | `euler` or `adams_bashforth2` (fixed, adaptive)               | euler   |
 /// | cpi.warmup        | direct simulation before the first coarse step                | 0       |
 /// | cpi.healing       | start of each burst left out of the slope                     | 10      |
 /// | cpi.window        | estimation window after healing (>= 3 samples)                | 10      |
@@ -15,11 +16,19 @@
 /// | cpi.periods       | k in DT = k T (projection = periods)                          | 2       |
 /// | cpi.max_extension | most a burst may be lengthened to see 2 periods               | 30      |
 /// | cpi.stability     | `warn`, `halve` or `stop` when DT is flagged                  | warn    |
+/// | cpi.tolerance     | adaptive: error one jump may add, RMS over the ICDF [d_p]     | required|
+/// | cpi.dt_min        | adaptive: shortest jump; below it a burst runs directly       | burst/2 |
+/// | cpi.dt_max        | adaptive: longest jump                                        | 8 burst |
+/// | cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     |
+/// | cpi.growth        | adaptive: DT_next <= growth x DT_last                         | 2       |
 ///
+/// With `adaptive`, cpi.dt (if given) caps the first jump (default: one burst) and the keys of
+/// `periods` are refused; the adaptive keys are refused with the other projections.
 /// warmup, healing, window and max_extension must be whole multiples of the sampling interval.
 
 #include <memory>
 
+#include "coarse/equation_free/multistep_projective_integrator.hpp"
 #include "coarse/equation_free/period_projective_euler.hpp"
 #include "coarse/equation_free/projective_forward_euler.hpp"
 #include "coarse/equation_free/projective_integrator.hpp"
@@ -28,7 +37,9 @@
 namespace efdem::coarse {
 
 struct CoarseRunSettings {
-    enum class Projection { fixed, periods } projection = Projection::fixed;
+    enum class Projection { fixed, periods, adaptive } projection = Projection::fixed;
+    /// 1: forward Euler; 2: Adams-Bashforth 2 (cpi.integrator).
+    int steps = 1;
     /// Direct simulation before the first coarse step (the packed start is not on the slow
     /// manifold).
     double warmup = 0.0;
@@ -36,6 +47,8 @@ struct CoarseRunSettings {
     ProjectiveEulerSettings fixed;
     /// Projection = periods: healing, window, k, burst extension, stability policy.
     PeriodProjectiveEulerSettings periods;
+    /// Projection = adaptive, or fixed with Adams-Bashforth 2.
+    MultistepSettings multistep;
 
     /// Reads the keys above from the `cpi` scope (in the order of the table). Both
     /// projections' keys are read, so that switching cpi.projection on the command line works on

@@ -62,6 +62,21 @@ class CoarseStepper {
      * feasible range, if the caller installed one).
      */
     virtual void lift(const Eigen::VectorXd& target, double new_time) = 0;
+
+    /// \name Going back: reject-and-redo of adaptive projective integration.
+    /// keep_state() keeps the whole micro state (every realization, the random streams, the
+    /// clock) in memory; the samples taken from then on are provisional. return_to_kept_state()
+    /// puts the micro model back exactly as it was kept and discards those samples (what the
+    /// redo runs is bit for bit what a run that never went further would run);
+    /// confirm_kept_state() makes them final and forgets the kept state. The work done stays
+    /// counted either way. Steppers that cannot (can_keep_state() false) may leave the
+    /// defaults, which are contract violations to call.
+    ///@{
+    virtual bool can_keep_state() const { return false; }
+    virtual void keep_state();
+    virtual void return_to_kept_state();
+    virtual void confirm_kept_state();
+    ///@}
 };
 
 }  // namespace efdem::coarse

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "coarse/equation_free/slope_estimators.hpp"
+#include "core/contracts.hpp"
 
 namespace efdem::coarse {
 
@@ -21,6 +22,8 @@ std::string_view to_string(StepStatus status) {
             return "invalid_burst";
         case StepStatus::infeasible_projection:
             return "infeasible_projection";
+        case StepStatus::rejected:
+            return "rejected";
     }
     return "unknown";
 }
@@ -32,6 +35,20 @@ double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, doub
     if (left <= dt + tol) return std::max(0.0, left);
     if (left - dt < burst - tol) return std::max(0.0, left - burst);
     return std::numeric_limits<double>::infinity();
+}
+
+void CoarseStepper::keep_state() { EFDEM_EXPECTS(can_keep_state()); }
+void CoarseStepper::return_to_kept_state() { EFDEM_EXPECTS(can_keep_state()); }
+void CoarseStepper::confirm_kept_state() { EFDEM_EXPECTS(can_keep_state()); }
+
+void ProjectiveIntegrator::save_state(std::vector<double>& reals, std::string& text) const {
+    reals.clear();
+    text.clear();
+}
+
+void ProjectiveIntegrator::restore_state([[maybe_unused]] const std::vector<double>& reals, const std::string& text) {
+    (void)text;
+    EFDEM_EXPECTS(reals.empty());
 }
 
 double ProjectiveIntegrator::jump_limit(double t_after_burst, double dt, double burst) const {

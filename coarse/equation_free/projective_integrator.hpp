@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -38,9 +39,33 @@ enum class StepStatus {
     invalid_burst,          ///< too few samples for the slope, non-finite samples, no phase
                             ///< signal, or the last sample is not at the end of the burst
     infeasible_projection,  ///< the projected vector is not finite, or the repair hook said so
+    rejected,               ///< adaptive: the burst after the jump showed its error above the
+                            ///< tolerance; the micro model is back where the jump started
 };
 
 std::string_view to_string(StepStatus status);
+
+/// What the step-size controller of the multistep integrator measured and decided for one
+/// jump (docs/error_control.md). Errors are RMS over the coarse vector's components [d_p for
+/// the ICDF]; per-component vectors in the same unit.
+struct ControllerRecord {
+    static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    bool active = false;    ///< the step was made by the multistep integrator
+    bool adaptive = false;  ///< DT chosen by the controller (else fixed)
+    int steps = 0;          ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
+    double tolerance = nan; ///< cpi.tolerance (NaN when fixed)
+    bool accepted = false;  ///< the jump was kept
+    double statistical = nan;           ///< projection noise of the jump
+    double truncation = nan;            ///< from the slope after the jump (a posteriori)
+    double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
+    Eigen::VectorXd statistical_nodes;  ///< per component
+    Eigen::VectorXd truncation_nodes;   ///< per component (noise not removed)
+    /// Largest DT the tolerance allows with the realizations run, and with 2 and 4 times as
+    /// many (standard errors / sqrt(2), / 2): what more realizations would buy.
+    double dt_tolerance = nan, dt_tolerance_2r = nan, dt_tolerance_4r = nan;
+    std::string limited_by;  ///< what set DT: "tolerance", "growth", "first jump", ...
+    double error() const { return statistical + truncation; }
+};
 
 /// Everything one outer step did, for output, diagnosis and tests. Times in sqrt(d_p/g).
 struct ProjectiveStepRecord {
@@ -70,6 +95,7 @@ struct ProjectiveStepRecord {
     StabilityAssessment stability;  ///< the monitor's verdict on the planned DT
     bool lifted = false;            ///< the stepper's lift() was called
     BurstSamples burst;             ///< the samples of this step's burst
+    ControllerRecord controller;    ///< the multistep integrator's error estimates and choice
 
     /// The largest slope_standard_error over the components; NaN when there is none.
     double max_slope_standard_error() const {
@@ -79,7 +105,8 @@ struct ProjectiveStepRecord {
 
     /// The step ended in a state from which the next step can go on as planned.
     bool advanced() const {
-        return status == StepStatus::projected || status == StepStatus::burst_only;
+        return status == StepStatus::projected || status == StepStatus::burst_only ||
+               status == StepStatus::rejected;
     }
 };
 
@@ -103,6 +130,12 @@ class ProjectiveIntegrator {
     /// remaining time is at least one burst ends at t_end exactly (default: no end).
     void set_end_time(double t_end) { end_time_ = t_end; }
     double end_time() const { return end_time_; }
+
+    /// The integrator's own state between two steps (slope history, step-size controller), for
+    /// a checkpoint; integrators without one save nothing. restore_state() takes what
+    /// save_state() wrote, so that the next step is bit for bit the one the saved run made.
+    virtual void save_state(std::vector<double>& reals, std::string& text) const;
+    virtual void restore_state(const std::vector<double>& reals, const std::string& text);
 
   protected:
     /// end_of_run_jump_limit() for this integrator's end time.

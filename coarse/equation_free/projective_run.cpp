@@ -29,13 +29,19 @@ double ProjectiveRun::planned_micro_time(double dt) const {
 }
 
 ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<ProjectiveRunState>& resume) {
-    state_ = resume.value_or(ProjectiveRunState{stepper_.time()});
+    if (resume) {
+        state_ = *resume;
+    } else {
+        state_ = ProjectiveRunState{};
+        state_.t_origin = stepper_.time();
+    }
     t_end_ = state_.t_origin + duration;
     const double tol = time_tolerance(t_end_);
     const double burst = settings_.burst();
     // From here on the fallback is the coarse variable when the primary one failed, now or
     // before the checkpoint this run resumed from.
     use(state_.fell_back && fallback_ ? *fallback_ : primary_);
+    if (resume) integrator_->restore_state(state_.integrator, state_.integrator_text);
     ProjectiveRunOutcome out;
     out.end_status = "completed";
     if (settings_.warmup > 0 && !resume) {
@@ -47,6 +53,7 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
         for (auto* o : observers_) o->warmup_done(*this);
     }
     while (stepper_.time() < t_end_ - tol) {
+        integrator_->save_state(state_.integrator, state_.integrator_text);
         for (auto* o : observers_) o->between_steps(*this);
         // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
         // plus one burst (or one whose period bursts were extended) can be left with less.

@@ -47,6 +47,10 @@ struct ProjectiveRunState {
     long coarse_steps = 0;      ///< outer steps done
     long without_progress = 0;  ///< consecutive steps without a jump
     bool fell_back = false;     ///< the primary coarse variable failed; the fallback is in use
+    /// The integrator's own state (ProjectiveIntegrator::save_state(); empty for the
+    /// single-step integrators).
+    std::vector<double> integrator;
+    std::string integrator_text;
 };
 
 /// A coarse variable the loop can integrate: how projected vectors are repaired, how the
@@ -105,6 +109,8 @@ class ProjectiveRun {
     ProjectiveRunOutcome run(double duration, const std::optional<ProjectiveRunState>& resume = std::nullopt);
 
     const ProjectiveRunState& state() const { return state_; }
+    /// The integrator in use (after run() started).
+    const ProjectiveIntegrator& integrator() const { return *integrator_; }
     const CoarseRunSettings& settings() const { return settings_; }
     const CoarseStepper& stepper() const { return stepper_; }
     double end_time() const { return t_end_; }

@@ -125,7 +125,20 @@ double slope_gain(const CpiCycle& cycle, double lambda) {
 
 double cpi_amplification(const CpiCycle& cycle, double lambda) {
     EFDEM_EXPECTS(cycle.dt >= 0.0);
+    if (cycle.steps == 2) return ab2_cpi_amplification(cycle, lambda);
     return std::exp(lambda * cycle.burst) + cycle.dt * slope_gain(cycle, lambda);
+}
+
+double ab2_cpi_amplification(const CpiCycle& cycle, double lambda) {
+    EFDEM_EXPECTS(cycle.dt >= 0.0 && cycle.estimator == SlopeEstimator::least_squares);
+    const double dt = cycle.dt, a = 0.5 * cycle.window, h = cycle.burst + dt;
+    const double w1 = dt * (a + h + 0.5 * dt) / h, w0 = -dt * (a + 0.5 * dt) / h;
+    const double s = slope_gain(cycle, lambda);
+    const double b = std::exp(lambda * cycle.burst) + s * w1, c = s * w0;  // mu^2 - b mu - c = 0
+    const double disc = b * b + 4.0 * c;
+    if (disc < 0.0) return std::sqrt(-c);  // complex pair: |mu|^2 = -c
+    const double r = std::sqrt(disc);
+    return std::max(std::abs(0.5 * (b + r)), std::abs(0.5 * (b - r)));
 }
 
 }  // namespace efdem::coarse

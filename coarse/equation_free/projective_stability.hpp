@@ -63,6 +63,9 @@ struct CpiCycle {
     double burst = 20.0;   ///< dt_b: lift to end of burst [sqrt(d_p/g)]
     double window = 10.0;  ///< W (least squares) or the period T (period mean) [sqrt(d_p/g)]
     double dt = 80.0;      ///< DT: projective step [sqrt(d_p/g)]
+    /// 1: forward Euler from this burst's slope; 2: Adams-Bashforth 2 from this and the
+    /// previous burst's (least squares only; every cycle alike).
+    int steps = 1;
 };
 
 /**
@@ -90,5 +93,18 @@ double slope_gain(const CpiCycle& cycle, double lambda);
  * \pre as slope_gain(); dt >= 0.
  */
 double cpi_amplification(const CpiCycle& cycle, double lambda);
+
+/**
+ * \brief Amplification of projective Adams-Bashforth 2 (cycle.steps = 2): the largest |mu| of
+ *        mu^2 - (e^(lambda dt_b) + S W_1) mu - S W_0 = 0.
+ *
+ * Each cycle lifts y_n, measures s_n = S(lambda) y_n at the window centre tau_n (W/2 before the
+ * end of the burst) and jumps y_{n+1} = e^(lambda dt_b) y_n + W_1 s_n + W_0 s_{n-1} with the
+ * weights of the line through (tau_{n-1}, s_{n-1}), (tau_n, s_n), tau_n - tau_{n-1} =
+ * dt_b + DT: W_1 = DT (a + h + DT/2)/h, W_0 = -DT (a + DT/2)/h, a = W/2, h = dt_b + DT
+ * (docs/error_control.md). Reduces to |G| of forward Euler as the previous slope's weight -> 0.
+ * \pre as cpi_amplification(), estimator least_squares.
+ */
+double ab2_cpi_amplification(const CpiCycle& cycle, double lambda);
 
 }  // namespace efdem::coarse

@@ -36,6 +36,10 @@ std::uint64_t CheckpointHeader::checksum() const {
     h = hash_value(driver.coarse_steps, h);
     h = hash_value(driver.without_progress, h);
     h = hash_value(driver.fell_back ? 1L : 0L, h);
+    if (format_version >= 2) {
+        h = fnv1a_array(driver.integrator, h);
+        h = hash_text(driver.integrator_text, h);
+    }
     for (const auto& o : outputs) {
         h = hash_text(o.name, h);
         h = hash_text(o.bytes, h);

@@ -12,6 +12,7 @@
 ///   /driver/integers        samples_taken, coarse_steps, without_progress, fell_back
 ///   /driver/lifting         R x 4: each realization's lifting random stream (xoshiro state)
 ///   /driver/observable, /driver/recorded   warm starts of the coarse observables
+///   /driver/integrator, /driver/integrator_text   the integrator's own state (version >= 2)
 ///   /output/<suffix>        the run's output files (HDF5, CSV) as they were at the checkpoint,
 ///                           named by what follows output.prefix (".h5", "_mean_icdf.csv", ...)
 ///   /realizations/...       per realization (global index order): meta (index, step,
@@ -30,7 +31,10 @@
 
 namespace efdem::mpi_driver {
 
-inline constexpr std::int64_t kCheckpointFormatVersion = 1;
+/// 2 added /driver/integrator and /driver/integrator_text (the multistep integrator's slope
+/// history and step-size controller); version 1 files (without them) are still read.
+inline constexpr std::int64_t kCheckpointFormatVersion = 2;
+inline constexpr std::int64_t kOldestReadableCheckpointFormat = 1;
 
 /// The root's state of the coarse layer (EnsembleStepper).
 struct StepperState {

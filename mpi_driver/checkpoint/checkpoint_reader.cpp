@@ -46,9 +46,9 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
                                                     : "is not an efdem checkpoint (no format_version attribute)");
         CheckpointHeader h;
         h.format_version = f.attribute_integer("/", "format_version");
-        if (h.format_version != kCheckpointFormatVersion)
-            refuse(path, fmt::format("has format version {}; this efdem reads version {}", h.format_version,
-                                     kCheckpointFormatVersion));
+        if (h.format_version < kOldestReadableCheckpointFormat || h.format_version > kCheckpointFormatVersion)
+            refuse(path, fmt::format("has format version {}; this efdem reads versions {} to {}", h.format_version,
+                                     kOldestReadableCheckpointFormat, kCheckpointFormatVersion));
         if (!f.has_attribute("/", "complete") || f.attribute_integer("/", "complete") != 1)
             refuse(path, "is incomplete: its writing was interrupted (use the previous checkpoint)");
         h.mode = f.attribute_text("/", "mode");
@@ -76,6 +76,10 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
                                          from_stored(lifting[r + 3])});
         h.stepper.observable = f.read_doubles("/driver/observable");
         h.stepper.recorded = f.read_doubles("/driver/recorded");
+        if (h.format_version >= 2) {
+            h.driver.integrator = f.read_doubles("/driver/integrator");
+            h.driver.integrator_text = f.read_text("/driver/integrator_text");
+        }
         for (const std::string& name : f.members("/output")) {
             const auto bytes = f.read_bytes("/output/" + name);
             h.outputs.push_back({name, std::string(bytes.begin(), bytes.end())});

@@ -207,6 +207,8 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     f.write("/driver/lifting", std::span<const std::int64_t>(lifting), {s.lifting.size(), 4});
     f.write("/driver/observable", std::span<const double>(s.observable), {s.observable.size()});
     f.write("/driver/recorded", std::span<const double>(s.recorded), {s.recorded.size()});
+    f.write("/driver/integrator", std::span<const double>(h.driver.integrator), {h.driver.integrator.size()});
+    f.write_text("/driver/integrator_text", h.driver.integrator_text);
     f.create_group("/output");
     for (const auto& o : h.outputs)
         f.write_bytes("/output/" + o.name, std::span<const std::uint8_t>(

@@ -65,6 +65,61 @@ void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
 
 void EnsembleStepper::finish() { broadcast({Command::finish, 0.0, false}); }
 
+void EnsembleStepper::keep_state() {
+    broadcast({Command::keep, 0.0, false});
+    do_keep();
+}
+
+void EnsembleStepper::return_to_kept_state() {
+    broadcast({Command::go_back, 0.0, false});
+    do_go_back();
+}
+
+void EnsembleStepper::confirm_kept_state() {
+    broadcast({Command::confirm, 0.0, false});
+    do_confirm();
+}
+
+void EnsembleStepper::do_keep() {
+    kept_.clear();
+    try {
+        for (const auto& r : local_) kept_.push_back(r->save_state());
+    } catch (const std::exception& e) {
+        fail(std::string("keeping the state before a projective jump: ") + e.what(), local_.front()->index());
+    }
+    kept_stepper_ = saved_state();
+    kept_sample_ = last_sample_;
+    pending_.clear();
+    provisional_ = true;
+}
+
+void EnsembleStepper::do_go_back() {
+    EFDEM_EXPECTS(provisional_ && kept_.size() == local_.size());
+    try {
+        for (std::size_t j = 0; j < local_.size(); ++j) local_[j]->restore_state(kept_[j]);
+    } catch (const std::exception& e) {
+        fail(std::string("going back to the state before a rejected jump: ") + e.what(), local_.front()->index());
+    }
+    // The rejected burst's work was done: it stays in the cost.
+    const double micro = micro_time_, steps = particle_steps_;
+    restore_state(kept_stepper_);
+    micro_time_ = micro;
+    particle_steps_ = steps;
+    last_sample_ = kept_sample_;
+    pending_.clear();
+    kept_.clear();
+    provisional_ = false;
+}
+
+void EnsembleStepper::do_confirm() {
+    EFDEM_EXPECTS(provisional_);
+    if (recorder_)
+        for (const SampleRecord& s : pending_) recorder_->sample(s);
+    pending_.clear();
+    kept_.clear();
+    provisional_ = false;
+}
+
 void EnsembleStepper::serve() {
     while (true) {
         const Message m = broadcast({Command::finish, 0.0, false});
@@ -72,13 +127,16 @@ void EnsembleStepper::serve() {
             case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
             case Command::lift: do_lift(m.value, m.top_half, nullptr); break;
             case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr); break;
+            case Command::keep: do_keep(); break;
+            case Command::go_back: do_go_back(); break;
+            case Command::confirm: do_confirm(); break;
             case Command::finish: return;
         }
     }
 }
 
 std::filesystem::path EnsembleStepper::checkpoint(long sequence, const DriverState& driver) {
-    EFDEM_EXPECTS(writer_ != nullptr);
+    EFDEM_EXPECTS(writer_ != nullptr && !provisional_);
     broadcast({Command::checkpoint, static_cast<double>(sequence), false});
     CheckpointHeader header;
     header.stepper = saved_state();
@@ -190,7 +248,10 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         if (observable_->restricts_members())
             out->members.push_back(observable_->restrict_members(all_icdf, all_top));
     }
-    if (recorder_) recorder_->sample(rec);
+    if (recorder_) {
+        if (provisional_) pending_.push_back(rec);  // recorded when the jump before it is kept
+        else recorder_->sample(rec);
+    }
     overhead_.restrict_seconds += MPI_Wtime() - start;
     ++overhead_.samples;
     if (progress_) progress_->update(rec.time, particle_steps_, "");

@@ -58,6 +58,15 @@ public:
     int realizations() const { return layout_.size(); }
     void run(double duration, coarse::BurstSamples& out) override;
     void lift(const Eigen::VectorXd& target, double new_time) override;
+    /// Every rank keeps its realizations' states in memory (RealizationState, as a checkpoint
+    /// does), the root its lifting streams and warm starts; samples are held back from the
+    /// recorder until confirm_kept_state() and dropped by return_to_kept_state(). The cost
+    /// counters (micro_time(), particle_steps()) keep counting the work that was discarded.
+    /// Per-realization VTK and thermo output of a discarded burst stays written.
+    bool can_keep_state() const override { return true; }
+    void keep_state() override;
+    void return_to_kept_state() override;
+    void confirm_kept_state() override;
 
     /// Root: write a whole-ensemble checkpoint numbered `sequence` with the driver's state
     /// (every rank joins through serve()). Needs set_checkpoint_writer(). Returns its path.
@@ -106,7 +115,7 @@ public:
     std::vector<std::unique_ptr<Realization>>& local() { return local_; }
 
 private:
-    enum class Command : int { run = 1, lift = 2, finish = 3, checkpoint = 4 };
+    enum class Command : int { run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7 };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
     /// exactly the collectives the root joins).
@@ -121,6 +130,9 @@ private:
     void take_sample(bool top_half, coarse::BurstSamples* out);
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header);
     [[noreturn]] void fail(const std::string& message, long realization) const;
+    void do_keep();
+    void do_go_back();
+    void do_confirm();
 
     const EnsembleLayout& layout_;
     std::vector<std::unique_ptr<Realization>> local_;
@@ -142,6 +154,11 @@ private:
     LiftRecord last_lift_;
     SampleRecord last_sample_;
     Overhead overhead_;
+    bool provisional_ = false;               ///< between keep_state() and its end
+    std::vector<RealizationState> kept_;     ///< every rank: its realizations' kept states
+    StepperState kept_stepper_;
+    SampleRecord kept_sample_;
+    std::vector<SampleRecord> pending_;      ///< root: samples since keep_state()
 };
 
 }  // namespace efdem::mpi_driver

@@ -36,7 +36,7 @@ CsvRecorder::CsvRecorder(const std::filesystem::path& dir, const std::string& pr
         fmt::print(steps_, "# efdem coarse projective steps; times in sqrt(d_p/g)\n"
                            "t_start,burst_length,healing,window,dt_requested,dt,period,status,"
                            "max_repair,clipped,labels_changed,stability_rate,stability_amplification,"
-                           "max_slope_se\n");
+                           "max_slope_se,error_statistical,error_truncation,tolerance,accepted\n");
         std::fflush(steps_);
     }
 }
@@ -57,10 +57,13 @@ void CsvRecorder::coarse_step(const coarse::ProjectiveStepRecord& r, const LiftR
     if (!steps_) return;
     long changed = 0;
     for (long c : lift.changed) changed += c;
-    fmt::print(steps_, "{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.6g},{},{},{:.6g},{:.6g},{:.6g}\n",
+    const coarse::ControllerRecord& c = r.controller;
+    fmt::print(steps_, "{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.6g},{},{},{:.6g},{:.6g},{:.6g},"
+                       "{:.6g},{:.6g},{:.6g},{}\n",
                r.t_start, r.burst_length, r.healing, r.window, r.dt_requested, r.dt, r.period,
                coarse::to_string(r.status), r.repair.max_adjustment, r.repair.n_clipped, changed,
-               r.stability.rate, r.stability.amplification, r.max_slope_standard_error());
+               r.stability.rate, r.stability.amplification, r.max_slope_standard_error(), c.statistical,
+               c.truncation, c.tolerance, c.active ? (c.accepted ? "1" : "0") : "");
     std::fflush(steps_);
 }
 

@@ -107,6 +107,24 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
     integer("stability_stable", rec.stability.stable ? 1 : 0);
     scalar("stability_rate", rec.stability.rate);
     scalar("stability_amplification", rec.stability.amplification);
+    if (const coarse::ControllerRecord& c = rec.controller; c.active) {
+        // /cpi/controller/*: one row per coarse step of the multistep integrator (every row of
+        // /cpi when it is the run's integrator). Errors RMS over the coarse vector [d_p].
+        if (!file_.exists("/cpi/controller")) file_.create_group("/cpi/controller");
+        auto cs = [&](const char* name, double v) { series(fmt::format("/cpi/controller/{}", name), {}, T::real).append(v); };
+        integer("controller/accepted", c.accepted ? 1 : 0);
+        integer("controller/steps", c.steps);
+        cs("tolerance", c.tolerance);
+        cs("error_statistical", c.statistical);
+        cs("error_truncation", c.truncation);
+        cs("predicted_truncation", c.predicted_truncation);
+        cs("dt_tolerance", c.dt_tolerance);
+        cs("dt_tolerance_2r", c.dt_tolerance_2r);
+        cs("dt_tolerance_4r", c.dt_tolerance_4r);
+        series("/cpi/controller/limited_by", {}, T::text).append_text(c.limited_by);
+        vec("controller/error_statistical_nodes", c.statistical_nodes);
+        vec("controller/error_truncation_nodes", c.truncation_nodes);
+    }
     std::vector<std::int64_t> changed(static_cast<std::size_t>(realizations_), 0);
     std::vector<double> deviation(static_cast<std::size_t>(realizations_), std::numeric_limits<double>::quiet_NaN());
     std::string messages;
@@ -130,6 +148,7 @@ void Hdf5Recorder::finish(const RunSummary& s) {
     file_.attribute("/", "coarse_steps", std::int64_t{s.coarse_steps});
     file_.attribute("/", "restrict_seconds", s.restrict_seconds);
     file_.attribute("/", "lift_seconds", s.lift_seconds);
+    if (!s.controller.empty()) file_.write_text("/cpi/controller_summary", s.controller);
     file_.flush();
 }
 

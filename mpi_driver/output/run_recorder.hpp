@@ -44,6 +44,9 @@ struct RunSummary {
     std::string end_status;      ///< "completed", or why the run stopped
     double restrict_seconds = 0; ///< root wall time in restriction (observe, gather, average, record)
     double lift_seconds = 0;     ///< root wall time in lifting (gather, compute, scatter, apply)
+    /// Adaptive CPI: what the controller did and what more realizations would buy (text lines;
+    /// empty otherwise).
+    std::string controller;
 };
 
 class RunRecorder {

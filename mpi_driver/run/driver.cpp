@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "coarse/equation_free/multistep_projective_integrator.hpp"
 #include "coarse/equation_free/projective_run.hpp"
 #include "core/log.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
@@ -34,7 +35,9 @@ void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress
 }  // namespace
 
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress, const RunControl& control) {
-    const DriverState state = control.resume.value_or(DriverState{stepper.time()});
+    DriverState state;
+    state.t_origin = stepper.time();
+    if (control.resume) state = *control.resume;
     const double t_end = state.t_origin + s.duration;
     const long total = std::lround(s.duration / s.observe.interval);
     long done = stepper.samples_taken();
@@ -91,6 +94,10 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     sum.simulated_time = out.simulated_time;
     fill_totals(sum, stepper, progress);
     sum.lift_seconds = stepper.overhead().lift_seconds;
+    if (const auto* m = dynamic_cast<const coarse::MultistepProjectiveIntegrator*>(&run.integrator())) {
+        sum.controller = m->summary(stepper.realizations());
+        log::info("{}", sum.controller);
+    }
     return sum;
 }
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "coarse/demixing/observable_table.hpp"
+#include "coarse/demixing/probability_grid.hpp"
 #include "core/whole_multiple.hpp"
 
 namespace efdem::mpi_driver {
@@ -64,6 +65,23 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.injected_failure.realization = debug.get_or<long>("fail_realization", -1);
     s.injected_failure.time = debug.get_or<double>("fail_time", 0.0);
     return s;
+}
+
+void RunSettings::check_ensemble(const Params& root, int realizations) const {
+    if (!is_cpi() || cpi.projection != coarse::CoarseRunSettings::Projection::adaptive) return;
+    const Params c = root.scope("cpi");
+    if (realizations < 2)
+        c.fail("projection",
+               fmt::format("needs at least 2 realizations to measure the statistical error of the slope from their "
+                           "spread; this run has {} (ranks x ensemble.realizations_per_rank)", realizations),
+               "fixed or periods with one realization; adaptive with >= 2 (more ranks or "
+               "ensemble.realizations_per_rank)");
+    const coarse::ProbabilityGrid grid(observe.quantiles);
+    const auto* row = coarse::observable_table().find(observable);
+    if (row && !row->make(grid)->restricts_members())
+        c.fail("observable", "cannot restrict a realization on its own, and cpi.projection = adaptive needs every "
+                             "realization's own slope",
+               "icdf with cpi.projection = adaptive");
 }
 
 }  // namespace efdem::mpi_driver

@@ -80,6 +80,11 @@ struct RunSettings {
 
     /// Reads and cross-checks the run keys (dt and species come from the DEM scene).
     static RunSettings from_params(const Params& root, const dem::DemScene& scene);
+    /// What the settings need of the ensemble they run on: an InputError naming the key when
+    /// `realizations` (ranks x ensemble.realizations_per_rank) cannot serve them (adaptive CPI
+    /// measures its statistical error from the spread of >= 2 realizations' own slopes, on an
+    /// observable that restricts each realization).
+    void check_ensemble(const Params& root, int realizations) const;
 };
 
 }  // namespace efdem::mpi_driver

@@ -17,6 +17,12 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
     if (r.lifted) s += fmt::format(", {} labels changed", changed);
     if (r.repair.changed()) s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
     if (r.slope_standard_error.size() > 0) s += fmt::format(", slope s.e. max {:.3g}", r.max_slope_standard_error());
+    if (const coarse::ControllerRecord& c = r.controller; c.adaptive && r.lifted)
+        s += fmt::format(", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}), DT set by {}",
+                         c.error(), c.error() / c.tolerance, c.statistical, c.truncation, c.limited_by);
+    else if (c.active && r.lifted)
+        s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})", c.error(),
+                         c.statistical, c.truncation);
     if (!r.message.empty()) s += " [" + r.message + "]";
     return s;
 }

@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include <optional>
+#include <random>
 #include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
@@ -124,6 +126,85 @@ class MemberTrendStepper final : public coarse::CoarseStepper {
     SineTrendStepper common_;
     Eigen::MatrixXd d_;
     Eigen::VectorXd d_mean_;
+};
+
+/**
+ * \brief An ensemble of R Ornstein-Uhlenbeck processes in m components,
+ *        dY_r = -k (.) Y_r dt + sigma dW_r, advanced exactly over each sampling interval h:
+ *        Y(t+h) = e^(-k h) Y(t) + sigma sqrt((1 - e^(-2 k h))/(2 k)) xi.
+ *
+ * The ensemble mean obeys dX/dt = -k (.) X in expectation (sigma = 0: exactly), so the exact
+ * coarse flow from X is e^(-k DT) X. A lift sets every member to the target (the spread
+ * collapses, as colour lifting does). Samples carry the members. keep_state() and
+ * return_to_kept_state() save and restore everything, the random streams included.
+ */
+class OuEnsembleStepper final : public coarse::CoarseStepper {
+  public:
+    OuEnsembleStepper(Eigen::VectorXd rates, double sigma, int members, double h, const Eigen::VectorXd& x0,
+                      std::uint64_t seed)
+        : k_(std::move(rates)), sigma_(sigma), h_(h), y_(members, k_.size()) {
+        for (int r = 0; r < members; ++r) {
+            y_.row(r) = x0.transpose();
+            rng_.emplace_back(seed * 1000 + static_cast<std::uint64_t>(r));
+        }
+    }
+    double time() const override { return t_; }
+    void run(double duration, coarse::BurstSamples& out) override {
+        const long n = std::lround(duration / h_);
+        const Eigen::ArrayXd decay = (-k_.array() * h_).exp();
+        const Eigen::ArrayXd amp = sigma_ * ((1.0 - (-2.0 * k_.array() * h_).exp()) / (2.0 * k_.array())).sqrt();
+        std::normal_distribution<double> normal;
+        for (long s = 0; s < n; ++s) {
+            for (Eigen::Index r = 0; r < y_.rows(); ++r)
+                for (Eigen::Index i = 0; i < y_.cols(); ++i)
+                    y_(r, i) = decay[i] * y_(r, i) + amp[i] * normal(rng_[static_cast<std::size_t>(r)]);
+            ++steps_;
+            t_ = t_lift_ + static_cast<double>(steps_) * h_;
+            out.t.push_back(t_);
+            out.x.push_back(y_.colwise().mean().transpose());
+            out.members.push_back(y_);
+        }
+        work_ += static_cast<double>(n) * h_;
+    }
+    void lift(const Eigen::VectorXd& target, double new_time) override {
+        y_.rowwise() = target.transpose();
+        t_lift_ = t_ = new_time;
+        steps_ = 0;
+        ++lifts_;
+    }
+    bool can_keep_state() const override { return true; }
+    void keep_state() override { kept_.emplace(Kept{t_, t_lift_, steps_, y_, rng_}); }
+    void return_to_kept_state() override {
+        t_ = kept_->t;
+        t_lift_ = kept_->t_lift;
+        steps_ = kept_->steps;
+        y_ = kept_->y;
+        rng_ = kept_->rng;
+        kept_.reset();
+    }
+    void confirm_kept_state() override { kept_.reset(); }
+
+    Eigen::VectorXd mean() const { return y_.colwise().mean().transpose(); }
+    const Eigen::VectorXd& rates() const { return k_; }
+    double work() const { return work_; }  ///< micro time run, discarded bursts included
+    int lifts() const { return lifts_; }
+
+  private:
+    struct Kept {
+        double t, t_lift;
+        long steps;
+        Eigen::MatrixXd y;
+        std::vector<std::mt19937_64> rng;
+    };
+    Eigen::VectorXd k_;
+    double sigma_, h_;
+    Eigen::MatrixXd y_;
+    std::vector<std::mt19937_64> rng_;
+    double t_ = 0.0, t_lift_ = 0.0;
+    long steps_ = 0;
+    double work_ = 0.0;
+    int lifts_ = 0;
+    std::optional<Kept> kept_;
 };
 
 }  // namespace efdem::test

@@ -1,0 +1,298 @@
+// The multistep projective integrator and its error controller (docs/error_control.md) on toy
+// steppers, without MPI or DEM: the slope-model formulas, the order of forward Euler and
+// Adams-Bashforth 2 in a convergence test, the Adams-Bashforth 2 amplification factor against
+// the implementation, the measured error of adaptive jumps on a noisy SDE inside the band the
+// controller predicts, reject-and-redo leaving no trace, and a bit-exact resume.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/multistep_projection.hpp"
+#include "coarse/equation_free/multistep_projective_integrator.hpp"
+#include "coarse/equation_free/projective_stability.hpp"
+#include "coarse/equation_free/step_size_controller.hpp"
+#include "tests/coarse/toy_steppers.hpp"
+
+using namespace efdem;
+using namespace efdem::coarse;
+
+namespace {
+
+SlopeNode node(double tau, Eigen::VectorXd s, double se = 0.0) {
+    Eigen::VectorXd e = Eigen::VectorXd::Constant(s.size(), se);
+    return {tau, std::move(s), std::move(e)};
+}
+
+Eigen::VectorXd rates19() {
+    Eigen::VectorXd k(19);
+    for (int i = 0; i < 19; ++i) k[i] = 0.01 + 0.04 * i / 18.0;
+    return k;
+}
+
+/// Runs `integrator` on `stepper` until `t_end`; returns the records.
+template <class Stepper>
+std::vector<ProjectiveStepRecord> run_to(MultistepProjectiveIntegrator& integrator, Stepper& stepper, double t_end) {
+    integrator.set_end_time(t_end);
+    std::vector<ProjectiveStepRecord> out;
+    const double burst = integrator.settings().healing + integrator.settings().window;
+    while (stepper.time() < t_end - 1e-9 && t_end - stepper.time() >= burst - 1e-9) {
+        out.push_back(integrator.step(stepper));
+        REQUIRE(out.back().advanced());
+    }
+    return out;
+}
+
+MultistepSettings fixed_settings(int steps, double dt) {
+    MultistepSettings s;
+    s.healing = 0.0;
+    s.window = 0.2;
+    s.steps = steps;
+    s.adaptive = false;
+    s.dt = dt;
+    return s;
+}
+
+/// Global error at t = 60 of fixed-DT projective integration of dX/dt = -k X (exact micro
+/// model, no noise), RMS over the components.
+double global_error(int steps, double dt) {
+    const Eigen::VectorXd k = rates19();
+    const Eigen::VectorXd x0 = Eigen::VectorXd::Constant(19, 3.0);
+    test::OuEnsembleStepper toy(k, 0.0, 2, 0.05, x0, 1);
+    MultistepProjectiveIntegrator integrator(fixed_settings(steps, dt));
+    run_to(integrator, toy, 60.0);
+    REQUIRE(toy.time() == Approx(60.0).margin(1e-9));
+    const Eigen::VectorXd exact = ((-k.array() * 60.0).exp() * x0.array()).matrix();
+    return rms(toy.mean() - exact);
+}
+
+}  // namespace
+
+TEST_CASE("projection weights integrate the slope model exactly", "[unit][coarse][multistep]") {
+    const Eigen::VectorXd s0 = Eigen::VectorXd::Constant(1, 1.0), s1 = Eigen::VectorXd::Constant(1, 2.0);
+    const std::vector<SlopeNode> one{node(5.0, s1)};
+    CHECK(projection_weights(one, 10.0, 4.0) == std::vector<double>{4.0});
+    // Line through (0, 1) and (5, 2): s(t) = 1 + t/5; integral over [10, 14] = 4 + (196 - 100)/10.
+    const std::vector<SlopeNode> two{node(0.0, s0), node(5.0, s1)};
+    const auto w = projection_weights(two, 10.0, 4.0);
+    CHECK(w[0] + w[1] == Approx(4.0).epsilon(1e-14));
+    CHECK(projected_increment(two, w)[0] == Approx(4.0 + 9.6).epsilon(1e-13));
+    // omega = (t - 0)(t - 5) over [10, 14]: [t^3/3 - 5 t^2/2] = 1232/3 - 240 = 520/3... exactly:
+    CHECK(omega_integral(two, 10.0, 4.0) == Approx((14.0 * 14 * 14 - 1000.0) / 3.0 - 2.5 * (196.0 - 100.0)).epsilon(1e-13));
+    // Noise: W0^2 se0^2 + W1^2 se1^2.
+    const std::vector<SlopeNode> noisy{node(0.0, s0, 0.1), node(5.0, s1, 0.2)};
+    CHECK(statistical_error(noisy, w)[0] == Approx(std::hypot(w[0] * 0.1, w[1] * 0.2)).epsilon(1e-14));
+}
+
+TEST_CASE("the divided difference's norm removes the slopes' noise", "[unit][coarse][multistep]") {
+    // Exact slopes of a quadratic X: s = 2 a t; first divided difference 2a, no noise.
+    const Eigen::VectorXd a = Eigen::VectorXd::LinSpaced(5, 0.1, 0.5);
+    const std::vector<SlopeNode> exact{node(2.0, 4.0 * a), node(7.0, 14.0 * a)};
+    const DividedDifference d = slope_divided_difference(exact);
+    CHECK((d.value - 2.0 * a).norm() < 1e-14);
+    CHECK(d.norm == Approx(2.0 * rms(a)).epsilon(1e-14));
+    // Pure noise (no curvature): the mean of norm^2 over many draws is ~0, while the raw RMS of
+    // the difference is the noise level sqrt(2) se / 5. 2000 draws of 19 components: the mean
+    // of norm^2 has a relative s.d. ~ sqrt(2/(19 x 2000)) of the raw level; 0.05 is > 5 s.d.
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> normal(0.0, 0.3);
+    double mean_norm2 = 0.0, mean_raw2 = 0.0;
+    for (int draw = 0; draw < 2000; ++draw) {
+        Eigen::VectorXd x(19), y(19);
+        for (int i = 0; i < 19; ++i) {
+            x[i] = normal(rng);
+            y[i] = normal(rng);
+        }
+        const std::vector<SlopeNode> noise{node(0.0, x, 0.3), node(5.0, y, 0.3)};
+        const DividedDifference n = slope_divided_difference(noise);
+        mean_norm2 += n.norm * n.norm / 2000;
+        mean_raw2 += n.value.squaredNorm() / 19 / 2000;
+    }
+    const double level = 2.0 * 0.09 / 25.0;
+    CHECK(mean_raw2 == Approx(level).epsilon(0.05));
+    CHECK(mean_norm2 < 0.5 * level);  // the positive part of a zero-mean excess: ~0.23 level
+}
+
+TEST_CASE("largest_dt_within returns the DT whose error is the target", "[unit][coarse][multistep]") {
+    JumpErrorModel m{{node(0.0, Eigen::VectorXd::Constant(3, 1.0), 0.01)}, 5.0, 1e-3, 1.0};
+    const double dt = largest_dt_within(m, 0.5, 1000.0);
+    CHECK(jump_error(m, dt).total() == Approx(0.5).epsilon(1e-5));
+    CHECK(jump_error(m, 2.0 * dt).total() > 0.5);
+    CHECK(largest_dt_within(m, 0.5, 1.0) == 1.0);  // the cap
+    // Twice the realizations: standard errors / sqrt(2), a longer DT.
+    m.se_scale = 1.0 / std::sqrt(2.0);
+    CHECK(largest_dt_within(m, 0.5, 1000.0) > dt);
+}
+
+TEST_CASE("projective forward Euler is first order and Adams-Bashforth 2 second order in DT",
+          "[unit][coarse][multistep]") {
+    // Halving DT (bursts of 0.2, so the jumps dominate) divides the global error by 2^order.
+    // Asymptotic ratios 2 and 4; at DT = 4 down to 1 (k DT <= 0.2) the next term changes them
+    // by ~ k DT, i.e. by up to 20 %: ranges [1.7, 2.3] and [3.3, 4.7].
+    const double e1[] = {global_error(1, 4.0), global_error(1, 2.0), global_error(1, 1.0)};
+    const double e2[] = {global_error(2, 4.0), global_error(2, 2.0), global_error(2, 1.0)};
+    INFO("euler " << e1[0] << " " << e1[1] << " " << e1[2] << "; ab2 " << e2[0] << " " << e2[1] << " " << e2[2]);
+    for (int i = 0; i < 2; ++i) {
+        CHECK(e1[i] / e1[i + 1] > 1.7);
+        CHECK(e1[i] / e1[i + 1] < 2.3);
+        CHECK(e2[i] / e2[i + 1] > 3.3);
+        CHECK(e2[i] / e2[i + 1] < 4.7);
+    }
+    CHECK(e2[2] < 0.1 * e1[2]);
+}
+
+TEST_CASE("the Adams-Bashforth 2 amplification factor is what the integrator does", "[unit][coarse][multistep]") {
+    // One exactly integrated mode x' = lambda x, sampled every 0.01 (the formula's window is
+    // continuous: the discrete least-squares slope differs by O(h/W) ~ 0.1 %). The growth per
+    // cycle over 30 cycles against the dominant root |mu|: within 1 %.
+    for (const double lambda : {-0.01, -0.05, -0.2}) {
+        const double h = 0.01;
+        Eigen::MatrixXd p(1, 1);
+        p(0, 0) = std::exp(lambda * h);
+        test::LinearToyStepper toy(p, h, Eigen::VectorXd::Constant(1, 1.0));
+        MultistepSettings s;
+        s.healing = 10.0;
+        s.window = 10.0;
+        s.steps = 2;
+        s.adaptive = false;
+        s.dt = 20.0;
+        MultistepProjectiveIntegrator ab2(s);
+        std::vector<double> x;
+        for (int n = 0; n < 40; ++n) {
+            const ProjectiveStepRecord r = ab2.step(toy);
+            x.push_back(std::abs(r.x_projected[0]));
+        }
+        const double measured = std::pow(x[39] / x[9], 1.0 / 30.0);
+        const CpiCycle cycle{SlopeEstimator::least_squares, 20.0, 10.0, 20.0, 2};
+        INFO("lambda " << lambda);
+        CHECK(measured == Approx(ab2_cpi_amplification(cycle, lambda)).epsilon(0.01));
+    }
+    // Slow modes: both schemes follow the exact e^(lambda (dt_b + DT)) to O(lambda^2).
+    const CpiCycle cycle{SlopeEstimator::least_squares, 20.0, 10.0, 80.0, 2};
+    CHECK(cpi_amplification(cycle, -0.001) == Approx(std::exp(-0.1)).epsilon(2e-3));
+}
+
+TEST_CASE("adaptive jumps on a noisy SDE add the error the controller predicts", "[unit][coarse][multistep]") {
+    // 8 OU members in 19 components (rates 0.002..0.01, sigma 0.005) around an exponentially
+    // decaying mean: DT ~ 10, statistical and truncation parts of similar size. Every jump's true
+    // error is X_proj - e^(-k DT) X_end (the exact mean flow from where it started). Its RMS
+    // over 19 components concentrates near its expectation, which the controller's statistical
+    // part estimates (the s.e. from 8 members has a relative s.d. ~ 1/sqrt(14) per component,
+    // averaged over 19); so the ratio true/predicted is ~1 with a spread of ~0.2: median in
+    // [0.6, 1.4], and at least 85 % of the kept jumps within 1.5 x the tolerance.
+    Eigen::VectorXd k(19);
+    for (int i = 0; i < 19; ++i) k[i] = 0.002 + 0.008 * i / 18.0;
+    std::vector<double> ratio;
+    long within = 0, kept = 0, rejected = 0;
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        test::OuEnsembleStepper toy(k, 0.005, 8, 0.1, Eigen::VectorXd::Constant(19, 3.0), seed);
+        MultistepSettings s;
+        s.healing = 2.0;
+        s.window = 4.0;
+        s.control.tolerance = 0.02;
+        s.control.dt_min = 2.0;
+        s.control.dt_max = 60.0;
+        MultistepProjectiveIntegrator integrator(s);
+        for (const ProjectiveStepRecord& r : run_to(integrator, toy, 300.0)) {
+            if (r.status == StepStatus::rejected) ++rejected;
+            if (r.status != StepStatus::projected) continue;
+            const Eigen::VectorXd exact = ((-k.array() * r.dt).exp() * r.x_end.array()).matrix();
+            const double e = rms(r.x_projected - exact);
+            ratio.push_back(e / r.controller.error());
+            within += e <= 1.5 * s.control.tolerance;
+            ++kept;
+        }
+    }
+    std::sort(ratio.begin(), ratio.end());
+    INFO(kept << " jumps kept, " << rejected << " rejected");
+    REQUIRE(kept >= 30);
+    CHECK(ratio[ratio.size() / 2] > 0.6);
+    CHECK(ratio[ratio.size() / 2] < 1.4);
+    CHECK(static_cast<double>(within) >= 0.85 * static_cast<double>(kept));
+}
+
+TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone", "[unit][coarse][multistep]") {
+    // A fast mode (k = 0.3) with no noise, a first jump allowed up to 40: its curvature makes
+    // the first jump far too long; the burst after it shows it, the step is redone shorter.
+    Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.3);
+    test::OuEnsembleStepper toy(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(3, 3.0), 1);
+    MultistepSettings s;
+    s.healing = 1.0;
+    s.window = 2.0;
+    s.first_dt = 40.0;
+    s.control = {.tolerance = 0.01, .dt_min = 0.1, .dt_max = 40.0};
+    MultistepProjectiveIntegrator integrator(s);
+    const auto records = run_to(integrator, toy, 30.0);
+    REQUIRE(records.size() >= 3);
+    CHECK(records[0].status == StepStatus::burst_only);
+    CHECK(records[1].status == StepStatus::rejected);
+    CHECK(records[1].controller.truncation > s.control.tolerance);
+    CHECK(records[2].t_end == records[1].t_end);  // the redo starts where the rejected jump did
+    CHECK(records[2].dt < records[1].dt);
+    CHECK(integrator.totals().rejected >= 1);
+    // Every kept jump's true error is within 2x its tolerance (the a posteriori estimate of a
+    // kept jump is <= the tolerance; its truncation model is exact to the next order).
+    for (const auto& r : records)
+        if (r.status == StepStatus::projected) {
+            const Eigen::VectorXd exact = ((-k.array() * r.dt).exp() * r.x_end.array()).matrix();
+            CHECK(rms(r.x_projected - exact) < 2.0 * s.control.tolerance);
+        }
+}
+
+TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the shorter DT", "[unit][coarse][multistep]") {
+    Eigen::VectorXd k(19);
+    for (int i = 0; i < 19; ++i) k[i] = 0.002 + 0.008 * i / 18.0;
+    auto run = [&](ForcedDecision::Kind kind, double& work) {
+        test::OuEnsembleStepper toy(k, 0.005, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 3);
+        MultistepSettings s;
+        s.healing = 2.0;
+        s.window = 4.0;
+        s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 60.0};
+        s.force = {kind, 3};
+        MultistepProjectiveIntegrator integrator(s);
+        const auto records = run_to(integrator, toy, 200.0);
+        work = toy.work();
+        long forced = 0;
+        for (const auto& r : records) forced += r.message.find("(forced)") != std::string::npos;
+        CHECK(forced == 1);
+        return toy.mean();
+    };
+    double work_reject = 0, work_shrink = 0;
+    const Eigen::VectorXd a = run(ForcedDecision::Kind::reject, work_reject);
+    const Eigen::VectorXd b = run(ForcedDecision::Kind::shrink, work_shrink);
+    CHECK((a.array() == b.array()).all());   // bit for bit
+    CHECK(work_reject == Approx(work_shrink + 6.0));  // the discarded burst was paid for
+}
+
+TEST_CASE("an adaptive run resumed from the saved integrator state continues bit for bit", "[unit][coarse][multistep]") {
+    const Eigen::VectorXd k = rates19();
+    MultistepSettings s;
+    s.healing = 2.0;
+    s.window = 4.0;
+    s.steps = 2;
+    s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 60.0};
+    test::OuEnsembleStepper toy(k, 0.05, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
+    MultistepProjectiveIntegrator a(s);
+    a.set_end_time(300.0);
+    for (int i = 0; i < 6; ++i) REQUIRE(a.step(toy).advanced());
+    std::vector<double> reals;
+    std::string text;
+    a.save_state(reals, text);
+    test::OuEnsembleStepper copy = toy;
+    MultistepProjectiveIntegrator b(s);
+    b.restore_state(reals, text);
+    b.set_end_time(300.0);
+    for (int i = 0; i < 8; ++i) {
+        const ProjectiveStepRecord ra = a.step(toy), rb = b.step(copy);
+        CHECK(ra.dt == rb.dt);
+        CHECK(to_string(ra.status) == to_string(rb.status));
+    }
+    CHECK((toy.mean().array() == copy.mean().array()).all());
+    std::vector<double> again;
+    b.save_state(again, text);
+    a.save_state(reals, text);
+    CHECK(again == reals);
+}
