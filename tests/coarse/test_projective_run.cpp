@@ -258,3 +258,50 @@ TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings",
     CHECK_THAT(e, Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.window") &&
                       Catch::Contains("holds 2 samples; a slope needs at least 3"));
 }
+
+TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive would ignore", "[unit][coarse][run]") {
+    ParamTable table = ParamTable::from_text(
+        "cpi.projection = adaptive\ncpi.integrator = adams_bashforth2\ncpi.healing = 4\ncpi.window = 6\n"
+        "cpi.tolerance = 0.05\ncpi.dt_max = 60\n",
+        "scene.cfg", "/scenes");
+    const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.5);
+    CHECK(s.projection == CoarseRunSettings::Projection::adaptive);
+    CHECK(s.multistep.adaptive);
+    CHECK(s.multistep.steps == 2);
+    CHECK(s.multistep.control.tolerance == 0.05);
+    CHECK(s.multistep.control.dt_min == 5.0);  // default: half a burst
+    CHECK(s.multistep.control.dt_max == 60.0);
+    CHECK(s.multistep.dt_quantum == 0.5);
+    CHECK(std::isnan(s.multistep.first_dt));
+    CHECK(s.make_integrator({})->name() == "adaptive_adams_bashforth2");
+
+    // Fixed DT with Adams-Bashforth 2: the multistep integrator without the controller.
+    ParamTable ab2 = ParamTable::from_text("cpi.integrator = adams_bashforth2\ncpi.dt = 40\n", "scene.cfg", "/scenes");
+    const CoarseRunSettings f = CoarseRunSettings::from_params(ab2.root().scope("cpi"), 0.5);
+    CHECK(!f.multistep.adaptive);
+    CHECK(f.multistep.dt == 40.0);
+    CHECK(f.make_integrator({})->name() == "projective_adams_bashforth2");
+
+    auto refused = [](const std::string& text) {
+        ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
+        return std::string(test::input_error([&] { CoarseRunSettings::from_params(t.root().scope("cpi"), 0.5); }).what());
+    };
+    // Each message names the key, the file and line, and what is allowed.
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.tolerance"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = -1\n"), Catch::Contains("cpi.tolerance"));
+    CHECK_THAT(refused("cpi.projection = adaptive\n"), Catch::Contains("cpi.tolerance"));  // required
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 50\ncpi.dt_max = 20\n"),
+               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.dt_min") && Catch::Contains("cpi.dt_max = 20"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.periods = 2\n"),
+               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.periods") &&
+                   Catch::Contains("not read with cpi.projection = adaptive"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt = 500\n"),
+               Catch::Contains("cpi.dt") && Catch::Contains("caps the first jump"));
+    CHECK_THAT(refused("cpi.projection = fixed\ncpi.tolerance = 0.1\n"),
+               Catch::Contains("cpi.tolerance") && Catch::Contains("only with cpi.projection = adaptive"));
+    CHECK_THAT(refused("cpi.projection = periods\ncpi.integrator = adams_bashforth2\n"),
+               Catch::Contains("cpi.integrator") && Catch::Contains("periods"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 0.3\n"),
+               Catch::Contains("cpi.dt_min"));  // not a whole multiple of the sampling interval
+}
