@@ -82,6 +82,7 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
                                      c.dt_max));
             m.first_dt = s.fixed.dt;
         }
+        m.drift_rate = c.tolerance / burst;  // the phase signal moves less than the tolerance per burst
         const Params debug = cpi.scope("debug");
         const std::string force = debug.get_or_choice("force", "none", {"none", "reject", "shrink"});
         m.force.kind = force == "reject"   ? ForcedDecision::Kind::reject
@@ -89,6 +90,10 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
                                            : ForcedDecision::Kind::none;
         m.force.attempt = debug.get_or<long>("force_attempt", 1, Bounds::closed(1, 1000000));
     }
+    s.warmup_until_steady = cpi.get_or_choice("warmup_until", adaptive ? "steady" : "time", {"time", "steady"}) == "steady";
+    s.warmup_max = cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::non_negative());
+    whole_multiple(cpi, "warmup_max", s.warmup_max, sample_interval, interval);
+    s.drift_rate = adaptive ? m.drift_rate : 0.0;
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
     return s;

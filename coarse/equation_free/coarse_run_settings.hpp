@@ -9,7 +9,10 @@
 /// |-------------------|---------------------------------------------------------------|---------|
 /// | cpi.projection    | `fixed` (DT = cpi.dt), `periods` (DT = k T) or `adaptive`     | fixed   |
 /// | cpi.integrator    | `euler` or `adams_bashforth2` (fixed, adaptive)               | euler   |
-/// | cpi.warmup        | direct simulation before the first coarse step                | 0       |
+/// | cpi.warmup        | direct simulation before the first coarse step (lower bound)  | 0       |
+/// | cpi.warmup_until  | `time` (cpi.warmup exactly) or `steady`: on until the phase    | adaptive:|
+/// |                   | signal (bed centre of mass) no longer drifts (phase_drift.hpp) | steady  |
+/// | cpi.warmup_max    | steady: most time the warm-up may run beyond cpi.warmup       | 10 burst|
 /// | cpi.healing       | start of each burst left out of the slope                     | 10      |
 /// | cpi.window        | estimation window after healing (>= 3 samples)                | 10      |
 /// | cpi.dt            | projective step DT (projection = fixed)                       | 80      |
@@ -43,6 +46,13 @@ struct CoarseRunSettings {
     /// Direct simulation before the first coarse step (the packed start is not on the slow
     /// manifold).
     double warmup = 0.0;
+    /// Warm-up on evidence: after `warmup`, go on in windows until the phase signal's drift is
+    /// within its noise (or slower than `drift_rate`), at most `warmup_max` longer.
+    bool warmup_until_steady = false;
+    double warmup_max = 0.0;
+    /// A drift of the phase signal this slow counts as steady [unit per sqrt(d_p/g)]:
+    /// cpi.tolerance per burst length (adaptive), 0 otherwise.
+    double drift_rate = 0.0;
     /// Projection = fixed: healing, window, DT, stability policy.
     ProjectiveEulerSettings fixed;
     /// Projection = periods: healing, window, k, burst extension, stability policy.

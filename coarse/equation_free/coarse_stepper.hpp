@@ -27,6 +27,10 @@ struct BurstSamples {
     /// is measured from (member_slope_standard_error()). Either empty (the stepper has no
     /// members, or cannot restrict one on its own) or one matrix per sample.
     std::vector<Eigen::MatrixXd> members;
+    /// The members' own phase signals at each time (R values, realization order), whose mean is
+    /// phase_signal: what the drift of a fast transient is judged from (phase_drift.hpp).
+    /// Either empty or one vector per sample.
+    std::vector<Eigen::VectorXd> member_phase;
 
     std::size_t size() const { return t.size(); }
 };

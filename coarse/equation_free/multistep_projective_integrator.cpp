@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/equation_free/phase_drift.hpp"
 #include "coarse/equation_free/projective_jump.hpp"
 #include "coarse/equation_free/slope_estimators.hpp"
 #include "coarse/equation_free/step_size_controller.hpp"
@@ -74,6 +75,11 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     out.t_end = check.t_end;
     out.x_end = check.x_end;
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
+    if (settings_.adaptive && std::isfinite(settings_.drift_rate)) {
+        const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
+        out.drifting = d.drifting;
+        out.drift = d.message;
+    }
     rec.window = slope.t_last - slope.t_first;
     return true;
 }
@@ -84,6 +90,8 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
     t_end_ = m.t_end;
     x_end_ = m.x_end;
     decay_ = m.decay;
+    drifting_ = m.drifting;
+    drift_ = m.drift;
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -110,6 +118,11 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         return std::min(settings_.dt, end_limit(settings_.dt));
     }
     const StepSizeSettings& s = settings_.control;
+    if (drifting_) {  // the slope is the fast transient's, not the slow dynamics'
+        append_message(rec, "still in a fast transient (" + drift_ + "): one burst of direct simulation");
+        c.limited_by = "fast transient";
+        return 0.0;
+    }
     const double target = s.safety * s.tolerance;
     c.dt_tolerance = largest_dt_within(model, target, s.dt_max);
     model.se_scale = 1.0 / std::sqrt(2.0);
@@ -336,7 +349,7 @@ void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::stri
     const Eigen::Index m = x_end_.size();
     r.insert(r.end(), {1.0 /* layout version */, static_cast<double>(history_.size()), static_cast<double>(m), t_end_,
                        dt_last_, dt_cap_, static_cast<double>(consecutive_rejections_), decay_.ok ? 1.0 : 0.0,
-                       decay_.rate, decay_.ratio, decay_.delay});
+                       decay_.rate, decay_.ratio, decay_.delay, drifting_ ? 1.0 : 0.0});
     r.insert(r.end(), x_end_.data(), x_end_.data() + m);
     for (const auto& n : history_) {
         r.push_back(n.tau);
@@ -347,16 +360,16 @@ void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::stri
     r.insert(r.end(), {static_cast<double>(t.attempts), static_cast<double>(t.accepted), static_cast<double>(t.rejected),
                        static_cast<double>(t.direct), t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r,
                        t.dt_tolerance_4r, t.statistical, t.truncation});
-    text = decay_.message;
+    text = decay_.message + '\n' + drift_;
 }
 
 void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, const std::string& text) {
     history_.clear();
     if (r.empty()) return;  // saved before the first burst
-    EFDEM_EXPECTS(r.size() >= 11 && r[0] == 1.0);
+    EFDEM_EXPECTS(r.size() >= 12 && r[0] == 1.0);
     const auto n = static_cast<std::size_t>(r[1]);
     const auto m = static_cast<Eigen::Index>(r[2]);
-    EFDEM_EXPECTS(r.size() == 11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10);
+    EFDEM_EXPECTS(r.size() == 12 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10);
     t_end_ = r[3];
     dt_last_ = r[4];
     dt_cap_ = r[5];
@@ -365,8 +378,11 @@ void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, 
     decay_.rate = r[8];
     decay_.ratio = r[9];
     decay_.delay = r[10];
-    decay_.message = text;
-    std::size_t k = 11;
+    drifting_ = r[11] != 0.0;
+    const std::size_t cut = text.find('\n');
+    decay_.message = text.substr(0, cut);
+    drift_ = cut == std::string::npos ? std::string{} : text.substr(cut + 1);
+    std::size_t k = 12;
     auto vec = [&] {
         Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(r.data() + k, m);
         k += static_cast<std::size_t>(m);

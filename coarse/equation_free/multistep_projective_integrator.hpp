@@ -72,6 +72,10 @@ struct MultistepSettings {
     /// adaptive = false: what a flagged DT does (adaptive always shortens DT until stable).
     StabilityPolicy stability_policy = StabilityPolicy::warn;
     ForcedDecision force;
+    /// adaptive: a burst whose phase signal drifts faster than this (and beyond its noise) is
+    /// still in a fast transient: no jump from it (phase_drift.hpp) [unit per sqrt(d_p/g)].
+    /// Infinite: no check.
+    double drift_rate = std::numeric_limits<double>::infinity();
 };
 
 class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
@@ -111,6 +115,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         double t_end = 0.0;
         Eigen::VectorXd x_end;
         DecayRateEstimate decay;
+        bool drifting = false;
+        std::string drift;
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out, double length = 0.0) const;
@@ -126,6 +132,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     double t_end_ = 0.0;             ///< end of the last accepted burst
     Eigen::VectorXd x_end_;          ///< X there
     DecayRateEstimate decay_;        ///< from the last accepted burst
+    bool drifting_ = false;          ///< its phase signal drifted: a fast transient
+    std::string drift_;              ///< what phase_drift() said
     double dt_last_ = std::numeric_limits<double>::quiet_NaN();   ///< last kept DT
     double dt_cap_ = std::numeric_limits<double>::infinity();     ///< set by a rejection
     long consecutive_rejections_ = 0;

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/equation_free/phase_drift.hpp"
 #include "coarse/equation_free/slope_estimators.hpp"
 #include "core/contracts.hpp"
 #include "core/log.hpp"
@@ -44,12 +45,10 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
     if (resume) integrator_->restore_state(state_.integrator, state_.integrator_text);
     ProjectiveRunOutcome out;
     out.end_status = "completed";
-    if (settings_.warmup > 0 && !resume) {
+    if ((settings_.warmup > 0 || settings_.warmup_until_steady) && !resume) {
         // The initial state (a packed bed at rest) is far from the slow manifold: run it
         // directly until the fast transients are gone before the first projection.
-        BurstSamples warmup;
-        stepper_.run(std::min(settings_.warmup, duration), warmup);
-        log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step", settings_.warmup);
+        warm_up();
         for (auto* o : observers_) o->warmup_done(*this);
     }
     while (stepper_.time() < t_end_ - tol) {
@@ -95,6 +94,45 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
         out.end_status = fmt::format("completed ({} observable fell back to {})", primary_.name,
                                      fallback_ ? fallback_->name : std::string{"?"});
     return out;
+}
+
+void ProjectiveRun::warm_up() {
+    const double t0 = stepper_.time(), burst = settings_.burst();
+    // Room for one burst after the warm-up.
+    const double room = std::max(0.0, t_end_ - burst - t0);
+    BurstSamples w;
+    if (!settings_.warmup_until_steady) {
+        stepper_.run(std::min(settings_.warmup, t_end_ - t0), w);
+        log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step", settings_.warmup);
+        return;
+    }
+    const double length = std::min(std::max(settings_.warmup, burst), room);
+    if (length > 0) stepper_.run(length, w);
+    // On until the phase signal's drift over the last burst length is within its noise.
+    const double window = settings_.projection == CoarseRunSettings::Projection::periods ? settings_.periods.window
+                                                                                          : settings_.fixed.window;
+    const double t_limit = std::min(t0 + settings_.warmup + settings_.warmup_max, t0 + room);
+    const double tol = time_tolerance(t_end_);
+    while (true) {
+        const PhaseDrift d = phase_drift(w, stepper_.time() - burst - tol, settings_.drift_rate);
+        if (!d.measured) {
+            log::warn("warm-up: {:.4g} time units; the drift of the phase signal cannot be measured (no "
+                      "per-realization phase signals, or fewer than 2 realizations): warm-up by time only",
+                      stepper_.time() - t0);
+            return;
+        }
+        if (!d.drifting) {
+            log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step, until "
+                      "steady: {}", stepper_.time() - t0, d.message);
+            return;
+        }
+        if (stepper_.time() + window > t_limit + tol) {
+            log::warn("warm-up: stopped after {:.4g} time units (cpi.warmup + cpi.warmup_max, or the end of the "
+                      "run) while still in a fast transient: {}", stepper_.time() - t0, d.message);
+            return;
+        }
+        stepper_.run(window, w);
+    }
 }
 
 double planned_micro_time(double t_now, double t_end, double burst, double dt) {

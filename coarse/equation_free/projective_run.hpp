@@ -4,7 +4,9 @@
 /// policy of a whole run, on any CoarseStepper (an MPI ensemble of DEM realizations or a toy
 /// ODE alike):
 ///
-/// * warm-up: `warmup` of direct simulation before the first coarse step (a new run only);
+/// * warm-up: `warmup` of direct simulation before the first coarse step (a new run only), or,
+///   with warmup_until_steady, on until the phase signal (the bed's centre of mass) no longer
+///   drifts beyond its noise (phase_drift.hpp) — the fast transient is judged from the run;
 /// * the step loop: one ProjectiveIntegrator::step after another until the end time;
 /// * the end-of-run rule: the integrators shorten their last jumps so that the run ends at
 ///   t_end exactly; a rest shorter than one burst ends the run early, with a log line;
@@ -119,6 +121,9 @@ class ProjectiveRun {
 
   private:
     void use(const CoarseVariable& variable);
+    /// cpi.warmup of direct simulation; with warmup_until_steady on in windows until the phase
+    /// signal no longer drifts (at most warmup_max longer; always leaving one burst of the run).
+    void warm_up();
 
     CoarseRunSettings settings_;
     CoarseStepper& stepper_;

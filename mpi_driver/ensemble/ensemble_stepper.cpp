@@ -244,6 +244,7 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         out->t.push_back(rec.time);
         out->x.push_back(x);
         out->phase_signal.push_back(coarse::ensemble_mean(all_scalars)[0]);
+        out->member_phase.push_back(all_scalars.col(0));
         // Rows in global realization order, as gathered: independent of the layout.
         if (observable_->restricts_members())
             out->members.push_back(observable_->restrict_members(all_icdf, all_top));

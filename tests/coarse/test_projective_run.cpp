@@ -305,3 +305,36 @@ TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive w
     CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 0.3\n"),
                Catch::Contains("cpi.dt_min"));  // not a whole multiple of the sampling interval
 }
+
+TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drifting", "[unit][coarse][run]") {
+    // Component 0 (the phase signal) relaxes fast, X0 = 3 e^(-0.5 t); the others slowly. The
+    // allowed drift is tolerance / burst = 0.05 / 6: the exact drift 1.5 e^(-0.5 t) falls below it
+    // at t = 10.4 (2 s.e. of 8 members' slopes with sigma = 0.005 is ~1e-3, smaller). The
+    // warm-up goes on in windows of 4 after cpi.warmup = 1, so it ends in [10.4, 14.4 + one
+    // window of noise]; a warm-up by time ends at 1.
+    Eigen::VectorXd k = Eigen::VectorXd::Constant(5, 0.005);
+    k[0] = 0.5;
+    struct WarmupTime final : ProjectiveRunObserver {
+        const CoarseStepper* stepper = nullptr;
+        double t = -1;
+        void warmup_done(const ProjectiveRun&) override { t = stepper->time(); }
+    };
+    for (const std::string until : {"steady", "time"}) {
+        ParamTable table = ParamTable::from_text("cpi.projection = adaptive\ncpi.tolerance = 0.05\ncpi.healing = 2\n"
+                                                 "cpi.window = 4\ncpi.warmup = 1\ncpi.warmup_until = " + until + "\n",
+                                                 "scene.cfg", "/scenes");
+        const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.1);
+        test::OuEnsembleStepper toy(k, 0.005, 8, 0.1, Eigen::VectorXd::Constant(5, 3.0), 2);
+        ProjectiveRun run(s, toy, variable("ou"));
+        WarmupTime w;
+        w.stepper = &toy;
+        run.add_observer(w);
+        run.run(60.0);
+        if (until == "steady") {
+            CHECK(w.t >= 10.4);
+            CHECK(w.t <= 18.4);
+        } else {
+            CHECK(w.t == Approx(1.0));
+        }
+    }
+}

@@ -163,6 +163,8 @@ class OuEnsembleStepper final : public coarse::CoarseStepper {
             out.t.push_back(t_);
             out.x.push_back(y_.colwise().mean().transpose());
             out.members.push_back(y_);
+            out.phase_signal.push_back(out.x.back()[0]);  // phase signal: component 0
+            out.member_phase.push_back(y_.col(0));
         }
         work_ += static_cast<double>(n) * h_;
     }

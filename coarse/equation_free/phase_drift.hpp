@@ -1,0 +1,36 @@
+#pragma once
+/// \file
+/// Is the micro model still in a fast transient? The phase signal of a burst (for the DEM: the
+/// centre-of-mass height of every particle, which demixing of equal spheres leaves unchanged and
+/// which the bed's expansion after fluidization moves by several d_p) drifts while the fast
+/// transient lasts and only oscillates (travelling waves) or fluctuates on the slow manifold.
+/// Judged from the run itself: the drift is the least-squares slope of the ensemble-mean phase
+/// signal over a window; its noise the spread of the members' own slopes / sqrt(R).
+
+#include <limits>
+#include <string>
+
+#include "coarse/equation_free/coarse_stepper.hpp"
+
+namespace efdem::coarse {
+
+struct PhaseDrift {
+    bool measured = false;  ///< members' phase signals over >= 3 samples were available
+    double slope = std::numeric_limits<double>::quiet_NaN();           ///< [unit per sqrt(d_p/g)]
+    double standard_error = std::numeric_limits<double>::quiet_NaN();  ///< of the slope
+    /// |slope| > 2 standard errors and > allowed_rate: still in the fast transient.
+    bool drifting = false;
+    std::string message;  ///< what was found, for the log
+};
+
+/**
+ * \brief The drift of the phase signal over the samples of `burst` with t >= t_start.
+ *
+ * `allowed_rate` (>= 0): a drift this slow is accepted even when it is significant (e.g. the
+ * tolerance per window length: the phase signal moves less than the tolerance over a window).
+ * Not measured (drifting false) without members' phase signals (BurstSamples::member_phase) or
+ * with fewer than 3 samples or 2 members.
+ */
+PhaseDrift phase_drift(const BurstSamples& burst, double t_start, double allowed_rate);
+
+}  // namespace efdem::coarse
