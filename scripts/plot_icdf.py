@@ -36,7 +36,10 @@ def load(path):
         if "cpi" in f and "t_end" in f["cpi"]:
             t_end = f["cpi/t_end"][:]
             dt = f["cpi/dt"][:]
-            run["jumps"] = [(a, a + d) for a, d in zip(t_end, dt) if d > 0]
+            # A rejected jump (adaptive CPI) was redone: it is not part of the trajectory.
+            status = [s.decode() if isinstance(s, bytes) else str(s) for s in f["cpi/status"][:]] \
+                if "status" in f["cpi"] else [""] * len(dt)
+            run["jumps"] = [(a, a + d) for a, d, s in zip(t_end, dt, status) if d > 0 and s != "rejected"]
     return run
 
 

@@ -1,0 +1,235 @@
+#!/usr/bin/python3
+"""Adaptive against fixed-DT CPI, every ensemble with its own seeds (issue 16). A resumable study on
+the 1,000-sphere demo bed, 200 time units, bursts of healing 10 + window 10, warm-up 10, at
+U_s = 0.19 and 0.41:
+
+    /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --out runs/adaptive_study
+
+Runs, one folder each under --out/u<U_s>/ (a run whose .h5 says "completed" is not repeated: rerun the
+command in a later session and it continues), most informative first:
+
+  direct_a, direct_b   mode=direct, seeds 101, 202: the empirical noise floor is their difference
+  adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values)
+  fixed_dt40           seed 303, cpi.dt = 40 (the demo bed's best fixed DT, docs/accuracy_vs_cost.md)
+
+Error of a CPI run: e^2 = (RMS^2(X - D_a) + RMS^2(X - D_b)) / 2 over the CPI run's samples (times
+and p-nodes), X its ensemble-mean light ICDF, D_a, D_b the direct ensembles at the same times. The
+floor: RMS(D_a - D_b) over the same samples. For a CPI ensemble that is as good as a third direct
+ensemble, E[e^2] = floor^2 (each difference of two independent ensembles of R carries 2 var/R):
+"within the noise floor" is e / floor ~ 1. Speed-up: simulated / DEM time (per realization), and
+the wall time of the mean direct run over the CPI run's (same ranks and R; the runs are made one
+after the other on a shared machine, so wall ratios carry its load).
+
+--realizations R (default 4: ranks x 2; 8 fits a larger machine) and --np (default 2).
+--deadline HH:MM (UTC): start no run that, at the direct runs' pace, would end after it.
+--analyse-only: no runs. Writes analysis.md, analysis.json and error_vs_speedup.png into --out.
+"""
+import argparse
+import datetime as dt_
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
+import accuracy_metrics as am  # noqa: E402
+
+SCENE = os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg")
+DURATION = 200.0
+TOLERANCES = (0.08, 0.04, 0.16)  # d_p per jump; the middle one first
+SPEEDS = (0.19, 0.41)
+
+
+def runs():
+    """(name, mode, seed, overrides) in the order they are made, per U_s."""
+    out = [("direct_a", "direct", 101, {}), ("direct_b", "direct", 202, {})]
+    out.append((f"adaptive_tol{TOLERANCES[0]:g}", "cpi", 404,
+                {"cpi.projection": "adaptive", "cpi.tolerance": TOLERANCES[0]}))
+    out.append(("fixed_dt40", "cpi", 303, {"cpi.dt": 40}))
+    for tol in TOLERANCES[1:]:
+        out.append((f"adaptive_tol{tol:g}", "cpi", 404, {"cpi.projection": "adaptive", "cpi.tolerance": tol}))
+    return out
+
+
+def base(u, realizations, np_):
+    return {"gas_drag.superficial_velocity": u, "run.duration": DURATION, "cpi.warmup": 10, "cpi.healing": 10,
+            "cpi.window": 10, "ensemble.realizations_per_rank": realizations // np_}
+
+
+def h5(folder, name):
+    return os.path.join(folder, name, name + ".h5")
+
+
+def attr_text(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+def completed(folder, name):
+    try:
+        with h5py.File(h5(folder, name), "r") as f:
+            return attr_text(f.attrs.get("end_status", "")).startswith("completed")
+    except (OSError, KeyError):
+        return False
+
+
+def direct_pace(folder):
+    """Wall seconds per time unit of the direct runs made so far (None before the first)."""
+    made = []
+    for name in ("direct_a", "direct_b"):
+        if completed(folder, name):
+            with h5py.File(h5(folder, name), "r") as f:
+                made.append(float(f.attrs["wall_seconds"]) / float(f.attrs["dem_time"]))
+    return float(np.mean(made)) if made else None
+
+
+def run_one(args, folder, u, name, mode, seed, extra):
+    if completed(folder, name):
+        print(f"  u{u:g}/{name}: done before, skipped", flush=True)
+        return True
+    if args.deadline:
+        pace = direct_pace(folder) or 4.0
+        est = pace * DURATION * (1.0 if mode == "direct" else 0.7)
+        if dt_.datetime.now(dt_.timezone.utc) + dt_.timedelta(seconds=est) > args.deadline:
+            print(f"  u{u:g}/{name}: not started: about {est / 60:.0f} min would end after {args.deadline:%H:%M} UTC",
+                  flush=True)
+            return False
+    d = os.path.join(folder, name)
+    if os.path.isdir(d):
+        shutil.rmtree(d)  # an incomplete run: start it again
+    os.makedirs(d)
+    over = {**base(u, args.realizations, args.np), "seed": seed, **extra}
+    cmd = ["mpirun", "-np", str(args.np), "--oversubscribe", args.efdem, SCENE, f"mode={mode}",
+           f"output.directory={os.path.abspath(d)}", f"output.prefix={name}"] + [f"{k}={v}" for k, v in over.items()]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    with open(os.path.join(d, "command.txt"), "w") as f:
+        f.write(" ".join(cmd) + "\n")
+    t0 = time.time()
+    print(f"  u{u:g}/{name}: started {dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
+    with open(os.path.join(d, name + ".log"), "w") as log:
+        code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+    ok = code == 0 and completed(folder, name)
+    print(f"  u{u:g}/{name}: {'ok' if ok else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
+    return ok
+
+
+def load(folder, name):
+    with h5py.File(h5(folder, name), "r") as f:
+        d = {k: attr_text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
+        d["t"] = f["samples/time"][:]
+        d["mean"] = f["samples/mean"][:]
+        d["var"] = f["samples/variance"][:]
+        if "cpi/status" in f:
+            d["status"] = [attr_text(s) for s in f["cpi/status"][:]]
+            d["dt"] = f["cpi/dt"][:]
+            if "cpi/controller" in f:
+                c = f["cpi/controller"]
+                d["controller"] = {k: c[k][:] for k in c.keys()}
+            if "cpi/controller_summary" in f:
+                d["summary"] = attr_text(f["cpi/controller_summary"][()])
+    return d
+
+
+def score(run, da, db):
+    keep_a, ya = am.align(da["t"], da["mean"], run["t"])
+    keep_b, yb = am.align(db["t"], db["mean"], run["t"])
+    keep = keep_a & keep_b
+    x = run["mean"][keep]
+    ya = ya[keep[keep_a]]
+    yb = yb[keep[keep_b]]
+    e2 = 0.5 * (np.mean((x - ya) ** 2) + np.mean((x - yb) ** 2))
+    floor = am.rms_error(ya, yb)
+    return math.sqrt(e2), floor, int(keep.sum())
+
+
+def analyse(args):
+    rows, report = [], ["# Adaptive vs fixed-DT CPI, independent seeds (bench/adaptive_study.py)", "",
+                        f"Demo bed (1,000 spheres), R = {args.realizations}, {DURATION:g} time units, "
+                        "burst 10 + 10, warm-up 10. Error e and noise floor as in the script's docstring.", ""]
+    for u in SPEEDS:
+        folder = os.path.join(args.out, f"u{u:g}")
+        if not (completed(folder, "direct_a") and completed(folder, "direct_b")):
+            report.append(f"U_s = {u:g}: the two direct ensembles are not complete yet; nothing to compare.\n")
+            continue
+        da, db = load(folder, "direct_a"), load(folder, "direct_b")
+        wall_direct = 0.5 * (float(da["wall_seconds"]) + float(db["wall_seconds"]))
+        floor_all = am.rms_error(da["mean"], am.align(db["t"], db["mean"], da["t"])[1])
+        report += [f"## U_s = {u:g}", "", f"Noise floor RMS(D_a - D_b) over all samples: **{floor_all:.3f} d_p**; "
+                   f"direct wall time {wall_direct:.0f} s (mean of the two).", "",
+                   "| run | error e [d_p] | floor on its samples | e / floor | DEM-time speed-up | wall speed-up | "
+                   "jumps kept / rejected / direct bursts | mean DT |", "|---|---|---|---|---|---|---|---|"]
+        for name, mode, _, _ in runs():
+            if mode != "cpi" or not completed(folder, name):
+                continue
+            r = load(folder, name)
+            e, floor, n = score(r, da, db)
+            s_dem = float(r["simulated_time"]) / float(r["dem_time"])
+            s_wall = wall_direct / float(r["wall_seconds"])
+            st = r.get("status", [])
+            kept = sum(1 for s in st if s == "projected")
+            rej = sum(1 for s in st if s == "rejected")
+            direct = sum(1 for s in st if s == "burst_only") - 1
+            dts = [dt for dt, s in zip(r["dt"], st) if s == "projected"]
+            rows.append({"u": u, "run": name, "error": e, "floor": floor, "ratio": e / floor, "speedup_dem": s_dem,
+                         "speedup_wall": s_wall, "kept": kept, "rejected": rej, "direct_bursts": direct,
+                         "mean_dt": float(np.mean(dts)) if dts else 0.0, "samples": n,
+                         "summary": r.get("summary", "")})
+            report.append(f"| {name} | {e:.3f} | {floor:.3f} | {e / floor:.2f} | {s_dem:.2f} | {s_wall:.2f} | "
+                          f"{kept} / {rej} / {direct} | {rows[-1]['mean_dt']:.1f} |")
+        report.append("")
+        for row in rows:
+            if row["u"] == u and row["summary"]:
+                report += [f"`{row['run']}`:", "```", row["summary"], "```", ""]
+    with open(os.path.join(args.out, "analysis.md"), "w") as f:
+        f.write("\n".join(report) + "\n")
+    with open(os.path.join(args.out, "analysis.json"), "w") as f:
+        json.dump(rows, f, indent=1)
+    if rows:
+        fig, axes = plt.subplots(1, len(SPEEDS), figsize=(11, 4.2), sharey=True)
+        for ax, u in zip(np.atleast_1d(axes), SPEEDS):
+            for row in (r for r in rows if r["u"] == u):
+                colour = "C0" if row["run"].startswith("adaptive") else "C3"
+                ax.plot(row["speedup_dem"], row["ratio"], "o", color=colour)
+                ax.plot(row["speedup_wall"], row["ratio"], "s", mfc="none", color=colour)
+                ax.annotate(row["run"].replace("adaptive_", ""), (row["speedup_dem"], row["ratio"]), fontsize=8,
+                            xytext=(4, 4), textcoords="offset points")
+            ax.axhline(1.0, color="k", lw=0.8, ls="--")
+            ax.set_title(f"U_s = {u:g}, R = {args.realizations}")
+            ax.set_xlabel("speed-up over a direct ensemble [-] (filled: DEM time, open: wall time)")
+        np.atleast_1d(axes)[0].set_ylabel("error / empirical noise floor [-]")
+        fig.tight_layout()
+        fig.savefig(os.path.join(args.out, "error_vs_speedup.png"), dpi=120)
+    print("\n".join(report))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--efdem", default=os.path.join(HERE, "..", "build", "mpi_driver", "efdem"))
+    ap.add_argument("--out", default=os.path.join(HERE, "..", "runs", "adaptive_study"))
+    ap.add_argument("--realizations", type=int, default=4)
+    ap.add_argument("--np", type=int, default=2)
+    ap.add_argument("--deadline", type=lambda s: dt_.datetime.combine(
+        dt_.datetime.now(dt_.timezone.utc).date(), dt_.time.fromisoformat(s), dt_.timezone.utc))
+    ap.add_argument("--analyse-only", action="store_true")
+    args = ap.parse_args()
+    if not args.analyse_only:
+        for name, mode, seed, extra in runs():  # both U_s for the first runs before the later ones
+            for u in SPEEDS:
+                folder = os.path.join(args.out, f"u{u:g}")
+                os.makedirs(folder, exist_ok=True)
+                run_one(args, folder, u, name, mode, seed, extra)
+    analyse(args)
+
+
+if __name__ == "__main__":
+    main()
