@@ -76,9 +76,21 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     out.x_end = check.x_end;
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
     if (settings_.adaptive && std::isfinite(settings_.drift_rate)) {
+        // No jump from a slope that is not the slow dynamics': a fast transient, or a wave
+        // the realizations share that the window does not average out.
         const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
-        out.drifting = d.drifting;
-        out.drift = d.message;
+        const WaveCoherence w = wave_coherence(rec.burst, t_start);
+        if (d.drifting) {
+            out.drifting = true;
+            out.drift = "still in a fast transient (" + d.message + ")";
+        } else if (w.in_phase && !(std::isfinite(w.period) && settings_.window >= 2.0 * w.period * (1.0 - 1e-9))) {
+            out.drifting = true;
+            out.drift = fmt::format("{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
+                                    "by the common wave beyond its standard error; use cpi.window >= {}",
+                                    w.message, settings_.window,
+                                    std::isfinite(w.period) ? fmt::format("{:.3g}", 2.0 * w.period)
+                                                            : std::string("two wave periods"));
+        }
     }
     rec.window = slope.t_last - slope.t_first;
     return true;
@@ -119,8 +131,8 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     }
     const StepSizeSettings& s = settings_.control;
     if (drifting_) {  // the slope is the fast transient's, not the slow dynamics'
-        append_message(rec, "still in a fast transient (" + drift_ + "): one burst of direct simulation");
-        c.limited_by = "fast transient";
+        append_message(rec, drift_ + ": one burst of direct simulation");
+        c.limited_by = drift_.rfind("still in a fast transient", 0) == 0 ? "fast transient" : "in-phase wave";
         return 0.0;
     }
     const double target = s.safety * s.tolerance;

@@ -33,4 +33,25 @@ struct PhaseDrift {
  */
 PhaseDrift phase_drift(const BurstSamples& burst, double t_start, double allowed_rate);
 
+/// Are the members' oscillations (travelling waves) in phase, so that the ensemble mean itself
+/// oscillates? Realizations that all fluidize at t = 0 start their waves together and stay in
+/// phase for a long time (the demo bed at U_s = 0.41: for all of its first 60 time units). Then
+/// the ensemble slope over less than two periods is biased by the common wave, and the spread of
+/// the members' slopes cannot see it (bench/wave_slope_bias.py).
+struct WaveCoherence {
+    bool measured = false;
+    /// RMS of the detrended ensemble-mean phase signal over RMS(detrended members)/sqrt(R):
+    /// ~1 for independent phases, sqrt(R) for members in phase.
+    double ratio = std::numeric_limits<double>::quiet_NaN();
+    double threshold = std::numeric_limits<double>::quiet_NaN();  ///< (1 + sqrt(R))/2
+    bool in_phase = false;                                          ///< ratio > threshold
+    /// Period of the ensemble-mean phase signal (NaN when fewer than two upward crossings).
+    double period = std::numeric_limits<double>::quiet_NaN();
+    std::string message;
+};
+
+/// Wave coherence over the samples of `burst` with t >= t_start (linear trends removed per
+/// member). Not measured without members' phase signals, with < 2 members or < 8 samples.
+WaveCoherence wave_coherence(const BurstSamples& burst, double t_start);
+
 }  // namespace efdem::coarse

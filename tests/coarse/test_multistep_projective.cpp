@@ -13,6 +13,7 @@
 
 #include "coarse/equation_free/multistep_projection.hpp"
 #include "coarse/equation_free/multistep_projective_integrator.hpp"
+#include "coarse/equation_free/phase_drift.hpp"
 #include "coarse/equation_free/projective_stability.hpp"
 #include "coarse/equation_free/step_size_controller.hpp"
 #include "tests/coarse/toy_steppers.hpp"
@@ -295,4 +296,37 @@ TEST_CASE("an adaptive run resumed from the saved integrator state continues bit
     b.save_state(again, text);
     a.save_state(reals, text);
     CHECK(again == reals);
+}
+
+TEST_CASE("phase_drift and wave_coherence judge the phase signal from the members", "[unit][coarse][multistep]") {
+    // Four members: a wave of period 9 and amplitude 0.1 on a drift of 0.05 per time unit.
+    auto burst = [](const double phases[4], double drift) {
+        BurstSamples b;
+        for (int k = 1; k <= 80; ++k) {
+            const double t = 0.25 * k;
+            Eigen::VectorXd m(4);
+            for (int r = 0; r < 4; ++r) m[r] = drift * t + 0.1 * std::sin(2 * M_PI * t / 9.0 + phases[r]);
+            b.t.push_back(t);
+            b.member_phase.push_back(m);
+            b.phase_signal.push_back(m.mean());
+        }
+        return b;
+    };
+    const double together[4] = {0, 0, 0, 0}, spread[4] = {0, M_PI / 2, M_PI, 3 * M_PI / 2};
+    const WaveCoherence in = wave_coherence(burst(together, 0.0), 0.0);
+    REQUIRE(in.measured);
+    CHECK(in.ratio == Approx(2.0).epsilon(1e-6));  // sqrt(R): the mean oscillates like each member
+    CHECK(in.in_phase);
+    CHECK(in.period == Approx(9.0).epsilon(0.02));
+    const WaveCoherence out = wave_coherence(burst(spread, 0.0), 0.0);
+    CHECK(out.ratio < 1e-6);  // the phases cancel in the mean
+    CHECK(!out.in_phase);
+    // A drift of 0.05 over a window of 10: significant against the members' spread of slopes
+    // (the waves, out of phase, make it) and faster than an allowed 0.01; not with 0.1 allowed.
+    const PhaseDrift d = phase_drift(burst(spread, 0.05), 10.0, 0.01);
+    REQUIRE(d.measured);
+    CHECK(d.slope == Approx(0.05).margin(1e-12));
+    CHECK(d.drifting);
+    CHECK(!phase_drift(burst(spread, 0.05), 10.0, 0.1).drifting);
+    CHECK(!phase_drift(burst(spread, 0.0), 10.0, 0.0).drifting);
 }
