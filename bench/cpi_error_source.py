@@ -173,7 +173,7 @@ def load(out, name):
         params = f["parameters"][()]
         d["params"] = params.decode() if isinstance(params, bytes) else str(params)
         if "cpi" in f:
-            d["cpi"] = {k: f["cpi"][k][:] for k in f["cpi"].keys()}
+            d["cpi"] = {k: f["cpi"][k][:] for k in f["cpi"].keys() if isinstance(f["cpi"][k], h5py.Dataset)}
     d["name"] = name
     d["partial"] = not completed(out, name)
     if d["partial"]:

@@ -63,7 +63,18 @@ def main(argv=None):
             check(se.shape == c["slope"].shape, f"/cpi/slope_standard_error shape {se.shape} != /cpi/slope {c['slope'].shape}")
             check(not np.any(se[:] < 0), "negative slope standard error")
             check(np.all(c["lift_changed"][:] >= 0), "negative label counts")
-            check(np.all(np.diff(c["t_start"][:]) > 0), "coarse steps not in time order")
+            status = [x.decode() if isinstance(x, bytes) else str(x) for x in c["status"][:]]
+            if "rejected" in status:
+                # Adaptive: a rejected jump is redone from where it started; the jump origins
+                # (t_end) never go back, and a redone burst starts earlier than the rejected one.
+                check(np.all(np.diff(c["t_end"][:]) >= 0), "coarse steps' jump origins go back in time")
+            else:
+                check(np.all(np.diff(c["t_start"][:]) > 0), "coarse steps not in time order")
+            if "controller" in c:
+                for name in ("accepted", "error_statistical", "error_truncation", "dt_tolerance", "limited_by"):
+                    check(len(c["controller"][name]) == k, f"/cpi/controller/{name} has {len(c['controller'][name])} rows, expected {k}")
+                acc = c["controller/accepted"][:]
+                check(all(acc[i] == 0 for i, x in enumerate(status) if x == "rejected"), "a rejected step marked accepted")
     if errors:
         print(f"check_run_file: {a.run}: " + "; ".join(errors))
         return 1
