@@ -31,6 +31,10 @@ struct BurstSamples {
     /// phase_signal: what the drift of a fast transient is judged from (phase_drift.hpp).
     /// Either empty or one vector per sample.
     std::vector<Eigen::VectorXd> member_phase;
+    /// The members' own expansion signal at each time (for the DEM: the mean particle height,
+    /// which the bed's expansion moves and demixing does not): what the end of a fast transient
+    /// is judged from (phase_drift.hpp). Either empty (member_phase is used) or one per sample.
+    std::vector<Eigen::VectorXd> member_expansion;
 
     std::size_t size() const { return t.size(); }
 };

@@ -1,9 +1,11 @@
 #pragma once
 /// \file
-/// Is the micro model still in a fast transient? The phase signal of a burst (for the DEM: the
-/// centre-of-mass height of every particle, which demixing of equal spheres leaves unchanged and
-/// which the bed's expansion after fluidization moves by several d_p) drifts while the fast
-/// transient lasts and only oscillates (travelling waves) or fluctuates on the slow manifold.
+/// Is the micro model still in a fast transient? The expansion signal of a burst (for the DEM:
+/// the number-weighted mean particle height, which demixing of equal spheres leaves unchanged
+/// and which the bed's expansion after fluidization moves by several d_p; without one, the phase
+/// signal) drifts while the fast transient lasts and only oscillates (travelling waves) or
+/// fluctuates on the slow manifold. (The mass-weighted centre of mass is no such signal: heavy
+/// particles sinking lower it — that is the slow dynamics.)
 /// Judged from the run itself: the drift is the least-squares slope of the ensemble-mean phase
 /// signal over a window; its noise the spread of the members' own slopes / sqrt(R).
 
@@ -24,7 +26,8 @@ struct PhaseDrift {
 };
 
 /**
- * \brief The drift of the phase signal over the samples of `burst` with t >= t_start.
+ * \brief The drift of the expansion signal (BurstSamples::member_expansion, or member_phase
+ *        when there is none) over the samples of `burst` with t >= t_start.
  *
  * `allowed_rate` (>= 0): a drift this slow is accepted even when it is significant (e.g. the
  * tolerance per window length: the phase signal moves less than the tolerance over a window).

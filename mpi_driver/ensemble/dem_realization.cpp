@@ -33,7 +33,9 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid, bool to
     for (const auto& x : p.x()) {
         o.z_min = std::min(o.z_min, x.z);
         o.z_max = std::max(o.z_max, x.z);
+        o.mean_height += x.z;
     }
+    if (!p.x().empty()) o.mean_height /= static_cast<double>(p.x().size());
     return o;
 }
 

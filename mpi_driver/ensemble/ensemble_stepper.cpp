@@ -214,7 +214,7 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         Observation o = r->observe(grid_, top);
         icdf.push_back(std::move(o.icdf));
         if (top) top_icdf.push_back(std::move(o.top));
-        scalars.push_back(Eigen::Vector3d(o.com, o.z_min, o.z_max));
+        scalars.push_back(Eigen::Vector4d(o.com, o.z_min, o.z_max, o.mean_height));
     }
     const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
     const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
@@ -245,6 +245,7 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         out->x.push_back(x);
         out->phase_signal.push_back(coarse::ensemble_mean(all_scalars)[0]);
         out->member_phase.push_back(all_scalars.col(0));
+        out->member_expansion.push_back(all_scalars.col(3));
         // Rows in global realization order, as gathered: independent of the layout.
         if (observable_->restricts_members())
             out->members.push_back(observable_->restrict_members(all_icdf, all_top));

@@ -26,6 +26,9 @@ struct Observation {
     Eigen::VectorXd icdf;  ///< ICDF of the observed species on the p-grid
     Eigen::VectorXd top;   ///< ICDF of the top half (only when asked for)
     double com = 0;        ///< centre-of-mass height: the travelling-wave phase signal
+    /// Number-weighted mean particle height: the bed's expansion, which (unlike the mass-weighted
+    /// centre of mass) demixing of equal spheres leaves unchanged.
+    double mean_height = 0;
     double z_min = 0;      ///< lowest particle centre
     double z_max = 0;      ///< highest particle centre
 };
