@@ -30,10 +30,7 @@ import datetime as dt_
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
-import time
 
 import h5py
 import matplotlib
@@ -45,6 +42,9 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
+
+sys.path.insert(0, HERE)
+import study_runs as sr  # noqa: E402
 
 SCENE = os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg")
 DURATION = 200.0
@@ -75,20 +75,9 @@ def base(u, realizations, np_):
             "cpi.window": 10, "ensemble.realizations_per_rank": realizations // np_}
 
 
-def h5(folder, name):
-    return os.path.join(folder, name, name + ".h5")
-
-
-def attr_text(v):
-    return v.decode() if isinstance(v, bytes) else str(v)
-
-
-def completed(folder, name):
-    try:
-        with h5py.File(h5(folder, name), "r") as f:
-            return attr_text(f.attrs.get("end_status", "")).startswith("completed")
-    except (OSError, KeyError):
-        return False
+h5 = sr.run_file
+completed = sr.completed
+attr_text = sr.text
 
 
 def direct_pace(folder):
@@ -112,23 +101,8 @@ def run_one(args, folder, u, name, mode, seed, extra):
             print(f"  u{u:g}/{name}: not started: about {est / 60:.0f} min would end after {args.deadline:%H:%M} UTC",
                   flush=True)
             return False
-    d = os.path.join(folder, name)
-    if os.path.isdir(d):
-        shutil.rmtree(d)  # an incomplete run: start it again
-    os.makedirs(d)
     over = {**base(u, args.realizations, args.np), "seed": seed, **extra}
-    cmd = ["mpirun", "-np", str(args.np), "--oversubscribe", args.efdem, SCENE, f"mode={mode}",
-           f"output.directory={os.path.abspath(d)}", f"output.prefix={name}"] + [f"{k}={v}" for k, v in over.items()]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    with open(os.path.join(d, "command.txt"), "w") as f:
-        f.write(" ".join(cmd) + "\n")
-    t0 = time.time()
-    print(f"  u{u:g}/{name}: started {dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
-    with open(os.path.join(d, name + ".log"), "w") as log:
-        code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
-    ok = code == 0 and completed(folder, name)
-    print(f"  u{u:g}/{name}: {'ok' if ok else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
-    return ok
+    return sr.run_case(args.efdem, args.np, SCENE, folder, name, mode, over, label=f"u{u:g}/{name}")
 
 
 def load(folder, name):
@@ -231,9 +205,8 @@ def main():
     ap.add_argument("--analyse-only", action="store_true")
     args = ap.parse_args()
     if not args.analyse_only:
-        for k in range(len(runs())):  # both U_s for the first runs before the later ones
-            for u in SPEEDS:
-                name, mode, seed, extra = runs(u)[k]
+        for u in SPEEDS:  # U_s = 0.19 (the >= 5x target) first, then 0.41
+            for name, mode, seed, extra in runs(u):
                 folder = os.path.join(args.out, f"u{u:g}")
                 os.makedirs(folder, exist_ok=True)
                 run_one(args, folder, u, name, mode, seed, extra)

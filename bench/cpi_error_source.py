@@ -34,7 +34,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 import warnings
 
 import h5py
@@ -47,6 +46,9 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
+
+sys.path.insert(0, HERE)
+import study_runs as sr  # noqa: E402
 
 SCENE = os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg")
 BASE = {"gas_drag.superficial_velocity": 0.19, "run.duration": 200, "cpi.healing": 10, "cpi.window": 10,
@@ -106,7 +108,6 @@ def estimate_seconds(out, mode, overrides):
 
 
 def run_one(args, name, mode, seed, extra):
-    folder = os.path.join(args.out, name)
     if completed(args.out, name):
         print(f"  {name}: done before, skipped", flush=True)
         return True
@@ -117,23 +118,8 @@ def run_one(args, name, mode, seed, extra):
             print(f"  {name}: not started: it would take about {est / 60:.0f} min and end after the deadline "
                   f"{args.deadline:%H:%M} UTC", flush=True)
             return False
-    if os.path.isdir(folder):
-        shutil.rmtree(folder)  # an incomplete run: start it again
-    os.makedirs(folder)
     over = {**BASE, "seed": seed, **extra}
-    cmd = ["mpirun", "-np", str(NP), "--oversubscribe", args.efdem, SCENE, f"mode={mode}",
-           f"output.directory={os.path.abspath(folder)}", f"output.prefix={name}"] + \
-        [f"{k}={v}" for k, v in over.items()]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    with open(os.path.join(folder, "command.txt"), "w") as f:
-        f.write(" ".join(cmd) + "\n")
-    t0 = time.time()
-    print(f"  {name}: started {dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
-    with open(os.path.join(folder, name + ".log"), "w") as log:
-        code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
-    ok = code == 0 and completed(args.out, name)
-    print(f"  {name}: {'ok' if ok else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
-    return ok
+    return sr.run_case(args.efdem, NP, SCENE, args.out, name, mode, over)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -247,24 +247,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     c.statistical_nodes = stat;
     c.statistical = rms(stat);
     Eigen::VectorXd x = x_end_ + projected_increment(nodes, w);
-    rec.x_projected = x;
-    if (!x.allFinite()) {
-        rec.status = StepStatus::infeasible_projection;
-        append_message(rec, "the projected state is not finite; nothing lifted");
-        dt_cap_ = 0.5 * rec.dt;
+    if (!repair_projection(rec, x, repair_)) {
+        dt_cap_ = 0.5 * rec.dt;  // the next attempt jumps less far
         return rec;
     }
-    if (repair_) {
-        rec.repair = repair_(x);
-        append_message(rec, rec.repair.message);
-        if (!rec.repair.feasible) {
-            rec.status = StepStatus::infeasible_projection;
-            append_message(rec, "repair hook rejected the projected state; nothing lifted");
-            dt_cap_ = 0.5 * rec.dt;
-            return rec;
-        }
-    }
-    rec.x_projected = x;
     if (settings_.adaptive) stepper.keep_state();
     stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;

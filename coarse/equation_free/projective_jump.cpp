@@ -51,6 +51,26 @@ bool check_burst(ProjectiveStepRecord& rec, double micro_time, bool needs_phase_
     return true;
 }
 
+bool repair_projection(ProjectiveStepRecord& rec, Eigen::VectorXd& x, const RepairHook& repair) {
+    rec.x_projected = x;  // kept for diagnosis if the jump is refused below
+    if (!x.allFinite()) {
+        rec.status = StepStatus::infeasible_projection;
+        append_message(rec, fmt::format("projected state X(t_end) + {:.6g} s is not finite; nothing lifted", rec.dt));
+        return false;
+    }
+    if (repair) {
+        rec.repair = repair(x);
+        append_message(rec, rec.repair.message);
+        if (!rec.repair.feasible) {
+            rec.status = StepStatus::infeasible_projection;
+            append_message(rec, "repair hook rejected the projected state; nothing lifted");
+            return false;
+        }
+    }
+    rec.x_projected = x;
+    return true;
+}
+
 void project_and_lift(ProjectiveStepRecord& rec, CoarseStepper& stepper, const JumpPlan& plan,
                       const RepairHook& repair) {
     EFDEM_EXPECTS(!plan.dt_candidates.empty() && plan.dt_candidates.front() >= 0.0);
@@ -96,24 +116,7 @@ void project_and_lift(ProjectiveStepRecord& rec, CoarseStepper& stepper, const J
     }
 
     Eigen::VectorXd x = rec.x_end + rec.dt * rec.slope;
-    rec.x_projected = x;  // kept for diagnosis if the jump is refused below
-    if (!x.allFinite()) {
-        rec.status = StepStatus::infeasible_projection;
-        append_message(rec, fmt::format("projected state X(t_end) + {:.6g} s is not finite; "
-                                        "nothing lifted",
-                                        rec.dt));
-        return;
-    }
-    if (repair) {
-        rec.repair = repair(x);
-        append_message(rec, rec.repair.message);
-        if (!rec.repair.feasible) {
-            rec.status = StepStatus::infeasible_projection;
-            append_message(rec, "repair hook rejected the projected state; nothing lifted");
-            return;
-        }
-    }
-    rec.x_projected = x;
+    if (!repair_projection(rec, x, repair)) return;
     stepper.lift(rec.x_projected, rec.t_end + rec.dt);
     rec.lifted = true;
     rec.status = StepStatus::projected;

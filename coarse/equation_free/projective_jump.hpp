@@ -49,6 +49,14 @@ struct JumpPlan {
 void project_and_lift(ProjectiveStepRecord& rec, CoarseStepper& stepper, const JumpPlan& plan,
                       const RepairHook& repair);
 
+/**
+ * \brief The checks every projected vector passes before a lift: finite, then `repair` (may be
+ *        empty). Sets rec.x_projected (the rejected vector, for diagnosis, when it fails) and
+ *        rec.repair; on failure rec.status = infeasible_projection with a message, and returns
+ *        false (nothing may be lifted).
+ */
+bool repair_projection(ProjectiveStepRecord& rec, Eigen::VectorXd& x, const RepairHook& repair);
+
 /// Appends `note` to rec.message ("; "-separated).
 void append_message(ProjectiveStepRecord& rec, const std::string& note);
 

@@ -111,16 +111,14 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
         // /cpi/controller/*: one row per coarse step of the multistep integrator (every row of
         // /cpi when it is the run's integrator). Errors RMS over the coarse vector [d_p].
         if (!file_.exists("/cpi/controller")) file_.create_group("/cpi/controller");
-        auto cs = [&](const char* name, double v) { series(fmt::format("/cpi/controller/{}", name), {}, T::real).append(v); };
         integer("controller/accepted", c.accepted ? 1 : 0);
         integer("controller/steps", c.steps);
-        cs("tolerance", c.tolerance);
-        cs("error_statistical", c.statistical);
-        cs("error_truncation", c.truncation);
-        cs("predicted_truncation", c.predicted_truncation);
-        cs("dt_tolerance", c.dt_tolerance);
-        cs("dt_tolerance_2r", c.dt_tolerance_2r);
-        cs("dt_tolerance_4r", c.dt_tolerance_4r);
+        const std::pair<const char*, double> reals[] = {
+            {"tolerance", c.tolerance},       {"error_statistical", c.statistical},
+            {"error_truncation", c.truncation}, {"predicted_truncation", c.predicted_truncation},
+            {"dt_tolerance", c.dt_tolerance}, {"dt_tolerance_2r", c.dt_tolerance_2r},
+            {"dt_tolerance_4r", c.dt_tolerance_4r}};
+        for (const auto& [name, value] : reals) scalar(fmt::format("controller/{}", name).c_str(), value);
         series("/cpi/controller/limited_by", {}, T::text).append_text(c.limited_by);
         vec("controller/error_statistical_nodes", c.statistical_nodes);
         vec("controller/error_truncation_nodes", c.truncation_nodes);

@@ -1,0 +1,48 @@
+"""What the resumable studies in bench/ share: one efdem run per folder, skipped when its run file
+says "completed", restarted from scratch when it is incomplete."""
+import datetime as dt_
+import os
+import shutil
+import subprocess
+import time
+
+import h5py
+
+
+def text(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+def run_file(folder, name):
+    return os.path.join(folder, name, name + ".h5")
+
+
+def completed(folder, name):
+    try:
+        with h5py.File(run_file(folder, name), "r") as f:
+            return text(f.attrs.get("end_status", "")).startswith("completed")
+    except (OSError, KeyError):
+        return False
+
+
+def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None):
+    """mpirun -np NP efdem SCENE mode=MODE output.* KEY=VALUE... into FOLDER/NAME/ (command.txt,
+    NAME.log, NAME.h5). Returns whether it completed."""
+    label = label or name
+    d = os.path.join(folder, name)
+    if os.path.isdir(d):
+        shutil.rmtree(d)  # an incomplete run: start it again
+    os.makedirs(d)
+    cmd = ["mpirun", "-np", str(np_), "--oversubscribe", efdem, scene, f"mode={mode}",
+           f"output.directory={os.path.abspath(d)}", f"output.prefix={name}"] + \
+        [f"{k}={v}" for k, v in overrides.items()]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    with open(os.path.join(d, "command.txt"), "w") as f:
+        f.write(" ".join(cmd) + "\n")
+    t0 = time.time()
+    print(f"  {label}: started {dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
+    with open(os.path.join(d, name + ".log"), "w") as log:
+        code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+    ok = code == 0 and completed(folder, name)
+    print(f"  {label}: {'ok' if ok else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
+    return ok
