@@ -168,7 +168,10 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     }
     const double end = end_limit(dt);
     if (end < dt) {
-        dt = end;
+        // The rule leaves room for one more burst; if the tolerance allows reaching the last
+        // burst in this jump (less than one burst further), do that instead.
+        const double to_last_burst = end_time() - (t_end_ + burst);
+        dt = to_last_burst > dt && to_last_burst <= c.dt_tolerance ? to_last_burst : end;
         c.limited_by = "end of run";
     }
     // Never a jump the measured transient would be amplified by: shorten until stable.
