@@ -157,6 +157,10 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     limit(dt_cap_, "rejection");
     if (settings_.dt_quantum > 0.0 && std::isfinite(dt))
         dt = std::floor(dt / settings_.dt_quantum * (1.0 + 1e-12)) * settings_.dt_quantum;
+    if (end_limit(dt) <= 0.0) {  // this step's burst is the run's last: no jump before it
+        c.limited_by = "end of run";
+        return 0.0;
+    }
     if (dt < s.dt_min * (1.0 - 1e-12)) {
         append_message(rec, fmt::format("the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = {:.3g} "
                                         "(statistical error of one DT_min jump {:.3g}): one burst of direct "

@@ -10,5 +10,5 @@ trap 'rm -rf "$work"' EXIT
 "$mpiexec" -n 2 "$@" "$efdem" "$here/../../examples/demo_small/scene.cfg" mode=cpi bed.count="200 200" \
   bed.settle=false run.duration=8 cpi.warmup=1 cpi.healing=1 cpi.window=2 cpi.dt=2 \
   output.directory="$work" output.prefix=demo > "$work/log" 2>&1 || { cat "$work/log"; exit 1; }
-/usr/bin/python3 "$here/check_run_file.py" "$work/demo.h5" --mode cpi --realizations 2 --min-samples 8
+/usr/bin/python3 "$here/check_run_file.py" "$work/demo.h5" --mode cpi --realizations 4 --min-samples 8
 test -s "$work/demo_mean_icdf.csv" && test -s "$work/demo_cpi_steps.csv"
