@@ -69,9 +69,11 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
                    RunRecorder* recorder, Progress& progress, const RunControl& control) {
     if (s.cpi.projection == coarse::CoarseRunSettings::Projection::periods && stepper.realizations() > 1)
         log::warn("cpi.projection = periods measures the wave period from the ensemble-mean centre of "
-                  "mass; with {} realizations the wave phases average out and the period may not be "
-                  "measurable. DT = k T is the single-realization method of the paper (Fig. 2b); for "
-                  "an ensemble use cpi.projection = fixed", stepper.realizations());
+                  "mass; the {} realizations' waves start in phase (they fluidize together) but lose phase "
+                  "over some 60-80 time units on the demo bed, and then the period of the mean cannot be "
+                  "measured (docs/accuracy_vs_cost.md). DT = k T is the single-realization method of the "
+                  "paper (Fig. 2b); for an ensemble use cpi.projection = adaptive with cpi.window of two "
+                  "periods", stepper.realizations());
     coarse::EnsembleObservable& primary = stepper.observable();
     std::optional<coarse::CoarseVariable> fallback_variable;
     if (fallback) fallback_variable = coarse_variable(*fallback, stepper);
