@@ -144,10 +144,15 @@ def analyse(args):
             report.append(f"U_s = {u:g}: the two direct ensembles are not complete yet; nothing to compare.\n")
             continue
         da, db = load(folder, "direct_a"), load(folder, "direct_b")
-        wall_direct = 0.5 * (float(da["wall_seconds"]) + float(db["wall_seconds"]))
+        # Wall times compare only runs made in this study, one after the other (a run copied from
+        # an earlier study, marked by provenance.txt, carried that session's load).
+        copied = lambda name: os.path.exists(os.path.join(folder, name, "provenance.txt"))  # noqa: E731
+        walls = [float(d["wall_seconds"]) for n, d in (("direct_a", da), ("direct_b", db)) if not copied(n)]
+        wall_direct = float(np.mean(walls)) if walls else math.nan
         floor_all = am.rms_error(da["mean"], am.align(db["t"], db["mean"], da["t"])[1])
         report += [f"## U_s = {u:g}", "", f"Noise floor RMS(D_a - D_b) over all samples: **{floor_all:.3f} d_p**; "
-                   f"direct wall time {wall_direct:.0f} s (mean of the two).", "",
+                   f"direct wall time {wall_direct:.0f} s (the directs made in this study; runs copied from an "
+                   "earlier study, which carried its load, have no wall ratio).", "",
                    "| run | error e [d_p] | floor on its samples | e / floor | DEM-time speed-up | wall speed-up | "
                    "jumps kept / rejected / direct bursts | mean DT |", "|---|---|---|---|---|---|---|---|"]
         for name, mode, _, _ in runs(u):
@@ -156,7 +161,7 @@ def analyse(args):
             r = load(folder, name)
             e, floor, n = score(r, da, db)
             s_dem = float(r["simulated_time"]) / float(r["dem_time"])
-            s_wall = wall_direct / float(r["wall_seconds"])
+            s_wall = math.nan if copied(name) else wall_direct / float(r["wall_seconds"])
             st = r.get("status", [])
             kept = sum(1 for s in st if s == "projected")
             rej = sum(1 for s in st if s == "rejected")
@@ -166,7 +171,8 @@ def analyse(args):
                          "speedup_wall": s_wall, "kept": kept, "rejected": rej, "direct_bursts": direct,
                          "mean_dt": float(np.mean(dts)) if dts else 0.0, "samples": n,
                          "summary": r.get("summary", "")})
-            report.append(f"| {name} | {e:.3f} | {floor:.3f} | {e / floor:.2f} | {s_dem:.2f} | {s_wall:.2f} | "
+            report.append(f"| {name}{' (copied)' if copied(name) else ''} | {e:.3f} | {floor:.3f} | {e / floor:.2f} | "
+                          f"{s_dem:.2f} | {s_wall:.2f} | "
                           f"{kept} / {rej} / {direct} | {rows[-1]['mean_dt']:.1f} |")
         report.append("")
         for row in rows:
