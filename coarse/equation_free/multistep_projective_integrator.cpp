@@ -157,7 +157,8 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     limit(dt_cap_, "rejection");
     if (settings_.dt_quantum > 0.0 && std::isfinite(dt))
         dt = std::floor(dt / settings_.dt_quantum * (1.0 + 1e-12)) * settings_.dt_quantum;
-    if (end_limit(dt) <= 0.0) {  // this step's burst is the run's last: no jump before it
+    const double tol = time_tolerance(end_time());
+    if (end_limit(dt) <= tol) {  // this step's burst is the run's last: no jump before it
         c.limited_by = "end of run";
         return 0.0;
     }
@@ -176,6 +177,7 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         // burst in this jump (less than one burst further), do that instead.
         const double to_last_burst = end_time() - (t_end_ + burst);
         dt = to_last_burst > dt && to_last_burst <= c.dt_tolerance ? to_last_burst : end;
+        if (dt <= tol) return 0.0;  // rounding: nothing left to jump
         c.limited_by = "end of run";
     }
     // Never a jump the measured transient would be amplified by: shorten until stable.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Adaptive CPI on a real MPI ensemble (4 realizations on 2 ranks): a rejected jump leaves no
-# trace in the ensemble. Run A is forced to reject its 2nd jump attempt and redo it with half
+# trace in the ensemble. Run A is forced to reject its 3rd jump attempt and redo it with half
 # the DT; run B is forced to plan that jump with half the DT directly. Every realization goes
 # back to its kept micro state and its lifting stream, so every sample both runs record
 # (/samples/*: the rejected burst's samples are never recorded) is bit for bit the same, and
@@ -12,8 +12,8 @@ mpiflags=("$@")
 here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-common=(mode=cpi cpi.projection=adaptive cpi.tolerance=0.3 cpi.dt_min=0.5 run.duration=12
-        ensemble.realizations_per_rank=2 output.directory="$work" cpi.debug.force_attempt=2)
+common=(mode=cpi cpi.projection=adaptive cpi.tolerance=0.1 cpi.dt_min=0.5 run.duration=24
+        ensemble.realizations_per_rank=2 output.directory="$work" cpi.debug.force_attempt=3)
 for kind in reject shrink; do
   timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$here/tiny_scene.cfg" "${common[@]}" cpi.debug.force=$kind \
     output.prefix=$kind > "$work/$kind.log" 2>&1 || { echo "FAIL: $kind run failed"; cat "$work/$kind.log"; exit 1; }
