@@ -321,7 +321,11 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     stepper.return_to_kept_state();
     const JumpErrorModel posterior{nodes, t_end_, d.norm, 1.0};
     const double redo = largest_dt_within(posterior, s.safety * s.tolerance, rec.dt);
-    dt_cap_ = forced_reject ? 0.5 * rec.dt : std::max(s.dt_min, std::min(redo, 0.5 * rec.dt));
+    // A redo that the curvature seen would not allow even at dt_min is not tried: the next step
+    // runs one burst directly (cap 0) instead of a jump known to exceed the tolerance.
+    dt_cap_ = forced_reject        ? 0.5 * rec.dt
+              : redo < s.dt_min    ? 0.0
+                                   : std::max(s.dt_min, std::min(redo, 0.5 * rec.dt));
     ++consecutive_rejections_;
     ++totals_.rejected;
     rec.status = StepStatus::rejected;
