@@ -46,7 +46,7 @@ import accuracy_metrics as am  # noqa: E402
 sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
 
-SCENE = os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg")
+SCENE = os.path.join(HERE, "scenes", "demo_bed.cfg")  # the demo bed without its cpi block
 DURATION = 200.0
 TOLERANCES = (0.08, 0.04, 0.16)  # d_p per jump; the middle one first
 SPEEDS = (0.19, 0.41)
@@ -64,7 +64,7 @@ def runs(u=0.19):
     out = [("direct_a", "direct", 101, {}), ("direct_b", "direct", 202, {})]
     adaptive = lambda tol: {"cpi.projection": "adaptive", "cpi.tolerance": tol, **ADAPTIVE_BURST[u]}  # noqa: E731
     out.append((f"adaptive_tol{TOLERANCES[0]:g}", "cpi", 404, adaptive(TOLERANCES[0])))
-    out.append(("fixed_dt40", "cpi", 303, {"cpi.dt": 40}))
+    out.append(("fixed_dt40", "cpi", 303, {"cpi.projection": "fixed", "cpi.dt": 40}))
     for tol in TOLERANCES[1:]:
         out.append((f"adaptive_tol{tol:g}", "cpi", 404, adaptive(tol)))
     return out
