@@ -50,7 +50,7 @@ import accuracy_metrics as am  # noqa: E402
 sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
 
-SCENE = os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg")
+SCENE = os.path.join(HERE, "scenes", "demo_bed.cfg")  # the demo bed without the demo's cpi block
 BASE = {"gas_drag.superficial_velocity": 0.19, "run.duration": 200, "cpi.healing": 10, "cpi.window": 10,
         "ensemble.realizations_per_rank": 2}
 NP = 2

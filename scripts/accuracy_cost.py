@@ -34,7 +34,7 @@ import accuracy_metrics as am  # noqa: E402
 # of the driver tests (256 spheres in 4.28 x 4.28), settled.
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = {
-    False: (os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg"),
+    False: (os.path.join(HERE, "..", "bench", "scenes", "demo_bed.cfg"),  # the demo bed, no cpi block
             {"run.duration": 200, "cpi.warmup": 10, "cpi.healing": 10, "cpi.window": 10, "cpi.dt": 40}),
     True: (os.path.join(HERE, "..", "tests", "scripts", "tiny_scene.cfg"),
            {"bed.settle": "true", "bed.settle.ke_threshold": 1e-5, "run.duration": 40, "cpi.warmup": 5,

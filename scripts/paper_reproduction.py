@@ -25,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCENE = os.path.join(HERE, "..", "examples", "demo_small", "scene.cfg")
+SCENE = os.path.join(HERE, "..", "bench", "scenes", "demo_bed.cfg")  # the demo bed without the demo's cpi block
 sys.path.insert(0, HERE)
 import plot_icdf  # noqa: E402
 
