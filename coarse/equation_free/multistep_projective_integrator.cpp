@@ -162,6 +162,12 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         c.limited_by = "end of run";
         return 0.0;
     }
+    if (dt < s.dt_min * (1.0 - 1e-12) && c.limited_by == "rejection") {
+        append_message(rec, fmt::format("the curvature the rejected jump showed allows no DT >= cpi.dt_min = {:.3g} "
+                                        "within the tolerance: one burst of direct simulation instead", s.dt_min));
+        c.limited_by = "tolerance below dt_min";
+        return 0.0;
+    }
     if (dt < s.dt_min * (1.0 - 1e-12)) {
         append_message(rec, fmt::format("the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = {:.3g} "
                                         "(statistical error of one DT_min jump {:.3g}): one burst of direct "
