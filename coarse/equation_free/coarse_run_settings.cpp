@@ -103,6 +103,10 @@ double CoarseRunSettings::burst() const {
     return projection == Projection::periods ? periods.healing + periods.window : fixed.healing + fixed.window;
 }
 
+double CoarseRunSettings::window() const {
+    return projection == Projection::periods ? periods.window : fixed.window;
+}
+
 std::unique_ptr<ProjectiveIntegrator> CoarseRunSettings::make_integrator(RepairHook repair) const {
     if (projection == Projection::adaptive || (projection == Projection::fixed && steps == 2))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));

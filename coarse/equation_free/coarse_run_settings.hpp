@@ -68,6 +68,8 @@ struct CoarseRunSettings {
 
     /// healing + window of the selected projection: the length of an unextended burst.
     double burst() const;
+    /// The estimation window of the selected projection.
+    double window() const;
     /// The integrator these settings select, with `repair` applied to every projected vector.
     std::unique_ptr<ProjectiveIntegrator> make_integrator(RepairHook repair) const;
 };

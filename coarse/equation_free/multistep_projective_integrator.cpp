@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <utility>
 
 #include <fmt/format.h>
@@ -43,13 +42,15 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     rec.burst = BurstSamples{};
     rec.burst_length = length;
     stepper.run(length, rec.burst);
-    ProjectiveStepRecord check;  // check_burst() fills t_end/x_end: keep rec's (the jump origin)
-    check.burst = rec.burst;
-    if (!check_burst(check, stepper.time(), false)) {
-        rec.status = StepStatus::invalid_burst;
-        append_message(rec, check.message);
-        return false;
-    }
+    // check_burst() sets rec.t_end/x_end to the burst's end; rec keeps the jump origin there.
+    const double origin_t = rec.t_end;
+    Eigen::VectorXd origin_x = std::move(rec.x_end);
+    const bool valid = check_burst(rec, stepper.time(), false);
+    out.t_end = rec.t_end;
+    out.x_end = std::move(rec.x_end);
+    rec.t_end = origin_t;
+    rec.x_end = std::move(origin_x);
+    if (!valid) return false;
     const double t_window = t_start + length - settings_.window;  // the last `window` of the burst
     const SlopeEstimate slope = least_squares_slope(rec.burst.t, rec.burst.x, t_window);
     if (!slope.ok) {
@@ -68,12 +69,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         }
         out.node.se = Eigen::VectorXd::Zero(slope.slope.size());  // fixed DT: estimates without noise
     }
-    double tau = 0.0;
-    const std::size_t first = first_sample_at_or_after(rec.burst.t, t_window);
-    for (std::size_t k = first; k < rec.burst.t.size(); ++k) tau += rec.burst.t[k];
-    out.node.tau = tau / static_cast<double>(rec.burst.t.size() - first);
-    out.t_end = check.t_end;
-    out.x_end = check.x_end;
+    out.node.tau = slope.t_mean;
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
     if (settings_.adaptive && std::isfinite(settings_.drift_rate)) {
         // No jump from a slope that is not the slow dynamics': a fast transient, or a wave
@@ -81,11 +77,11 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
         const WaveCoherence w = wave_coherence(rec.burst, t_start);
         if (d.drifting) {
-            out.drifting = true;
-            out.drift = "still in a fast transient (" + d.message + ")";
+            out.hold_kind = "fast transient";
+            out.hold = "still in a fast transient (" + d.message + ")";
         } else if (w.in_phase && !(std::isfinite(w.period) && settings_.window >= 2.0 * w.period * (1.0 - 1e-9))) {
-            out.drifting = true;
-            out.drift = fmt::format("{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
+            out.hold_kind = "in-phase wave";
+            out.hold = fmt::format("{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
                                     "by the common wave beyond its standard error; use cpi.window >= {}",
                                     w.message, settings_.window,
                                     std::isfinite(w.period) ? fmt::format("{:.3g}", 2.0 * w.period)
@@ -102,8 +98,8 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
     t_end_ = m.t_end;
     x_end_ = m.x_end;
     decay_ = m.decay;
-    drifting_ = m.drifting;
-    drift_ = m.drift;
+    hold_kind_ = m.hold_kind;
+    hold_ = m.hold;
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -130,9 +126,9 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         return std::min(settings_.dt, end_limit(settings_.dt));
     }
     const StepSizeSettings& s = settings_.control;
-    if (drifting_) {  // the slope is the fast transient's, not the slow dynamics'
-        append_message(rec, drift_ + ": one burst of direct simulation");
-        c.limited_by = drift_.rfind("still in a fast transient", 0) == 0 ? "fast transient" : "in-phase wave";
+    if (!hold_.empty()) {  // the slope is a fast transient's or a common wave's, not the slow dynamics'
+        append_message(rec, hold_ + ": one burst of direct simulation");
+        c.limited_by = hold_kind_;
         return 0.0;
     }
     const double target = s.safety * s.tolerance;
@@ -141,6 +137,7 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     c.dt_tolerance_2r = largest_dt_within(model, target, s.dt_max);
     model.se_scale = 0.5;
     c.dt_tolerance_4r = largest_dt_within(model, target, s.dt_max);
+    model.se_scale = 1.0;  // the realizations this run has
 
     double dt = c.dt_tolerance;
     c.limited_by = dt >= s.dt_max ? "dt_max" : "tolerance";
@@ -162,18 +159,15 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         c.limited_by = "end of run";
         return 0.0;
     }
-    if (dt < s.dt_min * (1.0 - 1e-12) && c.limited_by == "rejection") {
-        append_message(rec, fmt::format("the curvature the rejected jump showed allows no DT >= cpi.dt_min = {:.3g} "
-                                        "within the tolerance: one burst of direct simulation instead", s.dt_min));
-        c.limited_by = "tolerance below dt_min";
-        return 0.0;
-    }
     if (dt < s.dt_min * (1.0 - 1e-12)) {
-        append_message(rec, fmt::format("the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = {:.3g} "
-                                        "(statistical error of one DT_min jump {:.3g}): one burst of direct "
-                                        "simulation instead",
-                                        s.tolerance, c.dt_tolerance, s.dt_min,
-                                        jump_error({method_nodes(), t_end_, model.curvature, 1.0}, s.dt_min).statistical));
+        const std::string why =
+            c.limited_by == "rejection"
+                ? fmt::format("the curvature the rejected jump showed allows no DT >= cpi.dt_min = {:.3g} within the "
+                              "tolerance", s.dt_min)
+                : fmt::format("the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = {:.3g} (statistical error of "
+                              "one DT_min jump {:.3g})", s.tolerance, c.dt_tolerance, s.dt_min,
+                              jump_error(model, s.dt_min).statistical);
+        append_message(rec, why + ": one burst of direct simulation instead");
         c.limited_by = "tolerance below dt_min";
         return 0.0;
     }
@@ -364,9 +358,9 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
 void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::string& text) const {
     r.clear();
     const Eigen::Index m = x_end_.size();
-    r.insert(r.end(), {1.0 /* layout version */, static_cast<double>(history_.size()), static_cast<double>(m), t_end_,
+    r.insert(r.end(), {2.0 /* layout version */, static_cast<double>(history_.size()), static_cast<double>(m), t_end_,
                        dt_last_, dt_cap_, static_cast<double>(consecutive_rejections_), decay_.ok ? 1.0 : 0.0,
-                       decay_.rate, decay_.ratio, decay_.delay, drifting_ ? 1.0 : 0.0});
+                       decay_.rate, decay_.ratio, decay_.delay});
     r.insert(r.end(), x_end_.data(), x_end_.data() + m);
     for (const auto& n : history_) {
         r.push_back(n.tau);
@@ -377,16 +371,16 @@ void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::stri
     r.insert(r.end(), {static_cast<double>(t.attempts), static_cast<double>(t.accepted), static_cast<double>(t.rejected),
                        static_cast<double>(t.direct), t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r,
                        t.dt_tolerance_4r, t.statistical, t.truncation});
-    text = decay_.message + '\n' + drift_;
+    text = decay_.message + '\n' + hold_kind_ + '\n' + hold_;
 }
 
 void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, const std::string& text) {
     history_.clear();
     if (r.empty()) return;  // saved before the first burst
-    EFDEM_EXPECTS(r.size() >= 12 && r[0] == 1.0);
+    EFDEM_EXPECTS(r.size() >= 11 && r[0] == 2.0);
     const auto n = static_cast<std::size_t>(r[1]);
     const auto m = static_cast<Eigen::Index>(r[2]);
-    EFDEM_EXPECTS(r.size() == 12 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10);
+    EFDEM_EXPECTS(r.size() == 11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10);
     t_end_ = r[3];
     dt_last_ = r[4];
     dt_cap_ = r[5];
@@ -395,11 +389,13 @@ void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, 
     decay_.rate = r[8];
     decay_.ratio = r[9];
     decay_.delay = r[10];
-    drifting_ = r[11] != 0.0;
-    const std::size_t cut = text.find('\n');
-    decay_.message = text.substr(0, cut);
-    drift_ = cut == std::string::npos ? std::string{} : text.substr(cut + 1);
-    std::size_t k = 12;
+    // Three lines: the decay estimate's message, then why no jump may start here (kind, text).
+    const std::size_t a = text.find('\n'), b = a == std::string::npos ? a : text.find('\n', a + 1);
+    EFDEM_EXPECTS(b != std::string::npos);
+    decay_.message = text.substr(0, a);
+    hold_kind_ = text.substr(a + 1, b - a - 1);
+    hold_ = text.substr(b + 1);
+    std::size_t k = 11;
     auto vec = [&] {
         Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(r.data() + k, m);
         k += static_cast<std::size_t>(m);

@@ -115,8 +115,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         double t_end = 0.0;
         Eigen::VectorXd x_end;
         DecayRateEstimate decay;
-        bool drifting = false;
-        std::string drift;
+        /// Why no jump may start from this burst (empty: it may), and its short kind.
+        std::string hold, hold_kind;
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out, double length = 0.0) const;
@@ -132,8 +132,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     double t_end_ = 0.0;             ///< end of the last accepted burst
     Eigen::VectorXd x_end_;          ///< X there
     DecayRateEstimate decay_;        ///< from the last accepted burst
-    bool drifting_ = false;          ///< its phase signal drifted: a fast transient
-    std::string drift_;              ///< what phase_drift() said
+    std::string hold_;               ///< why no jump may start from it (empty: one may)
+    std::string hold_kind_;          ///< "fast transient" or "in-phase wave"
     double dt_last_ = std::numeric_limits<double>::quiet_NaN();   ///< last kept DT
     double dt_cap_ = std::numeric_limits<double>::infinity();     ///< set by a rejection
     long consecutive_rejections_ = 0;

@@ -109,8 +109,7 @@ void ProjectiveRun::warm_up() {
     const double length = std::min(std::max(settings_.warmup, burst), room);
     if (length > 0) stepper_.run(length, w);
     // On until the phase signal's drift over the last burst length is within its noise.
-    const double window = settings_.projection == CoarseRunSettings::Projection::periods ? settings_.periods.window
-                                                                                          : settings_.fixed.window;
+    const double window = settings_.window();
     const double t_limit = std::min(t0 + settings_.warmup + settings_.warmup_max, t0 + room);
     const double tol = time_tolerance(t_end_);
     while (true) {

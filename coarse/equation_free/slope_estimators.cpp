@@ -128,7 +128,9 @@ SlopeEstimate least_squares_slope(std::span<const double> t, std::span<const Eig
     }
     const auto tw = t.subspan(first);
     const auto xw = x.subspan(first);
-    est.slope = least_squares_line(tw, xw).slope;
+    const Line<Eigen::VectorXd> line = least_squares_line(tw, xw);
+    est.slope = line.slope;
+    est.t_mean = line.t_mean;
     est.t_first = tw.front();
     est.t_last = tw.back();
     est.ok = true;

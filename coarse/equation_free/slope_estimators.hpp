@@ -30,6 +30,8 @@ struct SlopeEstimate {
     Eigen::Index n_samples = 0;
     double t_first = 0.0;
     double t_last = 0.0;
+    /// Mean time of those samples: where a least-squares slope belongs (exact for a quadratic).
+    double t_mean = 0.0;
     /// Why there is no estimate (empty when ok).
     std::string message;
 };
