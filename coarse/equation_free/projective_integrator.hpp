@@ -135,6 +135,12 @@ class ProjectiveIntegrator {
     /// a checkpoint; integrators without one save nothing. restore_state() takes what
     /// save_state() wrote, so that the next step is bit for bit the one the saved run made.
     virtual void save_state(std::vector<double>& reals, std::string& text) const;
+    /// What the integrator did over the run, in a few lines for the log and the run file
+    /// (`realizations`: the ensemble's R); empty for integrators with nothing to add.
+    virtual std::string summary(int realizations) const {
+        (void)realizations;
+        return {};
+    }
     virtual void restore_state(const std::vector<double>& reals, const std::string& text);
 
   protected:

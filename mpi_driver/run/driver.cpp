@@ -4,7 +4,6 @@
 #include <cmath>
 #include <string>
 
-#include "coarse/equation_free/multistep_projective_integrator.hpp"
 #include "coarse/equation_free/projective_run.hpp"
 #include "core/log.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
@@ -96,10 +95,8 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     sum.simulated_time = out.simulated_time;
     fill_totals(sum, stepper, progress);
     sum.lift_seconds = stepper.overhead().lift_seconds;
-    if (const auto* m = dynamic_cast<const coarse::MultistepProjectiveIntegrator*>(&run.integrator())) {
-        sum.controller = m->summary(stepper.realizations());
-        log::info("{}", sum.controller);
-    }
+    sum.controller = run.integrator().summary(stepper.realizations());
+    if (!sum.controller.empty()) log::info("{}", sum.controller);
     return sum;
 }
 
