@@ -20,6 +20,9 @@ namespace efdem {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitInputError = 2;
 inline constexpr int kExitRuntimeFailure = 3;
+/// Stopped by a signal (SIGTERM, SIGINT, SIGUSR1) at a safe point, with a checkpoint written
+/// there: the run can be continued with restart=FILE (a batch script can requeue on it).
+inline constexpr int kExitInterrupted = 4;
 
 /// How a piece of user input is quoted inside a message: control bytes and bytes that are not
 /// printable ASCII or part of valid UTF-8 are shown as \xNN (a terminal never receives raw

@@ -35,6 +35,7 @@
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 #include "mpi_driver/ensemble/scene_input.hpp"
+#include "mpi_driver/ensemble/stop_signal.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;
@@ -128,8 +129,9 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         control.resume = restart->header.driver;
     }
 #if EFDEM_HAVE_HDF5
+    // Always a writer: a stop signal checkpoints even a run without periodic checkpoints.
     std::unique_ptr<CheckpointWriter> writer;
-    if (s.checkpoint.enabled()) {
+    {
         CheckpointHeader identity;
         identity.mode = prov.mode;
         identity.realizations = prov.realizations;
@@ -138,25 +140,52 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         // The recorders (root only) name the files they write; the checkpoint stores them whole.
         writer = std::make_unique<CheckpointWriter>(layout, s.checkpoint, s.output.prefix, std::move(identity),
                                                     recorders ? recorders->files() : std::vector<std::filesystem::path>{});
-        stepper.set_checkpoint_writer(writer.get());
+        stepper.set_checkpoint_writer(writer.get(), s.checkpoint.enabled());
         control.checkpoint_interval = s.checkpoint.interval;
     }
 #endif
     if (!mpi.is_root()) {
-        stepper.serve();
-        return kExitOk;
+        try {
+            stepper.serve();
+        } catch (const RunFailed&) {
+            return kExitRuntimeFailure;  // the failing rank said why; the root marks the run file
+        }
+        return stepper.finish_code();
     }
     RunSummary summary;
     try {
         summary = s.is_cpi() ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(), progress, control)
                              : run_direct(stepper, s, progress, control);
         recorders->finish(summary);
+    } catch (const RunFailed& e) {
+        summary.end_status = std::string("failed: ") + e.what();
+        try {
+            recorders->finish(summary);
+        } catch (const std::exception& again) {
+            log::error("the run file could not be marked failed: {}", again.what());
+        }
+        log::error("the run failed; its files in {} are marked 'failed'", s.output.directory.string());
+        return kExitRuntimeFailure;
     } catch (const std::exception& e) {
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
     log::info("{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall, {:.3e} particle-steps",
               summary.end_status, summary.simulated_time, summary.dem_time,
               format_duration(summary.wall_seconds), summary.particle_steps);
+    if (summary.stop_signal != 0) {
+        if (summary.checkpoint.empty()) {
+            std::fprintf(stderr, "efdem: stopped by %s; nothing could be saved (no HDF5)\n",
+                         signal_name(summary.stop_signal).c_str());
+        } else {
+            std::string command = fmt::format("mpirun -n {} efdem {}", mpi.size(), table.file());
+            for (const auto& o : table.overrides()) command += " " + o;
+            std::fprintf(stderr, "efdem: stopped by %s: checkpoint %s (t = %.6g); continue with: %s restart=%s\n",
+                         signal_name(summary.stop_signal).c_str(), summary.checkpoint.c_str(),
+                         summary.checkpoint_time, command.c_str(), summary.checkpoint.c_str());
+        }
+        std::fflush(stderr);
+        return kExitInterrupted;
+    }
     return kExitOk;
 }
 
@@ -172,6 +201,8 @@ void print_effects() {
 int main(int argc, char** argv) {
     MpiSession mpi(&argc, &argv);
     log::configure(mpi.rank(), mpi.size(), log::Level::info);
+    // From here on a stop signal is held until the run reaches a safe point (stop_signal.hpp).
+    install_stop_signal_handlers();
 
     RunOptions options;
     try {
@@ -222,7 +253,7 @@ int main(int argc, char** argv) {
             [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
         if (!check) {
             std::filesystem::create_directories(settings->output.directory);
-            if (settings->checkpoint.enabled()) std::filesystem::create_directories(settings->checkpoint.directory);
+            std::filesystem::create_directories(settings->checkpoint.directory);  // a stop signal checkpoints
         }
 #if !EFDEM_HAVE_HDF5
         if (settings->checkpoint.enabled() || !options.restart.empty())

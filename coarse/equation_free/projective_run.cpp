@@ -45,12 +45,15 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
     if (resume) integrator_->restore_state(state_.integrator, state_.integrator_text);
     ProjectiveRunOutcome out;
     out.end_status = "completed";
-    if ((settings_.warmup > 0 || settings_.warmup_until_steady) && !resume) {
+    if ((settings_.warmup > 0 || settings_.warmup_until_steady) && !state_.warmed_up) {
         // The initial state (a packed bed at rest) is far from the slow manifold: run it
         // directly until the fast transients are gone before the first projection.
+        integrator_->save_state(state_.integrator, state_.integrator_text);
+        for (auto* o : observers_) o->between_steps(*this);
         warm_up();
         for (auto* o : observers_) o->warmup_done(*this);
     }
+    state_.warmed_up = true;
     while (stepper_.time() < t_end_ - tol) {
         integrator_->save_state(state_.integrator, state_.integrator_text);
         for (auto* o : observers_) o->between_steps(*this);

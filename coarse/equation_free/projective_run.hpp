@@ -49,6 +49,9 @@ struct ProjectiveRunState {
     long coarse_steps = 0;      ///< outer steps done
     long without_progress = 0;  ///< consecutive steps without a jump
     bool fell_back = false;     ///< the primary coarse variable failed; the fallback is in use
+    /// The warm-up is done (false in a state saved before or during it: a run resumed from
+    /// there does the warm-up from the start).
+    bool warmed_up = false;
     /// The integrator's own state (ProjectiveIntegrator::save_state(); empty for the
     /// single-step integrators).
     std::vector<double> integrator;
@@ -76,7 +79,9 @@ class ProjectiveRunObserver {
     virtual ~ProjectiveRunObserver() = default;
     /// After the warm-up of a new run (not called on a resumed run or without warm-up).
     virtual void warmup_done(const ProjectiveRun& run) { (void)run; }
-    /// Before every coarse step, where nothing of a burst is pending: checkpoints go here.
+    /// Before every coarse step, where nothing of a burst is pending: checkpoints go here. Also
+    /// called once before the warm-up (state().warmed_up false), where a run that must stop can
+    /// go back to.
     virtual void between_steps(const ProjectiveRun& run) { (void)run; }
     /// After every coarse step (run.state().coarse_steps already counts it).
     virtual void step_done(const ProjectiveRun& run, const ProjectiveStepRecord& record) {

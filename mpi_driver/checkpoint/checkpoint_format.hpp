@@ -9,7 +9,8 @@
 ///                           complete = 1 (a file without it was interrupted)
 ///   /scene, /parameters     the scene text; every parameter as "key = value" lines
 ///   /driver/reals           t_origin, micro_time, particle_steps, height_lo, height_hi
-///   /driver/integers        samples_taken, coarse_steps, without_progress, fell_back
+///   /driver/integers        samples_taken, coarse_steps, without_progress, fell_back,
+///                           warmed_up (format 3; earlier formats: 4 values, warmed up)
 ///   /driver/lifting         R x 4: each realization's lifting random stream (xoshiro state)
 ///   /driver/observable, /driver/recorded   warm starts of the coarse observables
 ///   /driver/integrator, /driver/integrator_text   the integrator's own state (version >= 2)
@@ -33,7 +34,7 @@ namespace efdem::mpi_driver {
 
 /// 2 added /driver/integrator and /driver/integrator_text (the multistep integrator's slope
 /// history and step-size controller); version 1 files (without them) are still read.
-inline constexpr std::int64_t kCheckpointFormatVersion = 2;
+inline constexpr std::int64_t kCheckpointFormatVersion = 3;
 inline constexpr std::int64_t kOldestReadableCheckpointFormat = 1;
 
 /// The root's state of the coarse layer (EnsembleStepper).

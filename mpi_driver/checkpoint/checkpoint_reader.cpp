@@ -58,7 +58,8 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         h.parameters = f.read_text("/parameters");
         const auto reals = f.read_doubles("/driver/reals");
         const auto integers = f.read_integers("/driver/integers");
-        if (reals.size() != 5 || integers.size() != 4) refuse(path, "has a malformed /driver group");
+        if (reals.size() != 5 || integers.size() != (h.format_version >= 3 ? 5U : 4U))
+            refuse(path, "has a malformed /driver group");
         h.driver.t_origin = reals[0];
         h.stepper.micro_time = reals[1];
         h.stepper.particle_steps = reals[2];
@@ -68,6 +69,8 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         h.driver.coarse_steps = integers[1];
         h.driver.without_progress = integers[2];
         h.driver.fell_back = integers[3] != 0;
+        // Before format 3 checkpoints were only written after the warm-up.
+        h.driver.warmed_up = h.format_version < 3 || integers[4] != 0;
         const auto lifting = f.read_integers("/driver/lifting");
         if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
             refuse(path, "has a malformed /driver/lifting dataset");

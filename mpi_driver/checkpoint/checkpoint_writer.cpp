@@ -199,7 +199,7 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     const std::vector<double> reals{h.driver.t_origin, s.micro_time, s.particle_steps, s.height_lo, s.height_hi};
     f.write("/driver/reals", std::span<const double>(reals), {reals.size()});
     const std::vector<std::int64_t> integers{s.samples_taken, h.driver.coarse_steps, h.driver.without_progress,
-                                             h.driver.fell_back ? 1 : 0};
+                                             h.driver.fell_back ? 1 : 0, h.driver.warmed_up ? 1 : 0};
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
     std::vector<std::int64_t> lifting;
     for (const auto& st : s.lifting)

@@ -1,11 +1,13 @@
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include <fmt/format.h>
 
 #include "core/contracts.hpp"
 #include "core/error.hpp"
+#include "mpi_driver/ensemble/stop_signal.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -29,20 +31,55 @@ bool EnsembleStepper::needs_top_half() const {
     return observable_->needs_top_half() || (settings_.recorded && settings_.recorded->needs_top_half());
 }
 
-void EnsembleStepper::fail(const std::string& message, long realization) const {
-    // The failed state is not written: it is not healthy, and the other ranks are not at a
-    // point where they could join a collective write. The newest checkpoint is the last
+std::string EnsembleStepper::where_saved() const {
+    // The failed state is not written: it is not healthy. The newest checkpoint is the last
     // healthy state saved.
-    std::string saved;
-    if (!writer_) saved = "checkpointing is off (checkpoint.interval = 0): there is no checkpoint to restart from";
-    else if (last_checkpoint_.empty()) saved = "no checkpoint had been written yet";
-    else
-        saved = fmt::format("the failed state is not checkpointed; the newest checkpoint, {} (t = {:.6g}), "
-                            "holds the last saved healthy state (restart=FILE)",
-                            last_checkpoint_.string(), last_checkpoint_time_);
+    if (!writer_) return "there is no checkpoint to restart from (this efdem has no HDF5)";
+    if (!periodic_checkpoints_ && last_checkpoint_.empty())
+        return "checkpointing is off (checkpoint.interval = 0): there is no checkpoint to restart from";
+    if (last_checkpoint_.empty())
+        return "no checkpoint had been written yet (checkpoint.interval sets how often one is)";
+    return fmt::format("the failed state is not checkpointed; the newest checkpoint, {} (t = {:.6g}), "
+                       "holds the last saved healthy state (restart=FILE)",
+                       last_checkpoint_.string(), last_checkpoint_time_);
+}
+
+void EnsembleStepper::fail(const std::string& message, long realization) const {
+    // Used where the ranks cannot agree first (keeping or restoring states, checkpoints).
     const std::string who = fmt::format("realization {}: ", realization);
-    layout_.mpi().abort(fmt::format("{}{}; {}", message.rfind(who, 0) == 0 ? "" : who, message, saved),
+    layout_.mpi().abort(fmt::format("{}{}; {}", message.rfind(who, 0) == 0 ? "" : who, message, where_saved()),
                         kExitRuntimeFailure);
+}
+
+int EnsembleStepper::agree(const std::vector<Failure>& failures, bool with_signal) {
+    int local[2] = {with_signal ? stop_signal_received() : 0, static_cast<int>(failures.size())};
+    int global[2] = {0, 0};
+    MPI_Allreduce(local, global, 2, MPI_INT, MPI_MAX, layout_.mpi().comm());
+    if (global[1] > 0) fail_agreed(failures);
+    return global[0];
+}
+
+void EnsembleStepper::fail_agreed(const std::vector<Failure>& failures) {
+    // The failing rank says what failed (with its rank in the prefix); the root gets the
+    // messages so that the run file can say it too.
+    for (const Failure& f : failures) {
+        const std::string who = fmt::format("realization {}: ", f.realization);
+        const std::string text =
+            fmt::format("{}{}; {}", f.message.rfind(who, 0) == 0 ? "" : who, f.message, where_saved());
+        std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", layout_.mpi().rank(), layout_.mpi().size(),
+                     text.c_str());
+    }
+    std::fflush(stderr);
+    std::vector<std::vector<std::uint8_t>> mine(local_.size());
+    for (const Failure& f : failures) {
+        const std::string text = fmt::format("realization {} at t = {:.6g}: {}", f.realization, time(), f.message);
+        mine[static_cast<std::size_t>(f.realization - layout_.first_index())].assign(text.begin(), text.end());
+    }
+    const auto all = layout_.gather_arrays(mine);
+    std::string summary;
+    for (const auto& m : all)
+        if (!m.empty()) summary += (summary.empty() ? "" : "; ") + std::string(m.begin(), m.end());
+    throw RunFailed(summary.empty() ? std::string("a realization failed (see the messages above)") : summary);
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
@@ -52,9 +89,11 @@ EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
 }
 
 void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
+    if (interrupted_) throw RunInterrupted(interrupted_, time());
     const bool top = needs_top_half();
     broadcast({Command::run, duration, top});
-    do_run(std::lround(duration / settings_.sample_interval), top, &out);
+    const long wanted = std::lround(duration / settings_.sample_interval);
+    if (do_run(wanted, top, &out) < wanted) throw RunInterrupted(interrupted_, time());
 }
 
 void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
@@ -63,7 +102,54 @@ void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
     do_lift(new_time, top, &target);
 }
 
-void EnsembleStepper::finish() { broadcast({Command::finish, 0.0, false}); }
+void EnsembleStepper::finish(int exit_code) {
+    if (exit_code != kExitInterrupted) flush_since_mark();
+    finish_code_ = exit_code;
+    broadcast({Command::finish, static_cast<double>(exit_code), false});
+}
+
+void EnsembleStepper::record(const SampleRecord& s) {
+    if (!recorder_) return;
+    if (provisional_) pending_.push_back(s);  // recorded when the jump before it is kept
+    else if (has_resume_point_) since_mark_.push_back(s);
+    else recorder_->sample(s);
+}
+
+void EnsembleStepper::flush_since_mark() {
+    if (recorder_)
+        for (const SampleRecord& s : since_mark_) recorder_->sample(s);
+    since_mark_.clear();
+}
+
+void EnsembleStepper::mark_resume_point(const DriverState& driver) {
+    EFDEM_EXPECTS(!provisional_);
+    broadcast({Command::mark, 0.0, false});
+    do_mark();
+    resume_stepper_ = saved_state();
+    resume_driver_ = driver;
+    flush_since_mark();
+}
+
+void EnsembleStepper::do_mark() {
+    resume_states_.clear();
+    try {
+        for (const auto& r : local_) resume_states_.push_back(r->save_state());
+    } catch (const std::exception& e) {
+        fail(std::string("keeping the state between coarse steps: ") + e.what(), local_.front()->index());
+    }
+    resume_time_ = time();
+    has_resume_point_ = true;
+}
+
+std::filesystem::path EnsembleStepper::checkpoint_resume_point() {
+    EFDEM_EXPECTS(writer_ != nullptr && has_resume_point_);
+    const long sequence = resume_driver_.coarse_steps;
+    broadcast({Command::checkpoint_mark, static_cast<double>(sequence), false});
+    CheckpointHeader header;
+    header.stepper = resume_stepper_;
+    header.driver = resume_driver_;
+    return do_checkpoint(sequence, &header, true);
+}
 
 void EnsembleStepper::keep_state() {
     broadcast({Command::keep, 0.0, false});
@@ -113,11 +199,10 @@ void EnsembleStepper::do_go_back() {
 
 void EnsembleStepper::do_confirm() {
     EFDEM_EXPECTS(provisional_);
-    if (recorder_)
-        for (const SampleRecord& s : pending_) recorder_->sample(s);
+    provisional_ = false;
+    for (const SampleRecord& s : pending_) record(s);
     pending_.clear();
     kept_.clear();
-    provisional_ = false;
 }
 
 void EnsembleStepper::serve() {
@@ -126,30 +211,35 @@ void EnsembleStepper::serve() {
         switch (m.command) {
             case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
             case Command::lift: do_lift(m.value, m.top_half, nullptr); break;
-            case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr); break;
+            case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr, false); break;
             case Command::keep: do_keep(); break;
             case Command::go_back: do_go_back(); break;
             case Command::confirm: do_confirm(); break;
-            case Command::finish: return;
+            case Command::mark: do_mark(); break;
+            case Command::checkpoint_mark: do_checkpoint(std::lround(m.value), nullptr, true); break;
+            case Command::finish: finish_code_ = static_cast<int>(m.value); return;
         }
     }
 }
 
 std::filesystem::path EnsembleStepper::checkpoint(long sequence, const DriverState& driver) {
     EFDEM_EXPECTS(writer_ != nullptr && !provisional_);
+    flush_since_mark();  // the checkpoint stores the output files with every sample so far
     broadcast({Command::checkpoint, static_cast<double>(sequence), false});
     CheckpointHeader header;
     header.stepper = saved_state();
     header.driver = driver;
-    return do_checkpoint(sequence, &header);
+    return do_checkpoint(sequence, &header, false);
 }
 
-std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const CheckpointHeader* header) {
+std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const CheckpointHeader* header,
+                                                     bool at_resume_point) {
     std::vector<RealizationState> states;
     try {
-        for (const auto& r : local_) states.push_back(r->save_state());
-        last_checkpoint_ = writer_->write(sequence, states, header);
-        last_checkpoint_time_ = time();
+        if (!at_resume_point)
+            for (const auto& r : local_) states.push_back(r->save_state());
+        last_checkpoint_ = writer_->write(sequence, at_resume_point ? resume_states_ : states, header);
+        last_checkpoint_time_ = at_resume_point ? resume_time_ : time();
         return last_checkpoint_;
     } catch (const std::exception& e) {
         layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()), kExitRuntimeFailure);
@@ -181,8 +271,9 @@ void EnsembleStepper::restore_state(const StepperState& s) {
     if (settings_.recorded) settings_.recorded->restore_state(s.recorded);
 }
 
-void EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {
+long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {
     const InjectedFailure& inject = settings_.failure;
+    std::vector<Failure> failures;
     for (long s = 0; s < samples; ++s) {
         for (auto& r : local_) {
             try {
@@ -190,9 +281,10 @@ void EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
                 if (r->index() == inject.realization && r->time() >= inject.time)
                     throw RuntimeFailure("injected failure (debug.fail_realization)", r->index());
             } catch (const std::exception& e) {
-                fail(e.what(), r->index());
+                failures.push_back({r->index(), e.what()});
             }
         }
+        const int signal = agree(failures, true);
         micro_time_ += static_cast<double>(settings_.steps_per_sample) * local_.front()->dt();
         particle_steps_ += static_cast<double>(settings_.steps_per_sample) * total_particles_;
         take_sample(top_half, out);
@@ -201,10 +293,16 @@ void EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
             try {
                 r->after_sample(samples_taken_);
             } catch (const std::exception& e) {
-                fail(e.what(), r->index());
+                failures.push_back({r->index(), e.what()});
             }
         }
+        agree(failures, false);
+        if (signal != 0) {
+            interrupted_ = signal;
+            return s + 1;
+        }
     }
+    return samples;
 }
 
 void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
@@ -250,10 +348,7 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         if (observable_->restricts_members())
             out->members.push_back(observable_->restrict_members(all_icdf, all_top));
     }
-    if (recorder_) {
-        if (provisional_) pending_.push_back(rec);  // recorded when the jump before it is kept
-        else recorder_->sample(rec);
-    }
+    record(rec);
     overhead_.restrict_seconds += MPI_Wtime() - start;
     ++overhead_.samples;
     if (progress_) progress_->update(rec.time, particle_steps_, "");

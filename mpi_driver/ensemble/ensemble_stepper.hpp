@@ -14,11 +14,25 @@
 ///
 /// Only the root runs the macro integrator. The root's run()/lift() first broadcast a command;
 /// the other ranks sit in serve(), which executes the same collectives, until finish().
-/// A failure while running (e.g. a blown-up realization: the watchdog of dem::System) is printed
-/// with the rank and realization named, and where the last checkpoint is, and MPI_Abort ends the
-/// job: nobody waits in a collective.
+/// After every sample's DEM steps (and again after its per-realization output) the ranks agree
+/// (one MPI_Allreduce) on two things:
+///
+/// * a failure (e.g. a blown-up realization: the watchdog of dem::System, a full disk): the
+///   failing rank prints it with the rank and realization named and where the last checkpoint
+///   is; every rank throws RunFailed, the root marks the run file, and all exit together (no
+///   rank waits in a collective, nobody calls MPI_Abort);
+/// * a stop signal (stop_signal.hpp) received by any rank: every rank stops after that sample
+///   (interrupted()); the root's run() throws RunInterrupted if the burst was cut short.
+///
+/// Resume points (cpi): mark_resume_point() keeps every realization's state and the loop's state
+/// in memory between coarse steps and holds the samples taken after it back from the recorder
+/// until the next mark; checkpoint_resume_point() writes that state as a checkpoint. So a stop
+/// in the middle of a coarse step is checkpointed where the step began, and the restarted run
+/// redoes the step exactly as the uninterrupted run did it.
 
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -72,7 +86,12 @@ public:
     /// (every rank joins through serve()). Needs set_checkpoint_writer(). Returns its path.
     std::filesystem::path checkpoint(long sequence, const DriverState& driver);
     /// Every rank: the writer used by checkpoint() (null: none).
-    void set_checkpoint_writer(const CheckpointSink* writer) { writer_ = writer; }
+    /// `periodic`: the run also checkpoints at intervals (else only where a signal stops it).
+    void set_checkpoint_writer(const CheckpointSink* writer, bool periodic = true) {
+        writer_ = writer;
+        periodic_checkpoints_ = periodic;
+    }
+    bool can_checkpoint() const { return writer_ != nullptr; }
     /// The coarse layer's state (root: all of it; elsewhere the counters), and its restoration
     /// on a restart (every rank; the lifting streams and warm starts matter on the root only).
     StepperState saved_state() const;
@@ -81,8 +100,24 @@ public:
 
     /// Non-root ranks: execute the root's commands until finish(). Collective.
     void serve();
-    /// Root: release the other ranks from serve().
-    void finish();
+    /// Root: release the other ranks from serve() with the run's exit code (finish_code()).
+    /// Samples held back since the last resume point are recorded first, unless the run was
+    /// interrupted (the checkpoint continues it).
+    void finish(int exit_code = 0);
+    /// Non-root ranks, after serve(): the exit code the root finished with.
+    int finish_code() const { return finish_code_; }
+
+    /// Every rank: the stop signal the ensemble agreed on (0: none yet).
+    int interrupted() const { return interrupted_; }
+    /// Root: keep the state here (every realization, the stepper, the loop's `driver` state) as
+    /// the point a stop is checkpointed at, and record the samples held back since the last
+    /// one. Call only where nothing of a burst is pending (between coarse steps).
+    void mark_resume_point(const DriverState& driver);
+    bool has_resume_point() const { return has_resume_point_; }
+    /// Root: write the kept resume point as checkpoint number driver.coarse_steps (every rank
+    /// joins through serve()). Needs set_checkpoint_writer(). Returns its path.
+    std::filesystem::path checkpoint_resume_point();
+    double resume_point_time() const { return resume_time_; }
 
     /// Root: what the last lift did per realization, and the last sample.
     const LiftRecord& last_lift() const { return last_lift_; }
@@ -115,7 +150,10 @@ public:
     std::vector<std::unique_ptr<Realization>>& local() { return local_; }
 
 private:
-    enum class Command : int { run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7 };
+    enum class Command : int {
+        run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7, mark = 8,
+        checkpoint_mark = 9
+    };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
     /// exactly the collectives the root joins).
@@ -125,10 +163,25 @@ private:
         bool top_half;
     };
     Message broadcast(Message m) const;
-    void do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    /// Returns the samples taken (fewer than `samples` when a stop was agreed).
+    long do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    /// A local realization's failure: its global index and the message.
+    struct Failure {
+        long realization;
+        std::string message;
+    };
+    /// Collective: agree on failures (any: RunFailed on every rank) and, with `with_signal`,
+    /// on a stop signal (returned; 0: none).
+    int agree(const std::vector<Failure>& failures, bool with_signal);
+    [[noreturn]] void fail_agreed(const std::vector<Failure>& failures);
+    std::string where_saved() const;
+    /// Root: to the recorder, or held back (provisional, or after a resume point).
+    void record(const SampleRecord& s);
+    void do_mark();
+    void flush_since_mark();
     void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target);
     void take_sample(bool top_half, coarse::BurstSamples* out);
-    std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header);
+    std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header, bool at_resume_point);
     [[noreturn]] void fail(const std::string& message, long realization) const;
     void do_keep();
     void do_go_back();
@@ -142,6 +195,7 @@ private:
     RunRecorder* recorder_;
     Progress* progress_;
     const CheckpointSink* writer_ = nullptr;
+    bool periodic_checkpoints_ = false;
     std::filesystem::path last_checkpoint_;  ///< every rank: the newest checkpoint written
     double last_checkpoint_time_ = 0;
     coarse::ProbabilityGrid grid_;
@@ -159,6 +213,20 @@ private:
     StepperState kept_stepper_;
     SampleRecord kept_sample_;
     std::vector<SampleRecord> pending_;      ///< root: samples since keep_state()
+    int interrupted_ = 0;                    ///< every rank: the agreed stop signal
+    int finish_code_ = 0;
+    bool has_resume_point_ = false;
+    std::vector<RealizationState> resume_states_;  ///< every rank: at the resume point
+    StepperState resume_stepper_;            ///< root
+    DriverState resume_driver_;              ///< root
+    double resume_time_ = 0;
+    std::vector<SampleRecord> since_mark_;   ///< root: confirmed samples after the resume point
+};
+
+/// Every rank, when the ensemble agreed that a realization failed (its rank printed why).
+class RunFailed : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
 };
 
 }  // namespace efdem::mpi_driver

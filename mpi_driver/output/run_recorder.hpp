@@ -41,7 +41,10 @@ struct RunSummary {
     double wall_seconds = 0;
     double particle_steps = 0;   ///< summed over all realizations
     long coarse_steps = 0;
-    std::string end_status;      ///< "completed", or why the run stopped
+    std::string end_status;      ///< "completed", "interrupted: ...", "failed: ...", or why it stopped
+    int stop_signal = 0;         ///< the signal that stopped the run (0: none)
+    std::string checkpoint;      ///< a stopped run: the checkpoint written where it stopped (or empty)
+    double checkpoint_time = 0;  ///< its time
     double restrict_seconds = 0; ///< root wall time in restriction (observe, gather, average, record)
     double lift_seconds = 0;     ///< root wall time in lifting (gather, compute, scatter, apply)
     /// Adaptive CPI: what the controller did and what more realizations would buy (text lines;

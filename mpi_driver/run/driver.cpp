@@ -5,10 +5,15 @@
 #include <string>
 
 #include "coarse/equation_free/projective_run.hpp"
+#include "core/error.hpp"
 #include "core/log.hpp"
+#include <fmt/format.h>
+
+#include "mpi_driver/ensemble/stop_signal.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
 #include "mpi_driver/run/progress_observer.hpp"
 #include "mpi_driver/run/step_report_observer.hpp"
+#include "mpi_driver/run/stop_observer.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -31,6 +36,19 @@ void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress
     sum.particle_steps = stepper.particle_steps();
     sum.restrict_seconds = stepper.overhead().restrict_seconds;
 }
+
+/// The end of a run stopped by a signal: the checkpoint written where it can be continued.
+void stopped(RunSummary& sum, const EnsembleStepper& stepper, const std::filesystem::path& checkpoint,
+             double checkpoint_time) {
+    sum.stop_signal = stepper.interrupted();
+    sum.checkpoint = checkpoint.string();
+    sum.checkpoint_time = checkpoint_time;
+    sum.end_status = checkpoint.empty()
+                         ? fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (this efdem has no HDF5)",
+                                       signal_name(sum.stop_signal), stepper.time())
+                         : fmt::format("interrupted: {} at t = {:.6g}; checkpoint {} (t = {:.6g})",
+                                       signal_name(sum.stop_signal), stepper.time(), sum.checkpoint, checkpoint_time);
+}
 }  // namespace
 
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress, const RunControl& control) {
@@ -44,20 +62,35 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
     // Chunks of about 10 time units keep the burst buffer small; sampling is unaffected.
     const long chunk = std::max(1L, std::lround(10.0 / s.observe.interval));
     coarse::BurstSamples scratch;
-    while (done < total) {
-        long n = std::min(chunk, total - done);
-        if (every > 0) n = std::min(n, every - done % every);
-        scratch = {};
-        stepper.run(static_cast<double>(n) * s.observe.interval, scratch);
-        done += n;
-        if (every > 0 && done % every == 0 && done < total) {
-            const auto path = stepper.checkpoint(done, state);
-            log::info("checkpoint {} (t = {:.6g})", path.string(), stepper.time());
+    try {
+        while (done < total) {
+            long n = std::min(chunk, total - done);
+            if (every > 0) n = std::min(n, every - done % every);
+            scratch = {};
+            stepper.run(static_cast<double>(n) * s.observe.interval, scratch);
+            done += n;
+            if (stepper.interrupted()) break;
+            if (every > 0 && done % every == 0 && done < total) {
+                const auto path = stepper.checkpoint(done, state);
+                log::info("checkpoint {} (t = {:.6g})", path.string(), stepper.time());
+            }
         }
+    } catch (const RunInterrupted&) {
+        // Cut short at a sample: every sample so far is recorded, a safe point.
+    }
+    RunSummary sum;
+    if (stepper.interrupted() && stepper.samples_taken() < total) {
+        // Every whole sample is a safe point in a direct run: checkpoint exactly here.
+        std::filesystem::path path;
+        if (stepper.can_checkpoint()) path = stepper.checkpoint(stepper.samples_taken(), state);
+        stepper.finish(kExitInterrupted);
+        sum.simulated_time = stepper.time() - state.t_origin;
+        fill_totals(sum, stepper, progress);
+        stopped(sum, stepper, path, stepper.time());
+        return sum;
     }
     stepper.finish();
     progress.update(stepper.time(), stepper.particle_steps(), "done", true);
-    RunSummary sum;
     sum.simulated_time = s.duration;
     fill_totals(sum, stepper, progress);
     sum.end_status = std::abs(stepper.time() - t_end) < 1e-6 * std::max(1.0, t_end) ? "completed" : "incomplete";
@@ -78,6 +111,8 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     if (fallback) fallback_variable = coarse_variable(*fallback, stepper);
     coarse::ProjectiveRun run(s.cpi, stepper, coarse_variable(primary, stepper), std::move(fallback_variable));
 
+    StopObserver stop(stepper);
+    run.add_observer(stop);  // first: the resume point is kept before a checkpoint is written
     StepReportObserver report(stepper, recorder);
     ProgressObserver progress_line(stepper, progress);
     std::optional<CheckpointObserver> checkpoints;
@@ -87,7 +122,22 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     run.add_observer(report);
     run.add_observer(progress_line);
 
-    const coarse::ProjectiveRunOutcome out = run.run(s.duration, control.resume);
+    coarse::ProjectiveRunOutcome out;
+    try {
+        out = run.run(s.duration, control.resume);
+    } catch (const RunInterrupted&) {
+        // Checkpointed where the interrupted coarse step began (or before the warm-up): the
+        // restarted run redoes that step as the uninterrupted run did.
+        std::filesystem::path path;
+        if (stepper.can_checkpoint()) path = stepper.checkpoint_resume_point();
+        stepper.finish(kExitInterrupted);
+        RunSummary sum;
+        sum.coarse_steps = run.state().coarse_steps;
+        sum.simulated_time = stepper.time() - run.state().t_origin;
+        fill_totals(sum, stepper, progress);
+        stopped(sum, stepper, path, stepper.resume_point_time());
+        return sum;
+    }
     stepper.finish();
     RunSummary sum;
     sum.end_status = out.end_status;

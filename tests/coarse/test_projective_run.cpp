@@ -64,7 +64,7 @@ struct Recorder final : ProjectiveRunObserver {
     void warmup_done(const ProjectiveRun&) override { ++warmups; }
     void between_steps(const ProjectiveRun& run) override {
         ++betweens;
-        if (run.state().coarse_steps == at) {
+        if (run.state().coarse_steps == at && !snapshot) {  // the first between at `at`
             snapshot.emplace(*stepper);
             snapshot_state = run.state();
         }
@@ -117,7 +117,7 @@ TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the war
     CHECK_FALSE(out.fell_back);
     CHECK(toy.lifts == 10);
     CHECK(seen.warmups == 1);
-    CHECK(seen.betweens == 10);
+    CHECK(seen.betweens == 11);  // before the warm-up (where a run can stop) and before each step
     CHECK(seen.steps == 10);
     CHECK(run.end_time() == 100.0);
 }
@@ -234,6 +234,33 @@ TEST_CASE("a resumed run equals the uninterrupted one bit for bit", "[unit][coar
     CHECK(seen2.warmups == 0);  // no second warm-up
     CHECK(rest.coarse_steps == whole.coarse_steps);
     CHECK(rest.end_status == whole.end_status);
+    CHECK(copy.time() == toy.time());
+    CHECK(copy.state() == toy.state());
+}
+
+TEST_CASE("a run resumed from before its warm-up does the warm-up and equals the uninterrupted one",
+          "[unit][coarse][run]") {
+    // The state kept before the warm-up is where a run stopped during its warm-up goes back to.
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
+    Recorder<test::LinearToyStepper> seen;
+    seen.stepper = &toy;
+    seen.at = 0;
+    run.add_observer(seen);
+    const ProjectiveRunOutcome whole = run.run(100.0);
+    REQUIRE(seen.snapshot);
+    CHECK_FALSE(seen.snapshot_state->warmed_up);
+    CHECK(seen.snapshot->time() == 0.0);
+    CHECK(run.state().warmed_up);
+
+    test::LinearToyStepper copy = *seen.snapshot;
+    ProjectiveRun resumed(fixed_settings(2.0), copy, variable("x"));
+    Recorder<test::LinearToyStepper> seen2;
+    seen2.stepper = &copy;
+    resumed.add_observer(seen2);
+    const ProjectiveRunOutcome rest = resumed.run(100.0, seen.snapshot_state);
+    CHECK(seen2.warmups == 1);
+    CHECK(rest.coarse_steps == whole.coarse_steps);
     CHECK(copy.time() == toy.time());
     CHECK(copy.state() == toy.state());
 }
