@@ -23,6 +23,7 @@
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #if EFDEM_HAVE_HDF5
+#include "mpi_driver/checkpoint/checkpoint_reader.hpp"
 #include "mpi_driver/checkpoint/checkpoint_writer.hpp"
 #include "mpi_driver/output/hdf5_recorder.hpp"
 #endif
@@ -31,6 +32,7 @@
 #include "mpi_driver/output/recorder_list.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/checkpoint/restart_loader.hpp"
+#include "mpi_driver/run/output_guard.hpp"
 #include "mpi_driver/run/run_options.hpp"
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_settings.hpp"
@@ -159,6 +161,10 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         recorders->finish(summary);
     } catch (const RunFailed& e) {
         summary.end_status = std::string("failed: ") + e.what();
+        summary.simulated_time = stepper.time() - t0;
+        summary.dem_time = stepper.micro_time();
+        summary.particle_steps = stepper.particle_steps();
+        summary.wall_seconds = progress.elapsed_seconds();
         try {
             recorders->finish(summary);
         } catch (const std::exception& again) {
@@ -251,6 +257,15 @@ int main(int argc, char** argv) {
         }
         table->check_all_used(
             [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
+        // What a new run may not write over (the same check in --check); the root looks.
+        if (mpi.is_root()) {
+            check_output_is_free(root, *settings, !options.restart.empty());
+#if EFDEM_HAVE_HDF5
+            if (check && !options.restart.empty())
+                check_restart(options.restart, read_checkpoint_header(options.restart), parameter_lines(*table),
+                              mpi.size() * settings->realizations_per_rank, settings->checkpoint.allow_physics_change);
+#endif
+        }
         if (!check) {
             std::filesystem::create_directories(settings->output.directory);
             std::filesystem::create_directories(settings->checkpoint.directory);  // a stop signal checkpoints
@@ -279,6 +294,28 @@ int main(int argc, char** argv) {
     if (agreed.exit_code != kExitOk) {
         if (mpi.is_root()) log::error("{}", agreed.message);
         return agreed.exit_code;
+    }
+    if (!check && settings->output.overwrite && options.restart.empty()) {
+        // Replace the earlier run: none of its files may stay mixed with this run's.
+        int removal = kExitOk;
+        std::string why;
+        if (mpi.is_root()) {
+            try {
+                const auto removed = remove_earlier_run(*settings);
+                if (!removed.empty())
+                    log::info("output.overwrite = true: deleted the {} file(s) of the earlier run {}/{}", removed.size(),
+                              settings->output.directory.string(), settings->output.prefix);
+            } catch (const RuntimeFailure& e) {
+                removal = kExitRuntimeFailure;
+                why = e.what();
+            }
+        }
+        // Nobody writes before the root has deleted.
+        const Agreement removed = agree_on_failure(mpi.comm(), removal, why);
+        if (removed.exit_code != kExitOk) {
+            if (mpi.is_root()) log::error("{}", removed.message);
+            return removed.exit_code;
+        }
     }
     if (check) {
         if (mpi.is_root())

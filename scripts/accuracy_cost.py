@@ -80,7 +80,8 @@ def run_efdem(args, us, name, mode, R, overrides):
     if os.path.exists(h5):
         try:
             with h5py.File(h5, "r") as f:
-                if "end_status" in f.attrs:
+                status = f.attrs.get("end_status", "")
+                if (status.decode() if isinstance(status, bytes) else str(status)).startswith("completed"):
                     return h5
         except OSError:
             pass
@@ -90,7 +91,7 @@ def run_efdem(args, us, name, mode, R, overrides):
     overrides = {**base, "gas_drag.superficial_velocity": us, **overrides}
     cmd = ["mpirun", "-np", str(np_), "--oversubscribe", args.efdem, scene, f"mode={mode}",
            f"ensemble.realizations_per_rank={per_rank}", f"output.directory={args.out}",
-           f"output.prefix={name}"] + [f"{k}={v}" for k, v in overrides.items()]
+           f"output.prefix={name}", "output.overwrite=true"] + [f"{k}={v}" for k, v in overrides.items()]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     t0 = time.time()
     with open(os.path.join(args.out, name + ".log"), "w") as log:

@@ -17,9 +17,9 @@ mkdir -p "$out"
 # Two independent ensembles (their own seeds): a CPI run that shared the direct run's seeds would
 # follow it for a while after every jump and look better than it is.
 echo "== direct ensemble (2 ranks x 2 realizations, seed 1) =="
-mpirun -np 2 --oversubscribe "$build/mpi_driver/efdem" "$scene" mode=direct seed=1 output.prefix=direct
+mpirun -np 2 --oversubscribe "$build/mpi_driver/efdem" "$scene" mode=direct seed=1 output.prefix=direct output.overwrite=true
 echo "== adaptive coarse projective integration (2 ranks x 2 realizations, seed 2) =="
-mpirun -np 2 --oversubscribe "$build/mpi_driver/efdem" "$scene" mode=cpi seed=2 output.prefix=cpi
+mpirun -np 2 --oversubscribe "$build/mpi_driver/efdem" "$scene" mode=cpi seed=2 output.prefix=cpi output.overwrite=true
 /usr/bin/python3 "$src/scripts/plot_icdf.py" "$out/direct.h5" "$out/cpi.h5" -o "$out/icdf.png" \
   --title "demo_small: light-particle heights, direct vs adaptive CPI (R = 4, independent seeds)"
 /usr/bin/python3 - "$out/direct.h5" "$out/cpi.h5" <<'PY'

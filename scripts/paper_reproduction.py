@@ -51,11 +51,12 @@ def run(args, name):
     h5 = os.path.join(args.out, name + ".h5")
     if os.path.exists(h5):
         with h5py.File(h5, "r") as f:
-            if "end_status" in f.attrs:
+            status = f.attrs.get("end_status", "")
+            if (status.decode() if isinstance(status, bytes) else str(status)).startswith("completed"):
                 return h5
     np_ = min(R, args.np)
     cmd = ["mpirun", "-np", str(np_), "--oversubscribe", args.efdem, SCENE, f"mode={mode}",
-           f"ensemble.realizations_per_rank={R // np_}", f"output.directory={args.out}", f"output.prefix={name}"]
+           f"ensemble.realizations_per_rank={R // np_}", f"output.directory={args.out}", f"output.prefix={name}", "output.overwrite=true"]
     cmd += [f"{k}={v}" for k, v in overrides.items()]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     t0 = time.time()

@@ -41,6 +41,11 @@ std::vector<Vec3> vectors(const std::vector<double>& flat) {
 
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
     return with_checkpoint<CheckpointHeader>(path, [&](const H5File& f) {
+        if (f.exists("/samples") && !f.exists("/realizations"))
+            throw InputError(SourceLocation{path.string(), 0},
+                             "restart= names an efdem run file (the record of a run), not a checkpoint; checkpoints "
+                             "are the PREFIX_ckpt_NNNNNNNN.h5 files in checkpoint.directory (written every "
+                             "checkpoint.interval and when a stop signal ends a run)");
         if (!f.has_attribute("/", "format_version"))
             refuse(path, path.extension() == ".tmp" ? kPartialWrite
                                                     : "is not an efdem checkpoint (no format_version attribute)");

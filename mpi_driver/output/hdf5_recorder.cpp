@@ -29,8 +29,13 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
     if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
         file_.attribute("/", "ranks", std::int64_t{p.ranks});
         file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
+        file_.attribute("/", "end_status", std::string("running"));
+        file_.flush();
         return;
     }
+    // Until finish() says how it ended: a reader can tell a run in progress, or one that was
+    // killed, from a finished one.
+    file_.attribute("/", "end_status", std::string("running"));
     file_.attribute("/", "format_version", kRunFileFormatVersion);
     file_.write_build_provenance();
     file_.attribute("/", "date", now_utc());

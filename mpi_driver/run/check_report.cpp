@@ -64,6 +64,9 @@ std::string check_report(const ParamTable& table, const RunSettings& settings,
     (n.slab_fields ? built : not_built).push_back("slab fields");
     line(fmt::format("built: {}", built.empty() ? "nothing beyond the particles" : fmt::format("{}", fmt::join(built, ", "))));
     line(fmt::format("not built (no effect needs it): {}", not_built.empty() ? "-" : fmt::format("{}", fmt::join(not_built, ", "))));
+    const auto& o = settings.output;
+    line(fmt::format("run file: {}", (o.directory / (o.prefix + ".h5")).string()));
+    line(fmt::format("checkpoints: {}", (settings.checkpoint.directory / (o.prefix + "_ckpt_NNNNNNNN.h5")).string()));
     line("parameters (value, origin):");
     for (const auto& r : table.resolved())
         line(fmt::format("  {} = {}   [{}]", r.key, r.value, r.origin));

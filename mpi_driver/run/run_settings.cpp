@@ -60,6 +60,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     if (s.output.thermo_interval > 0)
         whole_multiple(output, "thermo_interval", s.output.thermo_interval, s.observe.interval, "observe.interval");
 
+    s.output.overwrite = output.get_or<bool>("overwrite", false);
     s.checkpoint = CheckpointSettings::from_params(root, s.output.directory);
     const Params debug = root.scope("debug");
     s.injected_failure.realization = debug.get_or<long>("fail_realization", -1);

@@ -27,6 +27,8 @@
 /// | output.prefix                  | file stem of the run's files                        | efdem   |
 /// | output.vtk_interval            | time between VTK snapshots per realization (0: none)| 0       |
 /// | output.thermo_interval         | time between thermo lines per realization (0: none) | 0       |
+/// | output.overwrite               | a new run may delete and replace the files an       | false   |
+/// |                                | earlier run left under output.prefix (output_guard) |         |
 /// | checkpoint.*, restart.*        | checkpoint/checkpoint_settings.hpp                  |         |
 /// | debug.fail_realization         | test only: this realization fails ...               | -1      |
 /// | debug.fail_time                | ... at the first sample at or after this time       | 0       |
@@ -57,6 +59,7 @@ struct OutputSettings {
     std::string prefix = "efdem";
     double vtk_interval = 0;
     double thermo_interval = 0;
+    bool overwrite = false;  ///< a new run may replace an earlier run's files of the same prefix
 };
 
 struct RunSettings {

@@ -1,0 +1,37 @@
+#pragma once
+/// \file
+/// The output guard: a run never destroys the output of an earlier one by accident.
+///
+/// At set-up (and in `efdem --check`) a new run refuses an output.directory it cannot write and
+/// an output.prefix under which an earlier run left files (its run file, CSV files, VTK series,
+/// thermo logs or checkpoints): exit 2, naming the file. output.overwrite = true replaces that
+/// run: its files are all deleted first, so that none of them is left mixed with the new run's.
+/// A restart (restart=FILE) continues its own run's files and is not refused.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/param_table.hpp"
+#include "mpi_driver/run/run_settings.hpp"
+
+namespace efdem::mpi_driver {
+
+/// The files of a run with `settings`' prefix that exist: in output.directory the run file,
+/// the CSV files, every realization's VTK series (.pvd, .vtp) and thermo log; in
+/// checkpoint.directory its checkpoints; and the .tmp files of any of them. Sorted.
+std::vector<std::filesystem::path> existing_run_files(const RunSettings& settings);
+
+/// Why `directory` cannot be written to (it or its nearest existing parent is not a writable
+/// directory); empty if it can.
+std::string unwritable_directory(const std::filesystem::path& directory);
+
+/// InputError (naming output.directory / output.prefix at their location in the scene) if a
+/// new run (not `restarting`) may not write its output: the directory cannot be written, or an
+/// earlier run's files are there and output.overwrite is false.
+void check_output_is_free(const Params& root, const RunSettings& settings, bool restarting);
+
+/// A new run with output.overwrite = true: deletes the earlier run's files; returns them.
+std::vector<std::filesystem::path> remove_earlier_run(const RunSettings& settings);
+
+}  // namespace efdem::mpi_driver
