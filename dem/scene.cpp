@@ -10,11 +10,11 @@ namespace efdem::dem {
 
 DemScene DemScene::from_params(const Params& root) {
     DemScene s;
-    s.dt = root.get<double>("dt", Bounds::positive());
+    s.dt = root.get<double>("dt", Bounds::closed_open(1e-9, 1.0));
     s.effect_names = root.get<std::vector<std::string>>("effects");
     s.domain = Domain::from_params(root.scope("domain"));
     s.species = SpeciesTable::from_params(root.scope("species"));
-    s.skin = root.scope("neighbor").get_or<double>("skin", 0.1, Bounds::positive());
+    s.skin = root.scope("neighbor").get_or<double>("skin", 0.1, Bounds::open_closed(0.0, 10.0));
     const double cutoff = s.species.max_diameter() + s.skin;
     if (s.domain.lx < 2 * cutoff)
         root.scope("domain").fail("lx", fmt::format("is narrower than twice the neighbour cutoff "

@@ -96,7 +96,13 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         int code = kExitOk;
         std::string message;
         try {
-            for (std::size_t j = 0; j < local.size(); ++j) local[j]->restore_state(restart->local[j]);
+            const auto& active = restart->header.stepper.active;
+            for (std::size_t j = 0; j < local.size(); ++j) {
+                const auto r = static_cast<std::size_t>(local[j]->index());
+                // A realization dropped after a failure stays as built: it is never advanced again.
+                if (!active.empty() && active[r] == 0) continue;
+                local[j]->restore_state(restart->local[j]);
+            }
         } catch (const std::exception& e) {
             code = kExitInputError;
             message = fmt::format("{}: checkpoint does not fit the scene: {}", restart->path.string(), e.what());
@@ -118,6 +124,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.quantiles = s.observe.quantiles;
     ss.seed = s.seed;
     ss.failure = s.injected_failure;
+    ss.on_failure = s.on_failure;
     ss.recorded = observables.recorded.get();
     // The run's start (progress counts from there; on the non-root ranks it is not used).
     const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
@@ -285,7 +292,7 @@ int main(int argc, char** argv) {
         code = kExitInputError;
         message = fmt::format("{} = '{}' cannot be created: {}",
                               e.path1() == settings->output.directory ? "output.directory" : "checkpoint.directory",
-                              e.path1().string(), e.code().message());
+                              quote_for_message(e.path1().string()), e.code().message());
     } catch (const std::exception& e) {
         code = kExitRuntimeFailure;
         message = std::string("unexpected failure during set-up: ") + e.what();

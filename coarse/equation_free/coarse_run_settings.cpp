@@ -10,8 +10,14 @@
 
 namespace efdem::coarse {
 
-CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sample_interval) {
+CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sample_interval, bool for_cpi_run) {
     const char* interval = "observe.interval";
+    // Times on the sampling grid: checked only for a run that uses them (a direct run reads the
+    // cpi block of its scene without running it).
+    auto on_grid = [&](const char* key, double value) -> long {
+        if (!for_cpi_run) return std::lround(value / sample_interval);
+        return whole_multiple(cpi, key, value, sample_interval, interval);
+    };
     CoarseRunSettings s;
     const std::string projection = cpi.get_or_choice("projection", "fixed", {"fixed", "periods", "adaptive"});
     s.projection = projection == "periods"    ? Projection::periods
@@ -23,16 +29,16 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
         cpi.fail("integrator", "needs slopes at known times from every burst; cpi.projection = periods takes "
                                "period means over bursts of varying length",
                  "euler with cpi.projection = periods; adams_bashforth2 with fixed or adaptive");
-    s.warmup = cpi.get_or<double>("warmup", 0.0, Bounds::non_negative());
-    whole_multiple(cpi, "warmup", s.warmup, sample_interval, interval);
-    const double healing = cpi.get_or<double>("healing", 10.0, Bounds::non_negative());
-    whole_multiple(cpi, "healing", healing, sample_interval, interval);
-    const double window = cpi.get_or<double>("window", 10.0, Bounds::positive());
-    const long window_samples = whole_multiple(cpi, "window", window, sample_interval, interval);
-    if (window_samples < 3)
+    s.warmup = cpi.get_or<double>("warmup", 0.0, Bounds::closed(0.0, 1e7));
+    on_grid("warmup", s.warmup);
+    const double healing = cpi.get_or<double>("healing", 10.0, Bounds::closed(0.0, 1e7));
+    on_grid("healing", healing);
+    const double window = cpi.get_or<double>("window", 10.0, Bounds::open_closed(0.0, 1e7));
+    const long window_samples = on_grid("window", window);
+    if (for_cpi_run && window_samples < 3)
         cpi.fail("window", fmt::format("holds {} samples; a slope needs at least 3", window_samples),
                  fmt::format(">= 3 x {} = {:g}", interval, 3 * sample_interval));
-    s.fixed.dt = cpi.get_or<double>("dt", 80.0, Bounds::non_negative());
+    s.fixed.dt = cpi.get_or<double>("dt", 80.0, Bounds::closed(0.0, 1e7));
     if (adaptive) {
         for (const char* key : {"periods", "max_extension"})
             if (cpi.contains(key))
@@ -40,8 +46,8 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
                          "remove it, or choose cpi.projection = periods");
     } else {
         s.periods.periods_per_step = cpi.get_or<int>("periods", 2, Bounds::closed(0, 1000));
-        s.periods.max_extension = cpi.get_or<double>("max_extension", 30.0, Bounds::non_negative());
-        whole_multiple(cpi, "max_extension", s.periods.max_extension, sample_interval, interval);
+        s.periods.max_extension = cpi.get_or<double>("max_extension", 30.0, Bounds::closed(0.0, 1e7));
+        on_grid("max_extension", s.periods.max_extension);
         for (const char* key : {"tolerance", "dt_min", "dt_max", "safety", "growth"})
             if (cpi.contains(key))
                 cpi.fail(key, fmt::format("is read only with cpi.projection = adaptive (this run uses {})", projection),
@@ -65,11 +71,12 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
     if (adaptive) {
         const double burst = healing + window;
         StepSizeSettings& c = m.control;
-        c.tolerance = cpi.get<double>("tolerance", Bounds::positive());
-        c.dt_min = cpi.get_or<double>("dt_min", 0.5 * burst, Bounds::positive());
-        whole_multiple(cpi, "dt_min", c.dt_min, sample_interval, interval);
-        c.dt_max = cpi.get_or<double>("dt_max", 8.0 * burst, Bounds::positive());
-        whole_multiple(cpi, "dt_max", c.dt_max, sample_interval, interval);
+        c.tolerance = for_cpi_run ? cpi.get<double>("tolerance", Bounds::open_closed(0.0, 1e6))
+                                  : cpi.get_or<double>("tolerance", 1.0, Bounds::open_closed(0.0, 1e6));
+        c.dt_min = cpi.get_or<double>("dt_min", 0.5 * burst, Bounds::open_closed(0.0, 1e7));
+        on_grid("dt_min", c.dt_min);
+        c.dt_max = cpi.get_or<double>("dt_max", 8.0 * burst, Bounds::open_closed(0.0, 1e7));
+        on_grid("dt_max", c.dt_max);
         if (c.dt_min > c.dt_max)
             cpi.fail("dt_min", fmt::format("is larger than cpi.dt_max = {:g}", c.dt_max), "cpi.dt_min <= cpi.dt_max");
         c.safety = cpi.get_or<double>("safety", 0.8, Bounds::open_closed(0.0, 1.0));
@@ -91,8 +98,8 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
         m.force.attempt = debug.get_or<long>("force_attempt", 1, Bounds::closed(1, 1000000));
     }
     s.warmup_until_steady = cpi.get_or_choice("warmup_until", adaptive ? "steady" : "time", {"time", "steady"}) == "steady";
-    s.warmup_max = cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::non_negative());
-    whole_multiple(cpi, "warmup_max", s.warmup_max, sample_interval, interval);
+    s.warmup_max = cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::closed(0.0, 1e7));
+    on_grid("warmup_max", s.warmup_max);
     s.drift_rate = adaptive ? m.drift_rate : 0.0;
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;

@@ -64,7 +64,9 @@ struct CoarseRunSettings {
     /// projections' keys are read, so that switching cpi.projection on the command line works on
     /// a scene written for the other one. `sample_interval`: the stepper's sampling interval,
     /// which the times must be whole multiples of (its key is `observe.interval`).
-    static CoarseRunSettings from_params(const Params& cpi, double sample_interval);
+    /// `for_cpi_run` false (a direct run of a cpi scene): the keys are read and their values
+    /// range-checked, but not checked against the sampling grid, and none is required.
+    static CoarseRunSettings from_params(const Params& cpi, double sample_interval, bool for_cpi_run = true);
 
     /// healing + window of the selected projection: the length of an unextended burst.
     double burst() const;

@@ -32,7 +32,8 @@ double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, doub
     if (!std::isfinite(t_end)) return std::numeric_limits<double>::infinity();
     const double left = t_end - t_after_burst;
     const double tol = time_tolerance(t_end);
-    if (left <= dt + tol) return std::max(0.0, left);
+    if (left <= tol) return 0.0;  // the burst ended the run: what is left is round-off, no jump
+    if (left <= dt + tol) return left;
     if (left - dt < burst - tol) return std::max(0.0, left - burst);
     return std::numeric_limits<double>::infinity();
 }

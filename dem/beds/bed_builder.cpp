@@ -108,10 +108,12 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
         // The settling protocol's keys are read (and checked) even with settle = false, so that
         // a scene can be run unsettled with one override, without editing out its settle block.
         const Params s = p.scope("settle");
-        b.settle_damping = s.get_or<double>("damping", 1.0, Bounds::non_negative());
-        b.settle_damped_time = s.get_or<double>("damped_time", 7.2, Bounds::non_negative());
-        b.settle_ke_threshold = s.get_or<double>("ke_threshold", 1e-6, Bounds::positive());
-        b.settle_max_time = s.get_or<double>("max_time", 100.0, Bounds::positive());
+        b.settle_damping = s.get_or<double>("damping", 1.0, Bounds::closed(0.0, 1e6));
+        b.settle_damped_time = s.get_or<double>("damped_time", 7.2, Bounds::non_negative());  // steps bounded below
+        // Kinetic energy per particle in m g d_p: a bed at rest is far below 1e-2; above 1,
+        // settling would stop before it started.
+        b.settle_ke_threshold = s.get_or<double>("ke_threshold", 1e-6, Bounds::open_closed(0.0, 1.0));
+        b.settle_max_time = s.get_or<double>("max_time", 100.0, Bounds::positive());  // steps bounded below
         if (b.settle) {
             // Each settling stage is a bounded number of steps, checked here so that
             // `efdem --check` reports it without settling.

@@ -38,7 +38,9 @@ ContactSpec ContactSpec::from_params(const Params& p, const Params* fb) {
     ContactSpec s;
     const std::string normal = choice_or_fallback(p, fb, "normal", "hooke", {"hooke", "hertz"});
     s.normal = normal == "hertz" ? NormalModel::hertz : NormalModel::hooke;
-    s.kn = real_or_fallback(p, fb, "kn", Bounds::positive());
+    // Physically sensible ranges in the units of physics.md (m g / d_p for stiffnesses): what
+    // lies outside is a unit mistake or a typo, not a material.
+    s.kn = real_or_fallback(p, fb, "kn", Bounds::closed(1.0, 1e12));
     const std::string damping =
         choice_or_fallback(p, fb, "damping", "restitution", {"restitution", "gamma", "none"});
     if (damping == "restitution") {
@@ -46,13 +48,13 @@ ContactSpec ContactSpec::from_params(const Params& p, const Params* fb) {
         s.restitution =
             real_or_fallback(p, fb, "restitution",
                              s.normal == NormalModel::hertz ? kHertzRestitutionRange
-                                                            : Bounds::open_closed(0.0, 1.0));
+                                                            : Bounds::closed(1e-3, 1.0));
     } else if (damping == "gamma") {
         if (s.normal == NormalModel::hertz)
             p.fail("damping", "'gamma' (LAMMPS' single gamma_n) is only defined here for hooke",
                    "restitution or none with normal = hertz");
         s.damping = DampingModel::gamma;
-        s.gamma_n = real_or_fallback(p, fb, "gamma_n", Bounds::non_negative());
+        s.gamma_n = real_or_fallback(p, fb, "gamma_n", Bounds::closed(0.0, 1e12));
     } else {
         s.damping = DampingModel::none;
     }
@@ -60,10 +62,11 @@ ContactSpec ContactSpec::from_params(const Params& p, const Params* fb) {
         choice_or_fallback(p, fb, "tangential", "history", {"history", "none"});
     s.tangential = tangential == "none" ? TangentialModel::none : TangentialModel::history;
     if (s.tangential == TangentialModel::history) {
-        s.kt = real_or_fallback(p, fb, "kt", 2.0 / 7.0 * s.kn, Bounds::positive());
+        s.kt = real_or_fallback(p, fb, "kt", 2.0 / 7.0 * s.kn, Bounds::closed(1e-6 * s.kn, s.kn));
         s.tangential_damping =
-            real_or_fallback(p, fb, "tangential_damping", 0.5, Bounds::non_negative());
-        s.mu = real_or_fallback(p, fb, "mu", Bounds::non_negative());
+            real_or_fallback(p, fb, "tangential_damping", 0.5, Bounds::closed(0.0, 1.0));
+        // Coulomb friction: measured granular values are 0.05-1; above 10 is a unit mistake.
+        s.mu = real_or_fallback(p, fb, "mu", Bounds::closed(0.0, 10.0));
     }
     return s;
 }

@@ -4,7 +4,7 @@
 
 namespace efdem::dem {
 
-Gravity::Gravity(const EffectSetup& s) : g_(s.scope.get_or<double>("g", 1.0, Bounds::non_negative())) {}
+Gravity::Gravity(const EffectSetup& s) : g_(s.scope.get_or<double>("g", 1.0, Bounds::closed(0.0, 1e3))) {}
 
 void Gravity::add_forces(ForceContext& ctx) {
     Vec3* f = ctx.particles.force().data();

@@ -5,7 +5,7 @@
 namespace efdem::dem {
 
 ViscousDamping::ViscousDamping(const EffectSetup& s)
-    : gamma_(s.scope.get<double>("gamma", Bounds::non_negative())) {}
+    : gamma_(s.scope.get<double>("gamma", Bounds::closed(0.0, 1e6))) {}
 
 void ViscousDamping::add_forces(ForceContext& ctx) {
     Vec3* f = ctx.particles.force().data();

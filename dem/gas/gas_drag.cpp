@@ -29,7 +29,7 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     if (!s.law)
         p.fail("law", "names an unknown drag law '" + law + "'",
                fmt::format("known drag laws: {}", fmt::join(drag_law_names(), ", ")));
-    s.superficial_velocity = p.get<double>("superficial_velocity", Bounds::non_negative());
+    s.superficial_velocity = p.get<double>("superficial_velocity", Bounds::closed(0.0, 1e3));
     s.phi_cap = p.get_or<double>("phi_cap", 0.70, Bounds::open(0.0, 1.0));
     s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::at_least(0.1));
 
@@ -45,13 +45,13 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
                        fmt::format("either {} alone, or {}, {}, {}, {} (SI units)", p.full_key("A"),
                                    p.full_key(kPhysical[0]), p.full_key(kPhysical[1]),
                                    p.full_key(kPhysical[2]), p.full_key(kPhysical[3])));
-        s.A = p.get<double>("A", Bounds::positive());
+        s.A = p.get<double>("A", Bounds::closed(1e-6, 1e6));
         s.physical = false;
     } else {
-        s.gas.viscosity = p.get_or<double>("gas_viscosity", 1.8e-5, Bounds::positive());
-        s.gas.particle_density = p.get_or<double>("particle_density", 900.0, Bounds::positive());
-        s.gas.particle_diameter = p.get_or<double>("particle_diameter", 1e-4, Bounds::positive());
-        s.gas.gravity = p.get_or<double>("gravity", 9.81, Bounds::positive());
+        s.gas.viscosity = p.get_or<double>("gas_viscosity", 1.8e-5, Bounds::closed(1e-7, 1e3));  // Pa s
+        s.gas.particle_density = p.get_or<double>("particle_density", 900.0, Bounds::closed(1.0, 1e5));  // kg/m^3
+        s.gas.particle_diameter = p.get_or<double>("particle_diameter", 1e-4, Bounds::closed(1e-8, 1.0));  // m
+        s.gas.gravity = p.get_or<double>("gravity", 9.81, Bounds::closed(1e-3, 1e4));  // m/s^2
         s.A = s.gas.drag_number();
         s.physical = true;
     }

@@ -40,7 +40,11 @@ std::uint64_t CheckpointHeader::checksum() const {
         h = fnv1a_array(driver.integrator, h);
         h = hash_text(driver.integrator_text, h);
     }
-    if (format_version >= 3) h = hash_value(driver.warmed_up ? 1L : 0L, h);
+    if (format_version >= 3) {
+        h = hash_value(driver.warmed_up ? 1L : 0L, h);
+        h = fnv1a_array(s.active, h);
+        h = hash_value(s.failures, h);
+    }
     for (const auto& o : outputs) {
         h = hash_text(o.name, h);
         h = hash_text(o.bytes, h);

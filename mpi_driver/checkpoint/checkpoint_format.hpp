@@ -46,6 +46,9 @@ struct StepperState {
     std::vector<RandomStream::State> lifting;  ///< per realization
     std::vector<double> observable;            ///< warm start of the integrator's observable
     std::vector<double> recorded;              ///< warm start of the recorded-only observable
+    /// Per realization: 1 in the ensemble, 0 dropped after a failure (empty: all in; format 3).
+    std::vector<std::int64_t> active;
+    long failures = 0;  ///< realization failures survived so far (ensemble.on_failure)
 };
 
 /// The run loop's state: coarse::ProjectiveRunState (t_origin, coarse_steps, without_progress,

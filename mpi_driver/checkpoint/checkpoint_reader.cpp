@@ -79,6 +79,13 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         const auto lifting = f.read_integers("/driver/lifting");
         if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
             refuse(path, "has a malformed /driver/lifting dataset");
+        if (h.format_version >= 3) {
+            h.stepper.active = f.read_integers("/driver/active");
+            const auto failures = f.read_integers("/driver/failures");
+            if (h.stepper.active.size() != static_cast<std::size_t>(h.realizations) || failures.size() != 1)
+                refuse(path, "has a malformed /driver/active or /driver/failures dataset");
+            h.stepper.failures = failures[0];
+        }
         for (std::size_t r = 0; r < lifting.size(); r += 4)
             h.stepper.lifting.push_back({from_stored(lifting[r]), from_stored(lifting[r + 1]), from_stored(lifting[r + 2]),
                                          from_stored(lifting[r + 3])});

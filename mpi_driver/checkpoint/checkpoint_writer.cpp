@@ -205,6 +205,9 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     for (const auto& st : s.lifting)
         for (std::uint64_t w : st) lifting.push_back(to_stored(w));
     f.write("/driver/lifting", std::span<const std::int64_t>(lifting), {s.lifting.size(), 4});
+    f.write("/driver/active", std::span<const std::int64_t>(s.active), {s.active.size()});
+    const std::vector<std::int64_t> failures{s.failures};
+    f.write("/driver/failures", std::span<const std::int64_t>(failures), {1});
     f.write("/driver/observable", std::span<const double>(s.observable), {s.observable.size()});
     f.write("/driver/recorded", std::span<const double>(s.recorded), {s.recorded.size()});
     f.write("/driver/integrator", std::span<const double>(h.driver.integrator), {h.driver.integrator.size()});

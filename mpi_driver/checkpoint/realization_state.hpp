@@ -32,6 +32,11 @@ struct RealizationState {
 };
 
 /// FNV-1a 64 of raw bytes, continuing from `h`.
+/// The state as bytes and back (to send a realization's state to another rank); the layout is
+/// this build's, not a file format.
+std::vector<std::uint8_t> pack(const RealizationState& s);
+RealizationState unpack(const std::vector<std::uint8_t>& bytes);
+
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 0xcbf29ce484222325ULL);
 
 /// FNV-1a of an array's length and contents (trivially copyable elements).

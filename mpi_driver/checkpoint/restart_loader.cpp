@@ -67,6 +67,14 @@ Agreement load_restart(const MpiComm& mpi, const std::filesystem::path& path, co
     out.header.stepper.samples_taken = std::lround(counters[0]);
     out.header.stepper.micro_time = counters[1];
     out.header.stepper.particle_steps = counters[2];
+    // Which realizations are in the ensemble (dropped ones are not restored or advanced), and
+    // the failures survived so far.
+    long failures_and_size[2] = {out.header.stepper.failures, static_cast<long>(out.header.stepper.active.size())};
+    MPI_Bcast(failures_and_size, 2, MPI_LONG, 0, mpi.comm());
+    out.header.stepper.failures = failures_and_size[0];
+    out.header.stepper.active.resize(static_cast<std::size_t>(failures_and_size[1]));
+    if (failures_and_size[1] > 0)
+        MPI_Bcast(out.header.stepper.active.data(), static_cast<int>(failures_and_size[1]), MPI_INT64_T, 0, mpi.comm());
     return a;
 #endif
 }

@@ -1,6 +1,8 @@
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -17,6 +19,7 @@ EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, std::vector<std::
     : layout_(layout), local_(std::move(local)), settings_(settings), observable_(&observable),
       lifter_(lifter), recorder_(recorder), progress_(progress), grid_(settings.quantiles) {
     EFDEM_EXPECTS(static_cast<int>(local_.size()) == layout.per_rank());
+    active_.assign(static_cast<std::size_t>(layout_.size()), 1);
     if (layout_.is_root())
         for (int r = 0; r < layout_.size(); ++r)
             lifting_.emplace_back(settings.seed, static_cast<std::uint64_t>(r), "lifting");
@@ -25,7 +28,16 @@ EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, std::vector<std::
     total_particles_ = static_cast<double>(layout_.sum(n));
 }
 
-double EnsembleStepper::time() const { return local_.front()->time(); }
+double EnsembleStepper::time() const {
+    // A dropped realization is not advanced: the clock is that of one in the ensemble.
+    for (const auto& r : local_)
+        if (is_active(*r)) return r->time();
+    return local_.front()->time();
+}
+
+int EnsembleStepper::active_realizations() const {
+    return static_cast<int>(std::count(active_.begin(), active_.end(), char{1}));
+}
 
 bool EnsembleStepper::needs_top_half() const {
     return observable_->needs_top_half() || (settings_.recorded && settings_.recorded->needs_top_half());
@@ -55,8 +67,66 @@ int EnsembleStepper::agree(const std::vector<Failure>& failures, bool with_signa
     int local[2] = {with_signal ? stop_signal_received() : 0, static_cast<int>(failures.size())};
     int global[2] = {0, 0};
     MPI_Allreduce(local, global, 2, MPI_INT, MPI_MAX, layout_.mpi().comm());
-    if (global[1] > 0) fail_agreed(failures);
+    if (global[1] > 0) on_failures(failures);
     return global[0];
+}
+
+std::vector<std::string> EnsembleStepper::gather_failure_messages(const std::vector<Failure>& failures) const {
+    std::vector<std::vector<std::uint8_t>> mine(local_.size());
+    for (const Failure& f : failures)
+        mine[static_cast<std::size_t>(f.realization - layout_.first_index())].assign(f.message.begin(), f.message.end());
+    std::vector<std::string> out;
+    for (const auto& m : layout_.gather_arrays(mine)) out.emplace_back(m.begin(), m.end());
+    return out;
+}
+
+void EnsembleStepper::on_failures(const std::vector<Failure>& failures) {
+    // Which realizations failed: every rank learns the same set.
+    const auto R = static_cast<std::size_t>(layout_.size());
+    std::vector<int> mine(R, 0), all(R, 0);
+    for (const Failure& f : failures) mine[static_cast<std::size_t>(f.realization)] = 1;
+    MPI_Allreduce(mine.data(), all.data(), static_cast<int>(R), MPI_INT, MPI_MAX, layout_.mpi().comm());
+    std::vector<long> failed;
+    for (std::size_t r = 0; r < R; ++r)
+        if (all[r]) failed.push_back(static_cast<long>(r));
+    const FailurePolicy& policy = settings_.on_failure;
+    const long total = failures_ + static_cast<long>(failed.size());
+    const int healthy = active_realizations() - static_cast<int>(failed.size());
+    const bool drop = policy.action == FailurePolicy::Action::drop;
+    std::string fatal;
+    if (policy.action == FailurePolicy::Action::abort) fatal = "-";
+    else if (total > policy.max_failures)
+        fatal = fmt::format("{} realization failures, more than ensemble.max_failures = {}", total, policy.max_failures);
+    else if ((drop ? healthy : healthy + static_cast<int>(failed.size())) < policy.min_active || healthy < 1)
+        fatal = fmt::format("only {} healthy realization(s) would remain; the run needs {}", healthy, policy.min_active);
+    if (!fatal.empty()) {
+        std::vector<Failure> told = failures;
+        if (fatal != "-")
+            for (Failure& f : told) f.message += "; the run ends: " + fatal;
+        fail_agreed(told);
+    }
+    for (const Failure& f : failures)
+        std::fprintf(stderr, "efdem: [rank %d of %d] warning: realization %ld at t = %.6g: %s; %s (ensemble.on_failure)\n",
+                     layout_.mpi().rank(), layout_.mpi().size(), f.realization, time(), f.message.c_str(),
+                     drop ? "dropped from the ensemble" : "to be rebuilt from a healthy realization");
+    std::fflush(stderr);
+    const std::vector<std::string> reasons = gather_failure_messages(failures);
+    failures_ = total;
+    if (!has_resume_point_) {
+        // Direct: every whole sample is a safe point; the realization leaves the ensemble here.
+        EFDEM_EXPECTS(drop);
+        for (long f : failed) active_[static_cast<std::size_t>(f)] = 0;
+        if (layout_.is_root() && recorder_)
+            for (long f : failed)
+                recorder_->failure({time(), f, reasons[static_cast<std::size_t>(f)], "dropped", -1, time(),
+                                    active_realizations()});
+        return;
+    }
+    // cpi: the coarse step is redone from its resume point with the changed ensemble.
+    failed_pending_ = failed;
+    failed_reasons_ = reasons;
+    failed_time_ = time();
+    changed_ = true;
 }
 
 void EnsembleStepper::fail_agreed(const std::vector<Failure>& failures) {
@@ -70,15 +140,11 @@ void EnsembleStepper::fail_agreed(const std::vector<Failure>& failures) {
                      text.c_str());
     }
     std::fflush(stderr);
-    std::vector<std::vector<std::uint8_t>> mine(local_.size());
-    for (const Failure& f : failures) {
-        const std::string text = fmt::format("realization {} at t = {:.6g}: {}", f.realization, time(), f.message);
-        mine[static_cast<std::size_t>(f.realization - layout_.first_index())].assign(text.begin(), text.end());
-    }
-    const auto all = layout_.gather_arrays(mine);
+    const std::vector<std::string> all = gather_failure_messages(failures);
     std::string summary;
-    for (const auto& m : all)
-        if (!m.empty()) summary += (summary.empty() ? "" : "; ") + std::string(m.begin(), m.end());
+    for (std::size_t r = 0; r < all.size(); ++r)
+        if (!all[r].empty())
+            summary += fmt::format("{}realization {} at t = {:.6g}: {}", summary.empty() ? "" : "; ", r, time(), all[r]);
     throw RunFailed(summary.empty() ? std::string("a realization failed (see the messages above)") : summary);
 }
 
@@ -93,7 +159,9 @@ void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
     const bool top = needs_top_half();
     broadcast({Command::run, duration, top});
     const long wanted = std::lround(duration / settings_.sample_interval);
-    if (do_run(wanted, top, &out) < wanted) throw RunInterrupted(interrupted_, time());
+    const long got = do_run(wanted, top, &out);
+    if (changed_) throw EnsembleChanged();
+    if (got < wanted) throw RunInterrupted(interrupted_, time());
 }
 
 void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
@@ -125,8 +193,9 @@ void EnsembleStepper::mark_resume_point(const DriverState& driver) {
     EFDEM_EXPECTS(!provisional_);
     broadcast({Command::mark, 0.0, false});
     do_mark();
-    resume_stepper_ = saved_state();
     resume_driver_ = driver;
+    resume_sample_ = last_sample_;
+    resume_x_ = last_x_;
     flush_since_mark();
 }
 
@@ -138,6 +207,7 @@ void EnsembleStepper::do_mark() {
         fail(std::string("keeping the state between coarse steps: ") + e.what(), local_.front()->index());
     }
     resume_time_ = time();
+    resume_stepper_ = saved_state();
     has_resume_point_ = true;
 }
 
@@ -217,6 +287,7 @@ void EnsembleStepper::serve() {
             case Command::confirm: do_confirm(); break;
             case Command::mark: do_mark(); break;
             case Command::checkpoint_mark: do_checkpoint(std::lround(m.value), nullptr, true); break;
+            case Command::rebuild: do_rebuild(m.top_half); break;
             case Command::finish: finish_code_ = static_cast<int>(m.value); return;
         }
     }
@@ -256,11 +327,18 @@ StepperState EnsembleStepper::saved_state() const {
     for (const auto& l : lifting_) s.lifting.push_back(l.state());
     s.observable = observable_->saved_state();
     if (settings_.recorded) s.recorded = settings_.recorded->saved_state();
+    s.active.assign(active_.begin(), active_.end());
+    s.failures = failures_;
     return s;
 }
 
 void EnsembleStepper::restore_state(const StepperState& s) {
     samples_taken_ = s.samples_taken;
+    if (!s.active.empty()) {
+        EFDEM_EXPECTS(s.active.size() == active_.size());
+        for (std::size_t r = 0; r < active_.size(); ++r) active_[r] = s.active[r] != 0 ? 1 : 0;
+    }
+    failures_ = s.failures;
     micro_time_ = s.micro_time;
     particle_steps_ = s.particle_steps;
     height_range_ = {s.height_lo, s.height_hi};
@@ -276,20 +354,26 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
     std::vector<Failure> failures;
     for (long s = 0; s < samples; ++s) {
         for (auto& r : local_) {
+            if (!is_active(*r)) continue;  // dropped after a failure: not advanced
             try {
                 r->advance(settings_.steps_per_sample);
-                if (r->index() == inject.realization && r->time() >= inject.time)
+                if (!injected_fired_ && r->index() == inject.realization && r->time() >= inject.time) {
+                    injected_fired_ = true;
                     throw RuntimeFailure("injected failure (debug.fail_realization)", r->index());
+                }
             } catch (const std::exception& e) {
                 failures.push_back({r->index(), e.what()});
             }
         }
         const int signal = agree(failures, true);
+        failures.clear();
         micro_time_ += static_cast<double>(settings_.steps_per_sample) * local_.front()->dt();
         particle_steps_ += static_cast<double>(settings_.steps_per_sample) * total_particles_;
+        if (changed_) return s;  // cpi: the step is redone from its resume point
         take_sample(top_half, out);
         ++samples_taken_;
         for (auto& r : local_) {
+            if (!is_active(*r)) continue;
             try {
                 r->after_sample(samples_taken_);
             } catch (const std::exception& e) {
@@ -297,6 +381,8 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
             }
         }
         agree(failures, false);
+        failures.clear();
+        if (changed_) return s + 1;
         if (signal != 0) {
             interrupted_ = signal;
             return s + 1;
@@ -305,37 +391,63 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
     return samples;
 }
 
+namespace {
+/// The rows of `all` listed in `rows` (all rows when every realization is in the ensemble).
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Index>& rows) {
+    if (all.size() == 0 || static_cast<Eigen::Index>(rows.size()) == all.rows()) return all;
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), all.cols());
+    for (std::size_t k = 0; k < rows.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = all.row(rows[k]);
+    return out;
+}
+}  // namespace
+
 void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     const double start = MPI_Wtime();
+    const auto m = static_cast<Eigen::Index>(grid_.values().size());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
     std::vector<Eigen::VectorXd> icdf, top_icdf, scalars;
     for (const auto& r : local_) {
+        if (!is_active(*r)) {  // dropped: a row of NaN in the record, not in the means
+            icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            scalars.push_back(Eigen::Vector4d::Constant(nan));
+            continue;
+        }
         Observation o = r->observe(grid_, top);
         icdf.push_back(std::move(o.icdf));
         if (top) top_icdf.push_back(std::move(o.top));
         scalars.push_back(Eigen::Vector4d(o.com, o.z_min, o.z_max, o.mean_height));
     }
     const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
-    const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
-    const Eigen::MatrixXd all_scalars = layout_.gather_rows(scalars);
+    const Eigen::MatrixXd all_top_rows = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+    const Eigen::MatrixXd all_scalar_rows = layout_.gather_rows(scalars);
     if (!layout_.is_root()) {
         overhead_.restrict_seconds += MPI_Wtime() - start;
         ++overhead_.samples;
         return;
     }
+    std::vector<Eigen::Index> in;
+    for (std::size_t r = 0; r < active_.size(); ++r)
+        if (active_[r]) in.push_back(static_cast<Eigen::Index>(r));
+    const Eigen::MatrixXd used_icdf = rows_of(all_icdf, in);
+    const Eigen::MatrixXd all_top = rows_of(all_top_rows, in);
+    const Eigen::MatrixXd all_scalars = rows_of(all_scalar_rows, in);
 
     SampleRecord& rec = last_sample_;
     rec.time = time();
     rec.realizations = all_icdf;
-    rec.mean = coarse::ensemble_mean(all_icdf);
-    rec.variance = coarse::ensemble_variance(all_icdf, rec.mean);
-    rec.com = all_scalars.col(0);
+    rec.realizations_used = static_cast<int>(in.size());
+    rec.mean = coarse::ensemble_mean(used_icdf);
+    rec.variance = coarse::ensemble_variance(used_icdf, rec.mean);
+    rec.com = all_scalar_rows.col(0);
     rec.top_mean = top ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
-    const Eigen::VectorXd x = observable_->restrict_ensemble(all_icdf, all_top);
+    const Eigen::VectorXd x = observable_->restrict_ensemble(used_icdf, all_top);
+    last_x_ = x;
     rec.compact = observable_->needs_top_half() ? x : Eigen::VectorXd();
     rec.compact_status = observable_->status();
     if (!observable_->needs_top_half() && settings_.recorded) {
-        rec.compact = settings_.recorded->restrict_ensemble(all_icdf, all_top);
+        rec.compact = settings_.recorded->restrict_ensemble(used_icdf, all_top);
         rec.compact_status = settings_.recorded->status();
     }
     if (out) {
@@ -346,7 +458,7 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
         out->member_expansion.push_back(all_scalars.col(3));
         // Rows in global realization order, as gathered: independent of the layout.
         if (observable_->restricts_members())
-            out->members.push_back(observable_->restrict_members(all_icdf, all_top));
+            out->members.push_back(observable_->restrict_members(used_icdf, all_top));
     }
     record(rec);
     overhead_.restrict_seconds += MPI_Wtime() - start;
@@ -354,13 +466,26 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     if (progress_) progress_->update(rec.time, particle_steps_, "");
 }
 
-void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target) {
+void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target,
+                              const std::vector<char>* only) {
     const double start = MPI_Wtime();
+    auto lifted_here = [&](long index) {
+        return active_[static_cast<std::size_t>(index)] != 0 && (!only || (*only)[static_cast<std::size_t>(index)] != 0);
+    };
+    const auto m = static_cast<Eigen::Index>(grid_.values().size());
     std::vector<std::vector<double>> reals;
     std::vector<std::vector<std::uint8_t>> bytes;
     std::vector<Eigen::VectorXd> top_icdf;
     std::vector<std::size_t> out_reals, out_bytes;
     for (const auto& r : local_) {
+        if (!lifted_here(r->index())) {  // dropped, or not among `only`: nothing sent, nothing changed
+            reals.emplace_back();
+            bytes.emplace_back();
+            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, std::numeric_limits<double>::quiet_NaN()));
+            out_reals.push_back(0);
+            out_bytes.push_back(0);
+            continue;
+        }
         LiftPayload in = r->lift_input();
         reals.push_back(std::move(in.reals));
         bytes.push_back(std::move(in.bytes));
@@ -378,6 +503,14 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
     if (layout_.is_root()) {
         last_lift_ = LiftRecord{};
         for (int r = 0; r < layout_.size(); ++r) {
+            if (!lifted_here(r)) {
+                last_lift_.changed.push_back(0);
+                last_lift_.max_deviation.push_back(std::numeric_limits<double>::quiet_NaN());
+                last_lift_.messages.emplace_back(active_[static_cast<std::size_t>(r)] ? "" : "dropped");
+                lifted_reals.emplace_back();
+                lifted_bytes.emplace_back();
+                continue;
+            }
             const Eigen::VectorXd goal =
                 observable_->lift_target(*target, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
             LiftOutcome res = lifter_.lift(goal, {all_reals[r], all_bytes[r]}, grid_, lifting_[r]);
@@ -391,11 +524,114 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
     const auto my_reals = layout_.scatter_arrays(lifted_reals, out_reals);
     const auto my_bytes = layout_.scatter_arrays(lifted_bytes, out_bytes);
     for (std::size_t j = 0; j < local_.size(); ++j) {
+        if (!lifted_here(local_[j]->index())) continue;
         local_[j]->apply_lift({my_reals[j], my_bytes[j]});
         local_[j]->set_time(new_time);
     }
     overhead_.lift_seconds += MPI_Wtime() - start;
     ++overhead_.lifts;
+}
+
+void EnsembleStepper::rebuild_after_failure() {
+    EFDEM_EXPECTS(changed_ && has_resume_point_);
+    broadcast({Command::rebuild, 0.0, observable_->needs_top_half()});
+    do_rebuild(observable_->needs_top_half());
+}
+
+void EnsembleStepper::send_states(const std::vector<long>& failed, const std::vector<long>& donors) {
+    // The donor's state at the resume point goes to the failed realization's rank.
+    const long k = layout_.per_rank();
+    const int me = layout_.mpi().rank();
+    for (std::size_t i = 0; i < failed.size(); ++i) {
+        if (donors[i] < 0) continue;
+        const int from = static_cast<int>(donors[i] / k), to = static_cast<int>(failed[i] / k);
+        RealizationState state;
+        if (from == me) state = resume_states_[static_cast<std::size_t>(donors[i] % k)];
+        if (from != to) {
+            if (me == from) {
+                const std::vector<std::uint8_t> bytes = pack(state);
+                const long n = static_cast<long>(bytes.size());
+                MPI_Send(&n, 1, MPI_LONG, to, 71, layout_.mpi().comm());
+                MPI_Send(bytes.data(), static_cast<int>(n), MPI_BYTE, to, 72, layout_.mpi().comm());
+            } else if (me == to) {
+                long n = 0;
+                MPI_Recv(&n, 1, MPI_LONG, from, 71, layout_.mpi().comm(), MPI_STATUS_IGNORE);
+                std::vector<std::uint8_t> bytes(static_cast<std::size_t>(n));
+                MPI_Recv(bytes.data(), static_cast<int>(n), MPI_BYTE, from, 72, layout_.mpi().comm(), MPI_STATUS_IGNORE);
+                state = unpack(bytes);
+            }
+        }
+        if (me == to) {
+            state.index = failed[i];
+            local_[static_cast<std::size_t>(failed[i] % k)]->restore_state(state);
+        }
+    }
+}
+
+void EnsembleStepper::do_rebuild(bool top_half) {
+    EFDEM_EXPECTS(changed_ && has_resume_point_);
+    const bool replace = settings_.on_failure.action == FailurePolicy::Action::replace;
+    const std::vector<char> active_now = active_;
+    const long failures_now = failures_;
+    // 1. Every realization back to where the interrupted coarse step began.
+    try {
+        for (std::size_t j = 0; j < local_.size(); ++j) local_[j]->restore_state(resume_states_[j]);
+    } catch (const std::exception& e) {
+        fail(std::string("going back to the resume point after a failure: ") + e.what(), local_.front()->index());
+    }
+    const double micro = micro_time_, steps = particle_steps_;  // the lost work stays counted
+    restore_state(resume_stepper_);
+    micro_time_ = micro;
+    particle_steps_ = steps;
+    active_ = active_now;
+    failures_ = failures_now;
+    pending_.clear();
+    since_mark_.clear();
+    kept_.clear();
+    provisional_ = false;
+    // 2. Drop, or rebuild from the next healthy realization (before the first coarse step, at
+    //    the run's start, from its own initial state: there is no ensemble state to lift to).
+    const std::vector<long> failed = failed_pending_;
+    std::vector<long> donors(failed.size(), -1);
+    std::vector<char> lift_these(active_.size(), 0);
+    const bool has_coarse_state = layout_.is_root() ? resume_x_.size() > 0 : true;
+    int lift_flag = has_coarse_state ? 1 : 0;
+    MPI_Bcast(&lift_flag, 1, MPI_INT, 0, layout_.mpi().comm());
+    const auto R = static_cast<long>(active_.size());
+    for (std::size_t i = 0; i < failed.size(); ++i) {
+        if (!replace) {
+            active_[static_cast<std::size_t>(failed[i])] = 0;
+            continue;
+        }
+        for (long step = 1; step < R && lift_flag; ++step) {
+            const long d = (failed[i] + step) % R;
+            if (active_[static_cast<std::size_t>(d)] &&
+                std::find(failed.begin(), failed.end(), d) == failed.end()) {
+                donors[i] = d;
+                break;
+            }
+        }
+        lift_these[static_cast<std::size_t>(failed[i])] = 1;
+    }
+    if (replace) send_states(failed, donors);
+    if (replace && layout_.is_root())
+        for (long f : failed)  // a fresh lifting stream of its own, never used before
+            lifting_[static_cast<std::size_t>(f)] =
+                RandomStream(settings_.seed, static_cast<std::uint64_t>(f + R * failures_), "lifting");
+    // 3. Lifted at once to the ensemble's coarse state at the resume point, so that the copy
+    //    leaves its donor's trajectory from the first step on.
+    if (replace && lift_flag) do_lift(resume_time_, top_half, layout_.is_root() ? &resume_x_ : nullptr, &lift_these);
+    if (layout_.is_root()) {
+        last_sample_ = resume_sample_;
+        if (recorder_)
+            for (std::size_t i = 0; i < failed.size(); ++i)
+                recorder_->failure({failed_time_, failed[i], failed_reasons_[static_cast<std::size_t>(failed[i])],
+                                    replace ? "replaced" : "dropped", donors[i], resume_time_, active_realizations()});
+    }
+    failed_pending_.clear();
+    changed_ = false;
+    // 4. The rebuilt ensemble is the new resume point (a stop now checkpoints it).
+    do_mark();
 }
 
 }  // namespace efdem::mpi_driver

@@ -42,6 +42,7 @@
 #include "core/rng.hpp"
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/ensemble/failure_policy.hpp"
 #include "mpi_driver/ensemble/injected_failure.hpp"
 #include "mpi_driver/output/progress.hpp"
 #include "mpi_driver/ensemble/realization.hpp"
@@ -55,6 +56,7 @@ struct StepperSettings {
     int quantiles = 19;               ///< m of the p-grid
     std::uint64_t seed = 1;           ///< master seed (for the lifting streams)
     InjectedFailure failure;
+    FailurePolicy on_failure;  ///< what a realization's failure does (abort, drop, replace)
     /// Root: an observable evaluated at every sample only to be recorded (e.g. the compact
     /// (A,B,C,D) of a direct run, for comparison with a compact CPI run); null for none.
     coarse::EnsembleObservable* recorded = nullptr;
@@ -109,6 +111,16 @@ public:
 
     /// Every rank: the stop signal the ensemble agreed on (0: none yet).
     int interrupted() const { return interrupted_; }
+    /// Realizations in the ensemble (R less those dropped), and failures survived so far.
+    int active_realizations() const;
+    long failures() const { return failures_; }
+    /// Root, after run() threw EnsembleChanged (cpi: a realization failed and is dropped or
+    /// replaced): every realization goes back to the resume point, the failed ones leave the
+    /// ensemble or are rebuilt there from a healthy one (fresh lifting stream, lifted to the
+    /// ensemble's coarse state at the resume point), and the failures are recorded. The loop
+    /// then continues from resume_driver(). Collective through serve().
+    void rebuild_after_failure();
+    const DriverState& resume_driver() const { return resume_driver_; }
     /// Root: keep the state here (every realization, the stepper, the loop's `driver` state) as
     /// the point a stop is checkpointed at, and record the samples held back since the last
     /// one. Call only where nothing of a burst is pending (between coarse steps).
@@ -152,7 +164,7 @@ public:
 private:
     enum class Command : int {
         run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7, mark = 8,
-        checkpoint_mark = 9
+        checkpoint_mark = 9, rebuild = 10
     };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
@@ -179,7 +191,14 @@ private:
     void record(const SampleRecord& s);
     void do_mark();
     void flush_since_mark();
-    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target);
+    /// `only` (every rank; null: all): lift just the realizations marked 1.
+    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, const std::vector<char>* only = nullptr);
+    bool is_active(const Realization& r) const { return active_[static_cast<std::size_t>(r.index())] != 0; }
+    void on_failures(const std::vector<Failure>& failures);
+    /// Root: every realization's failure message (empty where none); collective.
+    std::vector<std::string> gather_failure_messages(const std::vector<Failure>& failures) const;
+    void do_rebuild(bool top_half);
+    void send_states(const std::vector<long>& failed, const std::vector<long>& donors);
     void take_sample(bool top_half, coarse::BurstSamples* out);
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header, bool at_resume_point);
     [[noreturn]] void fail(const std::string& message, long realization) const;
@@ -217,10 +236,27 @@ private:
     int finish_code_ = 0;
     bool has_resume_point_ = false;
     std::vector<RealizationState> resume_states_;  ///< every rank: at the resume point
-    StepperState resume_stepper_;            ///< root
+    StepperState resume_stepper_;            ///< every rank (lifting streams, warm starts: root)
     DriverState resume_driver_;              ///< root
     double resume_time_ = 0;
     std::vector<SampleRecord> since_mark_;   ///< root: confirmed samples after the resume point
+    SampleRecord resume_sample_;             ///< root: the last sample at the resume point
+    Eigen::VectorXd last_x_, resume_x_;      ///< root: the last restricted coarse vector, and at the resume point
+    std::vector<char> active_;               ///< every rank: per realization, in the ensemble
+    long failures_ = 0;                      ///< every rank: failures survived
+    bool injected_fired_ = false;            ///< the injected failure happens once
+    bool changed_ = false;                   ///< every rank: failures await rebuild_after_failure()
+    std::vector<long> failed_pending_;       ///< every rank: which
+    std::vector<std::string> failed_reasons_;  ///< root: why (per realization)
+    double failed_time_ = 0;
+};
+
+/// Thrown on the root by EnsembleStepper::run() in cpi when realizations failed and are to be
+/// dropped or replaced: the driver calls rebuild_after_failure() and continues the loop from
+/// the resume point.
+class EnsembleChanged : public std::runtime_error {
+public:
+    EnsembleChanged() : std::runtime_error("realizations failed; the coarse step is redone without them") {}
 };
 
 /// Every rank, when the ensemble agreed that a realization failed (its rank printed why).

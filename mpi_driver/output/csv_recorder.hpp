@@ -22,6 +22,9 @@ public:
     void sample(const SampleRecord& s) override;
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;
+    /// Failures are recorded in the run file (/failures, /samples/realizations_used); the CSV
+    /// keeps its columns.
+    void failure(const FailureRecord&) override {}
     /// `<prefix>_mean_icdf.csv`, and `<prefix>_cpi_steps.csv` in cpi mode.
     std::vector<std::filesystem::path> files() const override;
 

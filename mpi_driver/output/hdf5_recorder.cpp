@@ -73,6 +73,7 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> icdf = s.realizations;
     series("/samples/icdf", {r, m}, T::real).append(std::span<const double>(icdf.data(), static_cast<std::size_t>(icdf.size())));
     series("/samples/com", {r}, T::real).append(as_span(s.com));
+    series("/samples/realizations_used", {}, T::integer).append_integer(s.realizations_used);
     if (s.top_mean.size() == m_) series("/samples/top_mean", {m}, T::real).append(as_span(s.top_mean));
     if (s.compact.size() == 4) {
         series("/samples/compact", {4}, T::real).append(as_span(s.compact));
@@ -139,6 +140,20 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
     series("/cpi/lift_changed", {r}, T::integer).append(std::span<const std::int64_t>(changed));
     series("/cpi/lift_max_deviation", {r}, T::real).append(std::span<const double>(deviation));
     series("/cpi/lift_message", {}, T::text).append_text(messages);
+    file_.flush();
+}
+
+void Hdf5Recorder::failure(const FailureRecord& f) {
+    // /failures/*: one row per failure the run survived.
+    using T = H5Series::Type;
+    if (!file_.exists("/failures")) file_.create_group("/failures");
+    series("/failures/time", {}, T::real).append(f.time);
+    series("/failures/realization", {}, T::integer).append_integer(f.realization);
+    series("/failures/action", {}, T::text).append_text(f.action);
+    series("/failures/reason", {}, T::text).append_text(f.reason);
+    series("/failures/donor", {}, T::integer).append_integer(f.donor);
+    series("/failures/resumed_at", {}, T::real).append(f.resumed_at);
+    series("/failures/realizations_left", {}, T::integer).append_integer(f.realizations_left);
     file_.flush();
 }
 

@@ -43,6 +43,7 @@ public:
     void sample(const SampleRecord& s) override;
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;
+    void failure(const FailureRecord& f) override;
     std::vector<std::filesystem::path> files() const override { return {path_}; }
 
 private:

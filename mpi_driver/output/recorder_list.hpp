@@ -19,6 +19,9 @@ public:
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override {
         for (auto& r : recorders_) r->coarse_step(step, lift);
     }
+    void failure(const FailureRecord& f) override {
+        for (auto& r : recorders_) r->failure(f);
+    }
     void finish(const RunSummary& summary) override {
         for (auto& r : recorders_) r->finish(summary);
     }

@@ -25,6 +25,19 @@ struct SampleRecord {
     Eigen::VectorXd top_mean;      ///< ensemble-mean ICDF of the N/2 highest particles, when gathered
     Eigen::VectorXd compact;       ///< (A, B, C, D) of the mean y(p), when used (else empty)
     int compact_status = 0;        ///< 0 ok; otherwise the fit's status code
+    /// Realizations in the means (R less those dropped after a failure; their rows are NaN).
+    int realizations_used = 0;
+};
+
+/// A realization that failed and what the ensemble did about it (ensemble.on_failure).
+struct FailureRecord {
+    double time = 0;          ///< when it failed
+    long realization = -1;
+    std::string reason;       ///< the failure's message
+    std::string action;       ///< "dropped", "replaced", or "fatal" (the run ends)
+    long donor = -1;          ///< replaced: the realization whose state it was rebuilt from
+    double resumed_at = 0;    ///< cpi: where the interrupted coarse step was redone from
+    int realizations_left = 0;  ///< realizations in the ensemble after it
 };
 
 /// What lifting did to each realization at one coarse step.
@@ -58,6 +71,8 @@ public:
     virtual void sample(const SampleRecord& s) = 0;
     virtual void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) = 0;
     virtual void finish(const RunSummary& summary) = 0;
+    /// A realization's failure that the run survived (drop, replace).
+    virtual void failure(const FailureRecord& f) = 0;
     /// The files this recorder writes (a checkpoint stores them whole, a restart puts them back).
     virtual std::vector<std::filesystem::path> files() const = 0;
 };

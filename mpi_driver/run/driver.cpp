@@ -94,6 +94,7 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
     sum.simulated_time = s.duration;
     fill_totals(sum, stepper, progress);
     sum.end_status = std::abs(stepper.time() - t_end) < 1e-6 * std::max(1.0, t_end) ? "completed" : "incomplete";
+    if (stepper.failures() > 0) sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
     return sum;
 }
 
@@ -124,7 +125,20 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
 
     coarse::ProjectiveRunOutcome out;
     try {
-        out = run.run(s.duration, control.resume);
+        std::optional<coarse::ProjectiveRunState> from = control.resume;
+        while (true) {
+            try {
+                out = run.run(s.duration, from);
+                break;
+            } catch (const EnsembleChanged&) {
+                // A realization failed (ensemble.on_failure = drop | replace): redo the coarse
+                // step from where it began, with the changed ensemble.
+                stepper.rebuild_after_failure();
+                from = stepper.resume_driver();
+                log::warn("continuing from t = {:.6g} with {} realizations ({} failure(s) so far)",
+                          stepper.time(), stepper.active_realizations(), stepper.failures());
+            }
+        }
     } catch (const RunInterrupted&) {
         // Checkpointed where the interrupted coarse step began (or before the warm-up): the
         // restarted run redoes that step as the uninterrupted run did.
@@ -145,6 +159,8 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     sum.simulated_time = out.simulated_time;
     fill_totals(sum, stepper, progress);
     sum.lift_seconds = stepper.overhead().lift_seconds;
+    if (stepper.failures() > 0 && sum.end_status.rfind("completed", 0) == 0)
+        sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
     sum.controller = run.integrator().summary(stepper.realizations());
     if (!sum.controller.empty()) log::info("{}", sum.controller);
     return sum;

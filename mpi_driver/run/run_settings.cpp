@@ -1,5 +1,7 @@
 #include "mpi_driver/run/run_settings.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "coarse/demixing/observable_table.hpp"
@@ -16,7 +18,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         root.scope("ensemble").get_or<int>("realizations_per_rank", 1, Bounds::closed(1, 4096));
 
     const Params observe = root.scope("observe");
-    s.observe.interval = observe.get_or<double>("interval", 0.5, Bounds::positive());
+    s.observe.interval = observe.get_or<double>("interval", 0.5, Bounds::open_closed(0.0, 1e6));
     s.observe.steps_per_sample = whole_multiple(observe, "interval", s.observe.interval, scene.dt, "dt");
     s.observe.quantiles = observe.get_or<int>("quantiles", 19, Bounds::closed(1, 999));
     s.observe.compact = observe.get_or<bool>("compact", false);
@@ -27,16 +29,24 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.observe.other = s.observe.species == 0 ? 1 : 0;
 
     const Params run = root.scope("run");
-    s.duration = run.get<double>("duration", Bounds::positive());
+    s.duration = run.get<double>("duration", Bounds::open_closed(0.0, 1e9));
     whole_multiple(run, "duration", s.duration, s.observe.interval, "observe.interval");
 
-    // The cpi block is read and checked in both modes: a direct run of a cpi scene is the
-    // reference that the cpi run is compared with (and its cpi.* keys are not "unused").
+    // The cpi block is read in both modes (a direct run of a cpi scene is the reference the cpi
+    // run is compared with, and its cpi.* keys are not "unused"), but checked against the
+    // sampling grid only in cpi mode: a direct run does not use them.
     const Params cpi = root.scope("cpi");
     const auto observables = coarse::observable_table().names();
     s.observable = cpi.get_or_choice("observable", observables.front(), observables);
-    s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval);
+    s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval, s.is_cpi());
     if (s.is_cpi()) {
+        const double least = s.cpi.warmup + s.cpi.burst();
+        if (s.duration < least - 1e-9 * least)
+            run.fail("duration",
+                     fmt::format("is shorter than cpi.warmup + one burst (cpi.healing + cpi.window) = {:g}: the cpi "
+                                 "run could not make a single coarse step", least),
+                     fmt::format("run.duration >= {:g} (several bursts and jumps to gain anything), or mode = direct",
+                                 least));
         if (scene.species.size() != 2)
             root.fail("mode", fmt::format("cpi lifts by swapping the labels of two species, but "
                                           "species.names lists {}", scene.species.size()),
@@ -53,23 +63,52 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.output.prefix = output.get_or<std::string>("prefix", "efdem");
     if (s.output.prefix.find('/') != std::string::npos)
         output.fail("prefix", "contains '/'", "a file stem; set output.directory for the folder");
-    s.output.vtk_interval = output.get_or<double>("vtk_interval", 0.0, Bounds::non_negative());
+    // File names are at most 255 bytes, and the longest name made from the prefix adds 21
+    // (PREFIX_r0000_000000.vtp.tmp, PREFIX_ckpt_00000000.h5.tmp).
+    if (s.output.prefix.empty() || s.output.prefix.size() > 200 || s.output.prefix == "." || s.output.prefix == "..")
+        output.fail("prefix", fmt::format("is {} characters long", s.output.prefix.size()),
+                    "a file stem of 1 to 200 characters, not . or ..");
+    if (s.output.directory.string().size() > 3000)
+        output.fail("directory", fmt::format("is {} characters long", s.output.directory.string().size()),
+                    "a path of at most 3000 characters");
+    s.output.vtk_interval = output.get_or<double>("vtk_interval", 0.0, Bounds::closed(0.0, 1e9));
     if (s.output.vtk_interval > 0)
         whole_multiple(output, "vtk_interval", s.output.vtk_interval, s.observe.interval, "observe.interval");
-    s.output.thermo_interval = output.get_or<double>("thermo_interval", 0.0, Bounds::non_negative());
+    s.output.thermo_interval = output.get_or<double>("thermo_interval", 0.0, Bounds::closed(0.0, 1e9));
     if (s.output.thermo_interval > 0)
         whole_multiple(output, "thermo_interval", s.output.thermo_interval, s.observe.interval, "observe.interval");
 
     s.output.overwrite = output.get_or<bool>("overwrite", false);
     s.checkpoint = CheckpointSettings::from_params(root, s.output.directory);
     const Params debug = root.scope("debug");
-    s.injected_failure.realization = debug.get_or<long>("fail_realization", -1);
-    s.injected_failure.time = debug.get_or<double>("fail_time", 0.0);
+    s.injected_failure.realization = debug.get_or<long>("fail_realization", -1, Bounds::closed(-1, 1e9));
+    s.injected_failure.time = debug.get_or<double>("fail_time", 0.0, Bounds::closed(0.0, 1e9));
+
+    const Params ensemble = root.scope("ensemble");
+    const std::string action = ensemble.get_or_choice("on_failure", "abort", {"abort", "drop", "replace"});
+    s.on_failure.action = action == "drop"      ? FailurePolicy::Action::drop
+                          : action == "replace" ? FailurePolicy::Action::replace
+                                                : FailurePolicy::Action::abort;
+    if (s.on_failure.action == FailurePolicy::Action::replace && !s.is_cpi())
+        ensemble.fail("on_failure",
+                      "= replace needs cpi mode: in a direct run a copy of a healthy realization would follow "
+                      "its donor's trajectory (the DEM is deterministic) and correlate the ensemble",
+                      "abort or drop in direct mode; abort, drop or replace in cpi mode");
+    s.on_failure.max_failures = ensemble.get_or<long>("max_failures", -1, Bounds::closed(-1, 1e9));
+    if (s.on_failure.action == FailurePolicy::Action::abort && ensemble.contains("max_failures"))
+        ensemble.fail("max_failures", "is read only with ensemble.on_failure = drop or replace",
+                      "remove it, or set ensemble.on_failure");
     return s;
 }
 
-void RunSettings::check_ensemble(const Params& root, int realizations) const {
-    if (!is_cpi() || cpi.projection != coarse::CoarseRunSettings::Projection::adaptive) return;
+void RunSettings::check_ensemble(const Params& root, int realizations) {
+    // A run that measures the spread of the realizations' slopes needs two of them to the end.
+    const bool spread = is_cpi() && cpi.projection == coarse::CoarseRunSettings::Projection::adaptive;
+    on_failure.min_active = spread ? 2 : 1;
+    if (on_failure.max_failures < 0) on_failure.max_failures = std::max(1, realizations / 4);
+    if (on_failure.action == FailurePolicy::Action::drop && on_failure.max_failures > realizations - on_failure.min_active)
+        on_failure.max_failures = std::max(0, realizations - on_failure.min_active);
+    if (!spread) return;
     const Params c = root.scope("cpi");
     if (realizations < 2)
         c.fail("projection",

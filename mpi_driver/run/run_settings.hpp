@@ -13,6 +13,9 @@
 /// | mode                           | `direct` (every realization runs the DEM) or `cpi`  | direct  |
 /// | seed                           | master seed of every random stream                  | 1       |
 /// | ensemble.realizations_per_rank | k: the ensemble has R = P x k realizations          | 1       |
+/// | ensemble.on_failure            | abort, drop or replace (cpi) a failing realization   | abort   |
+/// |                                | (failure_policy.hpp)                                 |         |
+/// | ensemble.max_failures          | failures a drop/replace run survives                 | R/4, >= 1 |
 /// | run.duration                   | simulated time to cover (cpi: until reached)        | required|
 /// | observe.interval               | time between ICDF samples (a multiple of dt)        | 0.5     |
 /// | observe.species                | species whose heights make the ICDF                 | first   |
@@ -41,6 +44,7 @@
 #include "core/param_table.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/checkpoint_settings.hpp"
+#include "mpi_driver/ensemble/failure_policy.hpp"
 #include "mpi_driver/ensemble/injected_failure.hpp"
 
 namespace efdem::mpi_driver {
@@ -76,6 +80,9 @@ struct RunSettings {
     CheckpointSettings checkpoint;
     /// debug.fail_*: a test-only injected failure.
     InjectedFailure injected_failure;
+    /// ensemble.on_failure, ensemble.max_failures (max_failures and min_active are completed by
+    /// check_ensemble, which knows R).
+    FailurePolicy on_failure;
 
     bool is_cpi() const { return mode == Mode::cpi; }
     /// "cpi" or "direct".
@@ -87,7 +94,7 @@ struct RunSettings {
     /// `realizations` (ranks x ensemble.realizations_per_rank) cannot serve them (adaptive CPI
     /// measures its statistical error from the spread of >= 2 realizations' own slopes, on an
     /// observable that restricts each realization).
-    void check_ensemble(const Params& root, int realizations) const;
+    void check_ensemble(const Params& root, int realizations);
 };
 
 }  // namespace efdem::mpi_driver

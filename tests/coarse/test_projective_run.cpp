@@ -365,3 +365,27 @@ TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drift
         }
     }
 }
+
+TEST_CASE("a burst that ends the run up to round-off leaves no jump", "[unit][coarse][run]") {
+    // Seen before: the last burst of 16 time units ended at 16 - 3.5e-12 and the jump
+    // "DT = 3.5e-12" was projected and lifted. Within the time tolerance nothing is left.
+    CHECK(end_of_run_jump_limit(16.0 - 3.5e-12, 16.0, 1.5, 1.5) == 0.0);
+    CHECK(end_of_run_jump_limit(14.0, 16.0, 1.5, 1.5) == Approx(0.5));  // shortened to leave a burst
+    CHECK(end_of_run_jump_limit(13.0, 16.0, 3.0, 1.5) == Approx(3.0));  // the jump ends the run
+    CHECK(end_of_run_jump_limit(12.0, 16.0, 3.0, 1.5) == Approx(2.5));  // leaves room for a last burst
+}
+
+TEST_CASE("a direct run reads the cpi block without checking it against the sampling grid", "[unit][coarse][run]") {
+    // LAMMPS' dt = 1.8e-4 makes observe.interval = 0.09: the defaults (healing 10, window 10)
+    // are not multiples of it. A cpi run refuses that, naming the key; a direct run does not use
+    // them and must not.
+    ParamTable table = ParamTable::from_text("cpi.projection = adaptive\n", "scene.cfg", "/scenes");
+    CHECK_NOTHROW(CoarseRunSettings::from_params(table.root().scope("cpi"), 0.09, false));
+    ParamTable strict = ParamTable::from_text("cpi.tolerance = 0.1\n", "scene.cfg", "/scenes");
+    try {
+        (void)CoarseRunSettings::from_params(strict.root().scope("cpi"), 0.09, true);
+        FAIL("expected an InputError");
+    } catch (const InputError& e) {
+        CHECK(e.key() == "cpi.healing");
+    }
+}

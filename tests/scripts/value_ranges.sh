@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Every key has a physically sensible range, and `efdem --check` refuses what lies outside it
+# with exit 2, naming the key and what is allowed (docs/reliability.md, "Value ranges"); keys are
+# checked only in the mode that uses them; long values are quoted cut at 120 characters.
+#   value_ranges.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+set -uo pipefail
+efdem=$1; mpiexec=$2; shift 2
+here=$(cd "$(dirname "$0")" && pwd)
+scene="$here/tiny_scene.cfg"
+failures=0
+long=$(printf 'a%.0s' $(seq 100000))
+
+refused() {  # refused KEY ALLOWED_SUBSTRING OVERRIDE...
+  local key=$1 allowed=$2; shift 2
+  local out code
+  out=$("$mpiexec" -n 1 "${launcher[@]}" "$@" 2>&1 > /dev/null)
+  code=$?
+  line=$(grep "^efdem: error:" <<< "$out")
+  if [ $code -eq 2 ] && grep -q "key '$key'" <<< "$line" && grep -qF "$allowed" <<< "$line" && [ ${#line} -lt 400 ]; then
+    echo "PASS: $key refused: $(grep -o "key '$key'.*" <<< "$out" | cut -c1-160)"
+  else
+    echo "FAIL: $key (exit $code, ${#out} characters): $out" | cut -c1-600; failures=$((failures + 1))
+  fi
+}
+launcher=("$@")
+check() { refused "$1" "$2" "$efdem" --check "$scene" "${@:3}"; }
+
+check run.duration "0 or a multiple of 0.25" run.duration=1e-300
+check observe.interval "a multiple of 0.0001" observe.interval=1e-300
+check pair_contact.mu "[0, 10]" pair_contact.mu=1e308
+check pair_contact.restitution "[0.001, 1]" pair_contact.restitution=4.9e-324
+check pair_contact.kn "[1, 1000000000000]" pair_contact.kn=1e300
+check bed.settle.ke_threshold "(0, 1]" bed.settle.ke_threshold=1e20
+check gas_drag.superficial_velocity "[0, 1000]" gas_drag.superficial_velocity=1e9
+check dt "[1e-09, 1)" dt=1e-12
+check cpi.tolerance "(0, 1000000]" mode=cpi cpi.projection=adaptive cpi.tolerance=1e300
+check output.prefix "1 to 200 characters" output.prefix=$long
+check mode "direct, cpi" mode=$long
+# A cpi run too short for one coarse step.
+check run.duration "or mode = direct" mode=cpi run.duration=1
+# LAMMPS' dt: a direct run does not check the (unused) cpi defaults against observe.interval...
+out=$("$mpiexec" -n 1 "${launcher[@]}" "$efdem" --check "$scene" mode=direct dt=1.8e-4 observe.interval=0.09 run.duration=0.9 2>&1)
+if [ $? -eq 0 ]; then echo "PASS: direct run with dt = 1.8e-4, observe.interval = 0.09 accepted"
+else echo "FAIL: direct run with LAMMPS' dt refused: $out" | tail -1; failures=$((failures + 1)); fi
+# ... a cpi run does, and names a key it reads.
+check cpi.warmup "a multiple of 0.09" mode=cpi dt=1.8e-4 observe.interval=0.09 run.duration=90
+
+[ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
+echo "PASS: value ranges"
