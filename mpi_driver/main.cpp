@@ -180,6 +180,13 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         log::error("the run failed; its files in {} are marked 'failed'", s.output.directory.string());
         return kExitRuntimeFailure;
     } catch (const std::exception& e) {
+        // A failure on the root (e.g. its run file on a full disk): mark the run file if it can
+        // be (finish() frees its reserve first), then end every rank.
+        summary.end_status = std::string("failed: ") + e.what();
+        try {
+            recorders->finish(summary);
+        } catch (const std::exception&) {
+        }
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
     log::info("{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall, {:.3e} particle-steps",

@@ -25,6 +25,7 @@ public:
 
 private:
     std::FILE* file_ = nullptr;
+    std::filesystem::path path_;
 };
 
 }  // namespace efdem::dem

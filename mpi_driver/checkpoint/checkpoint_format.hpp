@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "coarse/equation_free/projective_run.hpp"
+#include "core/error.hpp"
 #include "core/rng.hpp"
 
 namespace efdem::mpi_driver {
@@ -81,6 +82,12 @@ struct RealizationState;
 
 /// Where the EnsembleStepper sends a checkpoint (CheckpointWriter; an interface so that the
 /// stepper does not depend on HDF5).
+/// Thrown on every rank alike (collectively agreed) when a checkpoint would not fit on the disk.
+class CheckpointSpaceError : public RuntimeFailure {
+public:
+    explicit CheckpointSpaceError(const std::string& message) : RuntimeFailure(message) {}
+};
+
 class CheckpointSink {
 public:
     virtual ~CheckpointSink() = default;

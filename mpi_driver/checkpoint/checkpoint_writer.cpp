@@ -101,6 +101,7 @@ std::filesystem::path CheckpointWriter::write(long sequence, const std::vector<R
     const std::filesystem::path final_path = settings_.directory / checkpoint_file_name(prefix_, sequence);
     std::filesystem::path tmp = final_path;
     tmp += ".tmp";
+    ensure_space(final_path, local);
     write_realizations(tmp, local);
     MPI_Barrier(layout_.mpi().comm());
     if (!layout_.is_root()) return final_path;
@@ -113,6 +114,36 @@ std::filesystem::path CheckpointWriter::write(long sequence, const std::vector<R
                                              final_path.string(), ec.message()));
     prune(final_path);
     return final_path;
+}
+
+void CheckpointWriter::ensure_space(const std::filesystem::path& path, const std::vector<RealizationState>& local) const {
+    // A collective write that runs out of space can leave ranks waiting for each other in MPI-IO;
+    // so the space is looked at first, and every rank gives up together if it is short.
+    double bytes = 0;  // what this rank's rows take (x, v, omega, force, torque, reference, walls, tag, species; pairs)
+    for (const auto& s : local)
+        bytes += static_cast<double>(s.particles()) * (8 * sizeof(Vec3) + sizeof(dem::Tag) + 1) +
+                 static_cast<double>(s.pairs.size()) * sizeof(dem::PairHistoryRecord);
+    double total = 0;
+    MPI_Allreduce(&bytes, &total, 1, MPI_DOUBLE, MPI_SUM, layout_.mpi().comm());
+    double verdict[2] = {1.0, 0.0};  // ok, bytes free
+    if (layout_.is_root()) {
+        std::error_code ec;
+        for (const auto& p : outputs_) {
+            const auto size = std::filesystem::file_size(p, ec);
+            if (!ec) total += static_cast<double>(size);
+        }
+        total = 1.25 * total + (1 << 20);  // HDF5 layout and metadata
+        const auto space = std::filesystem::space(settings_.directory, ec);
+        verdict[1] = ec ? -1.0 : static_cast<double>(space.available);
+        verdict[0] = ec || verdict[1] >= total ? 1.0 : 0.0;
+        verdict[1] = total - (ec ? 0.0 : verdict[1]);
+    }
+    MPI_Bcast(verdict, 2, MPI_DOUBLE, 0, layout_.mpi().comm());
+    if (verdict[0] == 0.0)
+        throw CheckpointSpaceError(fmt::format(
+            "cannot write the checkpoint {}: no space left on device for it ({:.3g} MB more are needed; the disk "
+            "or the quota is full); the checkpoints already written are untouched",
+            path.string(), verdict[1] / 1e6));
 }
 
 void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,

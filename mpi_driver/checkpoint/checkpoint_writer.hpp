@@ -39,6 +39,8 @@ public:
                                 const CheckpointHeader* header) const override;
 
 private:
+    /// Collective: CheckpointSpaceError on every rank when the directory has too little space.
+    void ensure_space(const std::filesystem::path& path, const std::vector<RealizationState>& local) const;
     void write_realizations(const std::filesystem::path& tmp, const std::vector<RealizationState>& local) const;
     void write_header(const std::filesystem::path& tmp, long sequence, const CheckpointHeader& header) const;
     void prune(const std::filesystem::path& current) const;

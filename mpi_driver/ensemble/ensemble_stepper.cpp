@@ -312,6 +312,10 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
         last_checkpoint_ = writer_->write(sequence, at_resume_point ? resume_states_ : states, header);
         last_checkpoint_time_ = at_resume_point ? resume_time_ : time();
         return last_checkpoint_;
+    } catch (const CheckpointSpaceError& e) {
+        // Every rank knows it at once: they end together, and the root marks the run file.
+        if (layout_.is_root()) std::fprintf(stderr, "efdem: error: %s\n", e.what());
+        throw RunFailed(e.what());
     } catch (const std::exception& e) {
         layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()), kExitRuntimeFailure);
     }

@@ -19,6 +19,33 @@ void silence_hdf5() {
     (void)done;
 }
 
+/// Why the last HDF5 call failed, from its error stack: the system's reason where the library
+/// gives one (e.g. "No space left on device"), else its innermost description.
+std::string hdf5_error_reason() {
+    struct Found {
+        std::string innermost, system;
+    } found;
+    H5Ewalk2(
+        H5E_DEFAULT, H5E_WALK_UPWARD,
+        [](unsigned n, const H5E_error2_t* e, void* data) -> herr_t {
+            auto& f = *static_cast<Found*>(data);
+            const std::string desc = e->desc ? e->desc : "";
+            if (n == 0) f.innermost = desc;
+            const auto at = desc.find("error message = '");
+            if (f.system.empty() && at != std::string::npos) {
+                const auto start = at + 17, end = desc.find('\'', start);
+                f.system = desc.substr(start, end == std::string::npos ? std::string::npos : end - start);
+            }
+            return 0;
+        },
+        &found);
+    H5Eclear2(H5E_DEFAULT);
+    std::string reason = !found.system.empty() ? found.system : found.innermost;
+    if (reason.find("No space left") != std::string::npos || reason.find("quota") != std::string::npos)
+        reason += " (no space left: the disk or the quota is full)";
+    return reason;
+}
+
 hid_t string_type() {
     const hid_t t = H5Tcopy(H5T_C_S1);
     H5Tset_size(t, H5T_VARIABLE);
@@ -52,11 +79,17 @@ H5File::H5File(H5File&& other) noexcept : file_(other.file_), path_(std::move(ot
 }
 
 void H5File::check(herr_t status, const std::string& what) const {
-    if (status < 0) throw RuntimeFailure(fmt::format("HDF5 error in {}: {}", path_, what));
+    if (status < 0) {
+        const std::string why = hdf5_error_reason();
+        throw RuntimeFailure(fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
+    }
 }
 
 hid_t H5File::check_id(hid_t id, const std::string& what) const {
-    if (id < 0) throw RuntimeFailure(fmt::format("HDF5 error in {}: {}", path_, what));
+    if (id < 0) {
+        const std::string why = hdf5_error_reason();
+        throw RuntimeFailure(fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
+    }
     return id;
 }
 

@@ -1,7 +1,14 @@
 #include "mpi_driver/output/hdf5_recorder.hpp"
 
+#include <cerrno>
 #include <chrono>
 #include <ctime>
+#include <fcntl.h>
+#include <system_error>
+#include <unistd.h>
+
+#include "core/error.hpp"
+#include "core/io_error.hpp"
 
 #include <fmt/format.h>
 
@@ -9,6 +16,23 @@
 namespace efdem::mpi_driver {
 
 namespace {
+/// Bytes held in reserve for finishing the run file when the disk fills (its metadata and the
+/// end attributes need far less).
+constexpr off_t kReserveBytes = 1 << 20;
+
+std::filesystem::path make_reserve(const std::filesystem::path& run_file) {
+    const std::filesystem::path p = run_file.string() + ".reserve";
+    const int fd = ::open(p.c_str(), O_CREAT | O_WRONLY | O_TRUNC, 0644);
+    const int err = fd < 0 ? errno : ::posix_fallocate(fd, 0, kReserveBytes);
+    if (fd >= 0) ::close(fd);
+    if (err != 0) {
+        std::error_code ignored;
+        std::filesystem::remove(p, ignored);
+        throw RuntimeFailure(io_failure_message(p, "the run file's 1 MiB reserve (space to finish it on a full disk)", err));
+    }
+    return p;
+}
+
 std::string now_utc() {
     const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
     std::tm tm{};
@@ -23,6 +47,7 @@ std::span<const double> as_span(const Eigen::VectorXd& v) { return {v.data(), st
 Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::string& prefix,
                            const RunProvenance& p, Eigen::Index coarse_dimension, bool resume)
     : path_(directory / (prefix + ".h5")),
+      reserve_(make_reserve(path_)),
       file_(resume ? H5File::open(path_, true) : H5File::create(path_)),
       realizations_(p.realizations),
       m_(p.p_grid.size()), dim_(coarse_dimension) {
@@ -158,6 +183,10 @@ void Hdf5Recorder::failure(const FailureRecord& f) {
 }
 
 void Hdf5Recorder::finish(const RunSummary& s) {
+    // First free the reserve: if the disk filled, this is the space the end status and the
+    // file's metadata are written into.
+    std::error_code ignored;
+    std::filesystem::remove(reserve_, ignored);
     file_.attribute("/", "end_status", s.end_status);
     file_.attribute("/", "simulated_time", s.simulated_time);
     file_.attribute("/", "dem_time", s.dem_time);

@@ -50,6 +50,9 @@ private:
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
 
     std::filesystem::path path_;
+    /// PATH.reserve: space held for finishing the run file on a full disk (finish() frees it
+    /// first, so that the end status and the file's metadata can still be written).
+    std::filesystem::path reserve_;
     H5File file_;
     int realizations_;
     Eigen::Index m_;

@@ -32,7 +32,8 @@ bool is_realization_file(std::string_view name, const std::string& prefix) {
 }
 
 bool is_run_file(std::string_view name, const std::string& prefix) {
-    return name == prefix + ".h5" || name == prefix + "_mean_icdf.csv" || name == prefix + "_cpi_steps.csv";
+    return name == prefix + ".h5" || name == prefix + ".h5.reserve" || name == prefix + "_mean_icdf.csv" ||
+           name == prefix + "_cpi_steps.csv";
 }
 
 void collect(const std::filesystem::path& dir, const std::string& prefix, bool checkpoints,

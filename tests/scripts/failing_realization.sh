@@ -11,11 +11,7 @@
 #  4. direct + replace is refused (a copy would follow its donor); more failures than
 #     ensemble.max_failures end the run (exit 3, run file marked failed).
 #   failing_realization.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
-set -uo pipefail
-efdem=$1; mpiexec=$2; shift 2
-here=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
 scene="$here/tiny_scene.cfg"
 run() {  # run PREFIX ARGS...: expects success
   local p=$1; shift
@@ -23,7 +19,6 @@ run() {  # run PREFIX ARGS...: expects success
     output.directory="$work" output.prefix=$p "$@" > "$work/$p.log" 2>&1 \
     || { grep -v "^t = " "$work/$p.log"; echo "FAIL: run $p"; exit 1; }
 }
-launcher=("$@")
 fail=(debug.fail_realization=1 debug.fail_time=1)
 
 run dref mode=direct run.duration=4

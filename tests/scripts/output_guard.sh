@@ -9,25 +9,21 @@
 #  4. end_status in the run file: "running" from the start (what a killed run leaves),
 #     "completed", "interrupted: SIGTERM ..." (stop signal), "failed: realization 1 ...".
 #   output_guard.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
-set -uo pipefail
-efdem=$1; mpiexec=$2; shift 2
-here=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
 scene="$here/tiny_scene.cfg"
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-efd() { timeout 300 "$mpiexec" -n 1 "$@"; }
+efd() { timeout 300 "$mpiexec" -n 1 "${launcher[@]}" "$@"; }
 status_of() { /usr/bin/python3 -c "import h5py, sys; print(h5py.File(sys.argv[1], 'r').attrs['end_status'])" "$1"; }
 
 out="$work/out"
-efd "$@" "$efdem" "$scene" mode=direct run.duration=2 output.vtk_interval=0.5 output.directory="$out" \
+efd "$efdem" "$scene" mode=direct run.duration=2 output.vtk_interval=0.5 output.directory="$out" \
   > "$work/first.log" 2>&1 || { cat "$work/first.log"; fail "the first run failed"; }
 before=$(cd "$out" && sha256sum * | sort)
 [ "$(ls "$out"/*.vtp | wc -l)" -eq 5 ] || fail "expected 5 VTK frames from the first run"
 
 # 1. Refused, nothing touched; --check says the same.
-efd "$@" "$efdem" "$scene" mode=direct run.duration=1 seed=5 output.directory="$out" > "$work/again.log" 2>&1
+efd "$efdem" "$scene" mode=direct run.duration=1 seed=5 output.directory="$out" > "$work/again.log" 2>&1
 code=$?
 if [ $code -eq 2 ] && grep -q "key 'output.prefix': names an earlier run: $out/efdem.h5 exists" "$work/again.log" \
    && [ "$(cd "$out" && sha256sum * | sort)" = "$before" ]; then
@@ -35,13 +31,13 @@ if [ $code -eq 2 ] && grep -q "key 'output.prefix': names an earlier run: $out/e
 else
   cat "$work/again.log"; fail "second run with the same prefix: exit $code"
 fi
-efd "$@" "$efdem" --check "$scene" mode=direct output.directory="$out" > "$work/check-again.log" 2>&1
+efd "$efdem" --check "$scene" mode=direct output.directory="$out" > "$work/check-again.log" 2>&1
 code=$?
 [ $code -eq 2 ] && grep -q "names an earlier run" "$work/check-again.log" \
   && echo "PASS: --check refuses the same prefix" || { cat "$work/check-again.log"; fail "--check: exit $code"; }
 
 # 2. overwrite = true: a run without VTK output leaves no frame of the earlier one behind.
-efd "$@" "$efdem" "$scene" mode=direct run.duration=1 seed=5 output.directory="$out" output.overwrite=true \
+efd "$efdem" "$scene" mode=direct run.duration=1 seed=5 output.directory="$out" output.overwrite=true \
   > "$work/overwrite.log" 2>&1
 code=$?
 seed=$(/usr/bin/python3 -c "import h5py; print(h5py.File('$out/efdem.h5', 'r').attrs['seed'])")
@@ -54,15 +50,15 @@ fi
 
 # 3. --check findings.
 touch "$work/plain_file"
-efd "$@" "$efdem" --check "$scene" output.directory="$work/plain_file/sub" > "$work/dir.log" 2>&1
+efd "$efdem" --check "$scene" output.directory="$work/plain_file/sub" > "$work/dir.log" 2>&1
 code=$?
 [ $code -eq 2 ] && grep -q "key 'output.directory' = .*cannot be written to: '$work/plain_file' exists and is not a directory" "$work/dir.log" \
   && echo "PASS: --check refuses an output directory that cannot be created" || { cat "$work/dir.log"; fail "dir: exit $code"; }
-efd "$@" "$efdem" --check "$scene" mode=direct output.directory="$work/new" restart="$work/none.h5" > "$work/missing.log" 2>&1
+efd "$efdem" --check "$scene" mode=direct output.directory="$work/new" restart="$work/none.h5" > "$work/missing.log" 2>&1
 code=$?
 [ $code -eq 2 ] && grep -q "$work/none.h5: checkpoint file not found" "$work/missing.log" \
   && echo "PASS: --check refuses a missing restart= file" || { cat "$work/missing.log"; fail "missing: exit $code"; }
-efd "$@" "$efdem" --check "$scene" mode=direct output.directory="$work/new" restart="$out/efdem.h5" > "$work/runfile.log" 2>&1
+efd "$efdem" --check "$scene" mode=direct output.directory="$work/new" restart="$out/efdem.h5" > "$work/runfile.log" 2>&1
 code=$?
 [ $code -eq 2 ] && grep -q "restart= names an efdem run file (the record of a run), not a checkpoint" "$work/runfile.log" \
   && echo "PASS: --check says a run file given as restart= is a run file" || { cat "$work/runfile.log"; fail "run file: exit $code"; }
@@ -70,20 +66,20 @@ code=$?
 
 # 4. end_status marks.
 [ "$(status_of "$out/efdem.h5")" = "completed" ] && echo "PASS: end_status completed" || fail "end_status of a completed run"
-setsid "$mpiexec" -n 2 "$@" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/killed" > "$work/killed.log" 2>&1 &
+setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/killed" > "$work/killed.log" 2>&1 &
 job=$!
 for _ in $(seq 600); do [ -s "$work/killed/efdem_mean_icdf.csv" ] && break; sleep 0.05; done
 sleep 1; kill -9 $(ps -o pid= -s $job); wait $job 2>/dev/null
 [ "$(status_of "$work/killed/efdem.h5")" = "running" ] && echo "PASS: a killed run's file says end_status running" \
   || fail "end_status of a killed run: $(status_of "$work/killed/efdem.h5")"
-setsid "$mpiexec" -n 2 "$@" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/stopped" > "$work/stopped.log" 2>&1 &
+setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/stopped" > "$work/stopped.log" 2>&1 &
 job=$!
 for _ in $(seq 600); do [ -s "$work/stopped/efdem_mean_icdf.csv" ] && break; sleep 0.05; done
 kill -TERM $(ps -o pid=,comm= -s $job | awk '$2 == "efdem" {print $1}'); wait $job
 s=$(status_of "$work/stopped/efdem.h5")
 [[ $s == "interrupted: SIGTERM at t = "*"; checkpoint $work/stopped/efdem_ckpt_"* ]] \
   && echo "PASS: a stopped run's file says: $s" || fail "end_status of a stopped run: $s"
-timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$scene" mode=direct debug.fail_realization=1 debug.fail_time=0.5 \
+timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct debug.fail_realization=1 debug.fail_time=0.5 \
   output.directory="$work/failed" > "$work/failed.log" 2>&1
 s=$(status_of "$work/failed/efdem.h5")
 [[ $s == "failed: realization 1 at t = "*": injected failure (debug.fail_realization)" ]] \

@@ -17,11 +17,7 @@
 # The time from the signal to the end of the job is printed (docs/reliability.md has the
 # figures); `timeout` is a hang detector, not a speed requirement.
 #   signal_stop.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
-set -uo pipefail
-efdem=$1; mpiexec=$2; shift 2
-here=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
 scene="$here/tiny_scene.cfg"
 RANDOM=19  # the moments are random but the same in every run of the test
 failures=0
@@ -56,7 +52,7 @@ for spec in "direct|mode=direct run.duration=8|ranks one-rank" \
   read -r -a extra <<< "$overrides"
   common=("${extra[@]}" output.directory="$work" ensemble.realizations_per_rank=2)
   start=$(date +%s.%N)
-  timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=$mode-ref > "$work/$mode-ref.log" 2>&1 \
+  timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${common[@]}" output.prefix=$mode-ref > "$work/$mode-ref.log" 2>&1 \
     || { cat "$work/$mode-ref.log"; fail "$mode: the uninterrupted run failed"; continue; }
   length=$(echo "$(date +%s.%N) - $start" | bc)
   trial=0
@@ -65,7 +61,7 @@ for spec in "direct|mode=direct run.duration=8|ranks one-rank" \
     # A moment between 15 % and 85 % of the uninterrupted run's wall time (MPI start-up included).
     r=$RANDOM  # (in this shell: $RANDOM inside $(...) would not advance)
     delay=$(echo "scale=2; $length * $((15 + r % 71)) / 100" | bc)
-    setsid "$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=$p > "$work/$p.log" 2>&1 &
+    setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${common[@]}" output.prefix=$p > "$work/$p.log" 2>&1 &
     job=$!
     sleep "$delay"
     sent=$(date +%s.%N)
@@ -81,7 +77,7 @@ for spec in "direct|mode=direct run.duration=8|ranks one-rank" \
     [ -n "$line" ] || { grep -v "^t = " "$work/$p.log"; fail "$p: no 'stopped by ...' line"; continue; }
     ckpt=${line##*restart=}
     [ -f "$ckpt" ] || { fail "$p: the checkpoint $ckpt named in the message is missing"; continue; }
-    timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=$p restart="$ckpt" \
+    timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${common[@]}" output.prefix=$p restart="$ckpt" \
       > "$work/$p-restart.log" 2>&1 || { cat "$work/$p-restart.log"; fail "$p: the restart failed"; continue; }
     if same_output $mode-ref $p; then
       echo "PASS: $p stopped at $(grep -o 'checkpoint [^ ]* (t = [0-9.e+-]*)' <<< "$line"), restarted, equals the uninterrupted run"
@@ -92,7 +88,7 @@ for spec in "direct|mode=direct run.duration=8|ranks one-rank" \
 done
 
 # A second signal, after the first has had time to be taken as a stop request, ends at once.
-setsid "$mpiexec" -n 2 "$@" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work" \
+setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work" \
   output.prefix=twice debug.checkpoint_delay=30 checkpoint.interval=1 > "$work/twice.log" 2>&1 &
 job=$!
 # Wait for the first checkpoint write (held open by debug.checkpoint_delay), then signal twice.

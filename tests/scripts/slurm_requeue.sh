@@ -7,20 +7,16 @@
 #    uninterrupted run's bit for bit.
 # 3. A third start finds the run complete and does nothing.
 #   slurm_requeue.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
-set -uo pipefail
-efdem=$1; mpiexec=$2; shift 2
-here=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/lib.sh" "$@"
 mkdir "$work/bin"
-printf '#!/bin/bash\nexec %q -n 2 %s "$@"\n' "$mpiexec" "$*" > "$work/bin/srun"
+printf '#!/bin/bash\nexec %q -n 2 %s "$@"\n' "$mpiexec" "${launcher[*]}" > "$work/bin/srun"
 printf '#!/bin/bash\necho "$@" >> %q\n' "$work/scontrol.log" > "$work/bin/scontrol"
 chmod +x "$work/bin/srun" "$work/bin/scontrol"
 export PATH="$work/bin:$PATH" EFDEM="$efdem" SLURM_JOB_ID=4242
 job="$here/../../scripts/slurm_job.sh"
 args=(mode=cpi run.duration=16 ensemble.realizations_per_rank=2 checkpoint.interval=100)
 
-timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$here/tiny_scene.cfg" "${args[@]}" output.directory="$work/ref" \
+timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" "${args[@]}" output.directory="$work/ref" \
   > "$work/ref.log" 2>&1 || { cat "$work/ref.log"; echo "FAIL: reference run"; exit 1; }
 
 bash "$job" "$here/tiny_scene.cfg" "${args[@]}" output.directory="$work/job" > "$work/job1.log" 2>&1 &

@@ -3,9 +3,7 @@
 # with exit 2, naming the key and what is allowed (docs/reliability.md, "Value ranges"); keys are
 # checked only in the mode that uses them; long values are quoted cut at 120 characters.
 #   value_ranges.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
-set -uo pipefail
-efdem=$1; mpiexec=$2; shift 2
-here=$(cd "$(dirname "$0")" && pwd)
+source "$(dirname "$0")/lib.sh" "$@"
 scene="$here/tiny_scene.cfg"
 failures=0
 long=$(printf 'a%.0s' $(seq 100000))
@@ -22,7 +20,6 @@ refused() {  # refused KEY ALLOWED_SUBSTRING OVERRIDE...
     echo "FAIL: $key (exit $code, ${#out} characters): $out" | cut -c1-600; failures=$((failures + 1))
   fi
 }
-launcher=("$@")
 check() { refused "$1" "$2" "$efdem" --check "$scene" "${@:3}"; }
 
 check run.duration "0 or a multiple of 0.25" run.duration=1e-300

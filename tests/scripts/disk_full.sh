@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# A disk that fills during each kind of output ends the run cleanly (docs/reliability.md, "Full
+# disks"): exit 3 with "no space left" in the message, no rank hangs (`timeout` is the hang
+# detector), the run file stays readable and says end_status "failed: ... no space left ...",
+# no partial VTK frame is left under a frame's name, every VTK frame and complete checkpoint
+# left behind is readable. The file systems are small tmpfs mounts (needs root and mount; skipped
+# with a message, exit 77, where it cannot mount).
+#   disk_full.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+source "$(dirname "$0")/lib.sh" "$@"
+mounted=()
+cleanup() { for m in "${mounted[@]}"; do umount "$m" 2>/dev/null; done; rm -rf "$work"; }
+trap cleanup EXIT
+mount_small() {  # mount_small DIR SIZE
+  mkdir -p "$1"
+  mount -t tmpfs -o size="$2" tmpfs "$1" 2>/dev/null || return 1
+  mounted+=("$1")
+}
+mount_small "$work/probe" 64k || { echo "SKIP: cannot mount a tmpfs here (not root, or no mount permission)"; exit 77; }
+failures=0
+
+# kind, size of the output file system, size of a separate checkpoint file system (- : none), overrides
+for spec in "vtk 1500k - output.vtk_interval=0.25" \
+            "thermo 1150k - output.thermo_interval=0.25" \
+            "run-file 1100k - observe.interval=0.25" \
+            "checkpoint 4000k 1600k checkpoint.interval=2 checkpoint.keep=1"; do
+  read -r kind size cksize extra <<< "$spec"
+  read -r -a overrides <<< "$extra"
+  out="$work/$kind"; mount_small "$out" "$size" || { echo "FAIL: mount"; exit 1; }
+  ck=()
+  if [ "$cksize" != "-" ]; then mount_small "$work/$kind-ck" "$cksize"; ck=(checkpoint.directory="$work/$kind-ck"); fi
+  timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=1000 \
+    output.directory="$out" "${ck[@]}" "${overrides[@]}" > "$work/$kind.log" 2>&1
+  code=$?
+  msg=$(grep -i "error:.*no space left" "$work/$kind.log" | head -1 | cut -c1-220)
+  if [ $code -ne 3 ] || [ -z "$msg" ]; then
+    grep -v "^t = " "$work/$kind.log" | head -20; echo "FAIL: $kind: exit $code"; failures=$((failures + 1)); continue
+  fi
+  if /usr/bin/python3 - "$out" "$work/$kind-ck" <<'PY'
+import glob, os, sys, xml.etree.ElementTree as ET, h5py
+out, ck = sys.argv[1], sys.argv[2]
+status = h5py.File(os.path.join(out, "efdem.h5"), "r").attrs["end_status"]
+status = status.decode() if isinstance(status, bytes) else str(status)
+assert status.startswith("failed:") and "no space left" in status.lower(), status
+assert not glob.glob(os.path.join(out, "*.vtp.tmp")), "a partial VTK frame was left"
+for f in glob.glob(os.path.join(out, "*.vtp")) + glob.glob(os.path.join(out, "*.pvd")):
+    ET.parse(f)  # every frame and series file left is whole
+for f in glob.glob(os.path.join(ck, "*_ckpt_????????.h5")):
+    with h5py.File(f, "r") as c:
+        assert c.attrs["complete"] == 1, f
+print(f"  run file: {status[:110]}...; {len(glob.glob(os.path.join(out, '*.vtp')))} VTK frames, "
+      f"{len(glob.glob(os.path.join(ck, '*_ckpt_????????.h5')))} complete checkpoints, all readable")
+PY
+  then echo "PASS: $kind: exit 3: $msg"
+  else echo "FAIL: $kind: files left behind"; failures=$((failures + 1)); fi
+done
+[ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
+echo "PASS: full disks end the run cleanly"
