@@ -199,13 +199,18 @@ void EnsembleStepper::mark_resume_point(const DriverState& driver) {
     flush_since_mark();
 }
 
-void EnsembleStepper::do_mark() {
-    resume_states_.clear();
+std::vector<RealizationState> EnsembleStepper::saved_realizations(const char* when) const {
+    std::vector<RealizationState> states;
     try {
-        for (const auto& r : local_) resume_states_.push_back(r->save_state());
+        for (const auto& r : local_) states.push_back(r->save_state());
     } catch (const std::exception& e) {
-        fail(std::string("keeping the state between coarse steps: ") + e.what(), local_.front()->index());
+        fail(std::string("keeping the state ") + when + ": " + e.what(), local_.front()->index());
     }
+    return states;
+}
+
+void EnsembleStepper::do_mark() {
+    resume_states_ = saved_realizations("between coarse steps");
     resume_time_ = time();
     resume_stepper_ = saved_state();
     has_resume_point_ = true;
@@ -237,12 +242,7 @@ void EnsembleStepper::confirm_kept_state() {
 }
 
 void EnsembleStepper::do_keep() {
-    kept_.clear();
-    try {
-        for (const auto& r : local_) kept_.push_back(r->save_state());
-    } catch (const std::exception& e) {
-        fail(std::string("keeping the state before a projective jump: ") + e.what(), local_.front()->index());
-    }
+    kept_ = saved_realizations("before a projective jump");
     kept_stepper_ = saved_state();
     kept_sample_ = last_sample_;
     pending_.clear();

@@ -203,6 +203,8 @@ private:
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header, bool at_resume_point);
     [[noreturn]] void fail(const std::string& message, long realization) const;
     void do_keep();
+    /// This rank's realizations' states; a failure (`when`: for the message) ends the job.
+    std::vector<RealizationState> saved_realizations(const char* when) const;
     void do_go_back();
     void do_confirm();
 

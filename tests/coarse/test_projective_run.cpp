@@ -212,57 +212,63 @@ TEST_CASE("StabilityPolicy::stop ends the run at the first flagged step", "[unit
     CHECK(toy.lifts == 0);
 }
 
-TEST_CASE("a resumed run equals the uninterrupted one bit for bit", "[unit][coarse][run]") {
+namespace {
+/// A whole run of the slow toy (warm-up 2, 100 time units), and a second run resumed from the
+/// copy of the stepper and loop state kept at the first between_steps with `at` coarse steps
+/// done. Returns {whole, resumed} outcomes; the checks compare the two ends.
+struct ResumedPair {
+    ProjectiveRunOutcome whole, rest;
+    std::optional<ProjectiveRunState> kept;
+    test::LinearToyStepper end_whole, end_rest;
+    int warmups_resumed = 0;
+    bool warmed_up_at_end = false;
+};
+ResumedPair run_and_resume(long at) {
     auto toy = slow_toy();
     ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
     Recorder<test::LinearToyStepper> seen;
     seen.stepper = &toy;
-    seen.at = 4;
+    seen.at = at;
     run.add_observer(seen);
-    const ProjectiveRunOutcome whole = run.run(100.0);
+    ResumedPair out{run.run(100.0), {}, {}, toy, toy, 0, false};
     REQUIRE(seen.snapshot);
-    CHECK(seen.snapshot_state->coarse_steps == 4);
-    CHECK(seen.snapshot_state->t_origin == 0.0);
-
+    out.kept = seen.snapshot_state;
+    out.warmed_up_at_end = run.state().warmed_up;
     test::LinearToyStepper copy = *seen.snapshot;
     ProjectiveRun resumed(fixed_settings(2.0), copy, variable("x"));
     Recorder<test::LinearToyStepper> seen2;
     seen2.stepper = &copy;
-    seen2.first = 4;
+    seen2.first = at;
     resumed.add_observer(seen2);
-    const ProjectiveRunOutcome rest = resumed.run(100.0, seen.snapshot_state);
-    CHECK(seen2.warmups == 0);  // no second warm-up
-    CHECK(rest.coarse_steps == whole.coarse_steps);
-    CHECK(rest.end_status == whole.end_status);
-    CHECK(copy.time() == toy.time());
-    CHECK(copy.state() == toy.state());
+    out.rest = resumed.run(100.0, seen.snapshot_state);
+    out.end_whole = toy;
+    out.end_rest = copy;
+    out.warmups_resumed = seen2.warmups;
+    return out;
+}
+}  // namespace
+
+TEST_CASE("a resumed run equals the uninterrupted one bit for bit", "[unit][coarse][run]") {
+    const ResumedPair r = run_and_resume(4);
+    CHECK(r.kept->coarse_steps == 4);
+    CHECK(r.kept->t_origin == 0.0);
+    CHECK(r.warmups_resumed == 0);  // no second warm-up
+    CHECK(r.rest.coarse_steps == r.whole.coarse_steps);
+    CHECK(r.rest.end_status == r.whole.end_status);
+    CHECK(r.end_rest.time() == r.end_whole.time());
+    CHECK(r.end_rest.state() == r.end_whole.state());
 }
 
 TEST_CASE("a run resumed from before its warm-up does the warm-up and equals the uninterrupted one",
           "[unit][coarse][run]") {
     // The state kept before the warm-up is where a run stopped during its warm-up goes back to.
-    auto toy = slow_toy();
-    ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
-    Recorder<test::LinearToyStepper> seen;
-    seen.stepper = &toy;
-    seen.at = 0;
-    run.add_observer(seen);
-    const ProjectiveRunOutcome whole = run.run(100.0);
-    REQUIRE(seen.snapshot);
-    CHECK_FALSE(seen.snapshot_state->warmed_up);
-    CHECK(seen.snapshot->time() == 0.0);
-    CHECK(run.state().warmed_up);
-
-    test::LinearToyStepper copy = *seen.snapshot;
-    ProjectiveRun resumed(fixed_settings(2.0), copy, variable("x"));
-    Recorder<test::LinearToyStepper> seen2;
-    seen2.stepper = &copy;
-    resumed.add_observer(seen2);
-    const ProjectiveRunOutcome rest = resumed.run(100.0, seen.snapshot_state);
-    CHECK(seen2.warmups == 1);
-    CHECK(rest.coarse_steps == whole.coarse_steps);
-    CHECK(copy.time() == toy.time());
-    CHECK(copy.state() == toy.state());
+    const ResumedPair r = run_and_resume(0);
+    CHECK_FALSE(r.kept->warmed_up);
+    CHECK(r.warmed_up_at_end);
+    CHECK(r.warmups_resumed == 1);
+    CHECK(r.rest.coarse_steps == r.whole.coarse_steps);
+    CHECK(r.end_rest.time() == r.end_whole.time());
+    CHECK(r.end_rest.state() == r.end_whole.state());
 }
 
 TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings", "[unit][coarse][run]") {
