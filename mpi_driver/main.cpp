@@ -84,7 +84,8 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         }
         RealizationOutput out{s.output.directory, s.output.prefix,
                               std::lround(s.output.vtk_interval / s.observe.interval),
-                              std::lround(s.output.thermo_interval / s.observe.interval)};
+                              std::lround(s.output.thermo_interval / s.observe.interval),
+                              resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
         for (auto& sys : systems)
             local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species, s.observe.other, out,
                                                              resume));

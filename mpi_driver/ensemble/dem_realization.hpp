@@ -20,6 +20,10 @@ struct RealizationOutput {
     std::string prefix;
     long vtk_every = 0;
     long thermo_every = 0;
+    /// Inserted after PREFIX_rNNNN in the per-realization file names: "" for a new run,
+    /// "_contNNNNNNNN" (samples done at the checkpoint) for a restarted one, so that the
+    /// continuation never writes over the files of the run it continues.
+    std::string continuation;
 };
 
 class DemRealization final : public Realization {

@@ -64,6 +64,21 @@ code=$?
   && echo "PASS: --check says a run file given as restart= is a run file" || { cat "$work/runfile.log"; fail "run file: exit $code"; }
 [ ! -e "$work/new" ] || fail "--check created the output directory"
 
+# A restart writes its VTK frames and thermo logs beside the continued run's, not over them.
+efd "$efdem" "$scene" mode=direct run.duration=2 output.vtk_interval=0.5 output.thermo_interval=0.5 \
+  checkpoint.interval=4 checkpoint.keep=10 output.directory="$work/cont" > "$work/cont.log" 2>&1 \
+  || { cat "$work/cont.log"; fail "the run to continue failed"; }
+kept=$(cd "$work/cont" && sha256sum efdem_r0000* | sort)
+efd "$efdem" "$scene" mode=direct run.duration=2 output.vtk_interval=0.5 output.thermo_interval=0.5 \
+  output.directory="$work/cont" restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/cont2.log" 2>&1
+code=$?
+if [ $code -eq 0 ] && [ "$(cd "$work/cont" && sha256sum efdem_r0000* | grep -v _cont | sort)" = "$kept" ] \
+   && [ -f "$work/cont/efdem_r0000_cont00000004_000000.vtp" ] && [ -f "$work/cont/efdem_r0000_cont00000004_thermo.log" ]; then
+  echo "PASS: a restart's VTK frames and thermo log are new files (_cont00000004); the continued run's are unchanged"
+else
+  grep -v "^t = " "$work/cont2.log"; ls "$work/cont"; fail "restart output files (exit $code)"
+fi
+
 # 4. end_status marks.
 [ "$(status_of "$out/efdem.h5")" = "completed" ] && echo "PASS: end_status completed" || fail "end_status of a completed run"
 setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/killed" > "$work/killed.log" 2>&1 &
