@@ -82,3 +82,27 @@ TEST_CASE("the thermo log writes a header and one line per call", "[unit][io]") 
     CHECK(last_step == 100);
     CHECK_THROWS_AS(ThermoLog("/nonexistent_dir/x.log"), RuntimeFailure);
 }
+
+TEST_CASE("a full disk under the thermo log is a runtime failure that says no space left", "[unit][output]") {
+    // /dev/full accepts the open and fails every write with ENOSPC: what a full disk does to a
+    // log that is flushed after every line.
+    if (!std::filesystem::exists("/dev/full")) SKIP("no /dev/full on this system");
+    try {
+        ThermoLog log("/dev/full");
+        FAIL("expected a RuntimeFailure");
+    } catch (const RuntimeFailure& e) {
+        CHECK_THAT(std::string(e.what()), Catch::Contains("cannot write the thermo log /dev/full") &&
+                                              Catch::Contains("no space left: the disk or the quota is full"));
+    }
+}
+
+TEST_CASE("a VTK frame that cannot be written leaves neither the frame nor its .tmp", "[unit][output]") {
+    // The frame is written to NAME.tmp and renamed: writing into a directory that does not exist
+    // fails before anything is left under NAME.
+    const auto dir = std::filesystem::temp_directory_path() / "efdem_vtk_missing_dir_test";
+    std::filesystem::remove_all(dir);
+    const System sys = three_particles();
+    CHECK_THROWS_AS(write_vtp(dir / "frame.vtp", sys.particles()), RuntimeFailure);
+    CHECK_FALSE(std::filesystem::exists(dir / "frame.vtp"));
+    CHECK_FALSE(std::filesystem::exists(dir / "frame.vtp.tmp"));
+}
