@@ -86,7 +86,10 @@ TEST_CASE("the thermo log writes a header and one line per call", "[unit][io]") 
 TEST_CASE("a full disk under the thermo log is a runtime failure that says no space left", "[unit][output]") {
     // /dev/full accepts the open and fails every write with ENOSPC: what a full disk does to a
     // log that is flushed after every line.
-    if (!std::filesystem::exists("/dev/full")) SKIP("no /dev/full on this system");
+    if (!std::filesystem::exists("/dev/full")) {
+        WARN("no /dev/full on this system: not tested");
+        return;
+    }
     try {
         ThermoLog log("/dev/full");
         FAIL("expected a RuntimeFailure");
