@@ -29,7 +29,8 @@ EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, std::vector<std::
 }
 
 double EnsembleStepper::time() const {
-    // A dropped realization is not advanced: the clock is that of one in the ensemble.
+    // The clock of one in the ensemble where there is one (a dropped realization's clock is
+    // moved on with the ensemble's, but by sums of its own).
     for (const auto& r : local_)
         if (is_active(*r)) return r->time();
     return local_.front()->time();
@@ -358,7 +359,10 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
     std::vector<Failure> failures;
     for (long s = 0; s < samples; ++s) {
         for (auto& r : local_) {
-            if (!is_active(*r)) continue;  // dropped after a failure: not advanced
+            if (!is_active(*r)) {  // dropped after a failure: not advanced, but its clock keeps time
+                r->set_time(r->time() + static_cast<double>(settings_.steps_per_sample) * r->dt());
+                continue;
+            }
             try {
                 r->advance(settings_.steps_per_sample);
                 if (!injected_fired_ && r->index() == inject.realization && r->time() >= inject.time) {
@@ -528,9 +532,14 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
     const auto my_reals = layout_.scatter_arrays(lifted_reals, out_reals);
     const auto my_bytes = layout_.scatter_arrays(lifted_bytes, out_bytes);
     for (std::size_t j = 0; j < local_.size(); ++j) {
-        if (!lifted_here(local_[j]->index())) continue;
-        local_[j]->apply_lift({my_reals[j], my_bytes[j]});
-        local_[j]->set_time(new_time);
+        if (lifted_here(local_[j]->index())) {
+            local_[j]->apply_lift({my_reals[j], my_bytes[j]});
+            local_[j]->set_time(new_time);
+        } else if (!only) {
+            // A dropped realization's clock follows the jump too: a rank whose realizations were
+            // all dropped still knows the ensemble's time.
+            local_[j]->set_time(new_time);
+        }
     }
     overhead_.lift_seconds += MPI_Wtime() - start;
     ++overhead_.lifts;

@@ -79,4 +79,12 @@ status=$(/usr/bin/python3 -c "import h5py; print(h5py.File('$work/limit.h5', 'r'
 [ $code -eq 3 ] && [[ $status == *"more than ensemble.max_failures = 0"* ]] \
   && echo "PASS: a failure beyond ensemble.max_failures ends the run (exit 3): $status" \
   || { grep -v "^t = " "$work/limit.log"; echo "FAIL: max_failures (exit $code): $status"; exit 1; }
+# A rank whose realizations were all dropped keeps the ensemble's time (its clock was frozen:
+# the run stopped with "sample times are not strictly increasing").
+timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=cpi run.duration=8 output.directory="$work" \
+  output.prefix=rootdrop ensemble.on_failure=drop debug.fail_realization=0 debug.fail_time=2 > "$work/rootdrop.log" 2>&1
+code=$?
+grep -q "^completed with 1 failure(s): simulated 8 time units" "$work/rootdrop.log" && [ $code -eq 0 ] \
+  && echo "PASS: cpi with the root's only realization dropped completes" \
+  || { grep -v "^t = " "$work/rootdrop.log"; echo "FAIL: root's realization dropped (exit $code)"; exit 1; }
 echo "PASS: failing realizations"
