@@ -57,11 +57,17 @@ std::string EnsembleStepper::where_saved() const {
                        last_checkpoint_.string(), last_checkpoint_time_);
 }
 
+namespace {
+/// "realization R: MESSAGE", unless the message names it already.
+std::string naming(long realization, const std::string& message) {
+    const std::string who = fmt::format("realization {}: ", realization);
+    return message.rfind(who, 0) == 0 ? message : who + message;
+}
+}  // namespace
+
 void EnsembleStepper::fail(const std::string& message, long realization) const {
     // Used where the ranks cannot agree first (keeping or restoring states, checkpoints).
-    const std::string who = fmt::format("realization {}: ", realization);
-    layout_.mpi().abort(fmt::format("{}{}; {}", message.rfind(who, 0) == 0 ? "" : who, message, where_saved()),
-                        kExitRuntimeFailure);
+    layout_.mpi().abort(fmt::format("{}; {}", naming(realization, message), where_saved()), kExitRuntimeFailure);
 }
 
 int EnsembleStepper::agree(const std::vector<Failure>& failures, bool with_signal) {
@@ -94,16 +100,16 @@ void EnsembleStepper::on_failures(const std::vector<Failure>& failures) {
     const long total = failures_ + static_cast<long>(failed.size());
     const int healthy = active_realizations() - static_cast<int>(failed.size());
     const bool drop = policy.action == FailurePolicy::Action::drop;
+    // Why the run cannot survive these failures (empty: it can; abort needs no reason).
     std::string fatal;
-    if (policy.action == FailurePolicy::Action::abort) fatal = "-";
-    else if (total > policy.max_failures)
+    if (total > policy.max_failures)
         fatal = fmt::format("{} realization failures, more than ensemble.max_failures = {}", total, policy.max_failures);
     else if ((drop ? healthy : healthy + static_cast<int>(failed.size())) < policy.min_active || healthy < 1)
         fatal = fmt::format("only {} healthy realization(s) would remain; the run needs {}", healthy, policy.min_active);
+    if (policy.action == FailurePolicy::Action::abort) fail_agreed(failures);
     if (!fatal.empty()) {
         std::vector<Failure> told = failures;
-        if (fatal != "-")
-            for (Failure& f : told) f.message += "; the run ends: " + fatal;
+        for (Failure& f : told) f.message += "; the run ends: " + fatal;
         fail_agreed(told);
     }
     for (const Failure& f : failures)
@@ -134,9 +140,7 @@ void EnsembleStepper::fail_agreed(const std::vector<Failure>& failures) {
     // The failing rank says what failed (with its rank in the prefix); the root gets the
     // messages so that the run file can say it too.
     for (const Failure& f : failures) {
-        const std::string who = fmt::format("realization {}: ", f.realization);
-        const std::string text =
-            fmt::format("{}{}; {}", f.message.rfind(who, 0) == 0 ? "" : who, f.message, where_saved());
+        const std::string text = fmt::format("{}; {}", naming(f.realization, f.message), where_saved());
         std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", layout_.mpi().rank(), layout_.mpi().size(),
                      text.c_str());
     }
