@@ -14,6 +14,8 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/version.hpp"
+#include "dem/beds/bed_diagnostics.hpp"
+#include "dem/beds/bed_observation.hpp"
 #include "dem/effect_registry.hpp"
 #include "dem/realization_builder.hpp"
 #include "mpi_driver/run/check_report.hpp"
@@ -43,6 +45,21 @@ using namespace efdem;
 using namespace efdem::mpi_driver;
 
 namespace {
+/// observe.bed: how every realization measures the bed (the same on every rank: the profile's
+/// default top depends only on the particle count and sizes, which every realization shares).
+std::optional<dem::BedObservationSettings> bed_settings(const RunSettings& s, const dem::System& any) {
+    if (!s.observe.bed) return std::nullopt;
+    dem::BedObservationSettings b;
+    b.profile_dz = s.observe.profile_dz;
+    b.profile_slabs = s.observe.profile_height > 0
+                          ? static_cast<std::size_t>(std::ceil(s.observe.profile_height / b.profile_dz - 1e-9))
+                          : dem::default_profile_slabs(any, b.profile_dz);
+    b.mixing_layer = s.observe.mixing_layer;
+    b.mixing_species = s.observe.species;
+    b.species = any.species().size();
+    return b;
+}
+
 RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
                          const dem::System& any) {
     RunProvenance p;
@@ -57,6 +74,13 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
     p.seed = s.seed;
     p.p_grid = coarse::ProbabilityGrid(s.observe.quantiles).values();
     p.observed_species = any.species()[s.observe.species].name;
+    if (const auto bed = bed_settings(s, any)) {
+        for (std::size_t k = 0; k < bed->species; ++k) p.species_names.push_back(any.species()[static_cast<dem::SpeciesId>(k)].name);
+        p.profile_dz = bed->profile_dz;
+        p.profile_slabs = static_cast<long>(bed->profile_slabs);
+        p.mixing_layer = bed->mixing_layer;
+        p.weight_per_area = dem::weight_per_area(any);
+    }
     return p;
 }
 
@@ -66,6 +90,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         std::vector<dem::System> systems, const RestartData* restart) {
     const RunProvenance prov = provenance(mpi, table, s, systems.front());
     const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
+    const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
     RunObservables observables = RunObservables::from_settings(s);
 
     std::unique_ptr<RecorderList> recorders;
@@ -88,7 +113,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
                               resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
         for (auto& sys : systems)
             local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species, s.observe.other, out,
-                                                             resume));
+                                                             resume, bed));
     } catch (const std::exception& e) {
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
@@ -127,6 +152,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.failure = s.injected_failure;
     ss.on_failure = s.on_failure;
     ss.recorded = observables.recorded.get();
+    ss.bed = bed;
     // The run's start (progress counts from there; on the non-root ranks it is not used).
     const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);

@@ -1,9 +1,11 @@
 #include "dem/beds/bed_diagnostics.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "core/contracts.hpp"
+#include "dem/effects/gravity.hpp"
 #include "dem/gas/gas_drag.hpp"
 #include "dem/gas/slab_fields.hpp"
 
@@ -20,6 +22,11 @@ double weight_per_area(const Particles& p, const Domain& domain, double g) {
     double m = 0;
     for (double mi : p.mass()) m += mi;
     return m * g / domain.area();
+}
+
+double weight_per_area(const System& system) {
+    const auto* gravity = dynamic_cast<const Gravity*>(system.find_effect("gravity"));
+    return weight_per_area(system.particles(), system.domain(), gravity ? gravity->g() : 1.0);
 }
 
 double bed_height(const Particles& p, double fraction) {
@@ -65,6 +72,48 @@ std::vector<double> solid_fraction_profile(const Particles& p, const Domain& dom
     SlabFields slabs(dz, d_max > 0 ? d_max : 1.0);
     slabs.update(p, domain);
     return {slabs.phi().begin(), slabs.phi().end()};
+}
+
+std::vector<double> solid_fraction_profile(const Particles& p, const Domain& domain, double dz,
+                                           std::size_t slabs) {
+    EFDEM_EXPECTS(slabs > 0);
+    std::vector<double> phi = solid_fraction_profile(p, domain, dz);
+    phi.resize(slabs, 0.0);
+    return phi;
+}
+
+double lacey_mixing_index(const Particles& p, SpeciesId species, double layer) {
+    EFDEM_EXPECTS(layer > 0);
+    const auto x = p.x();
+    const auto sp = p.species();
+    std::vector<double> n, of_species;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(x[i].z / layer)));
+        if (k >= n.size()) {
+            n.resize(k + 1, 0.0);
+            of_species.resize(k + 1, 0.0);
+        }
+        n[k] += 1;
+        if (sp[i] == species) of_species[k] += 1;
+    }
+    const double total = static_cast<double>(x.size());
+    double in_species = 0, occupied = 0;
+    for (std::size_t k = 0; k < n.size(); ++k) {
+        in_species += of_species[k];
+        if (n[k] > 0) occupied += 1;
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (total == 0 || in_species == 0 || in_species == total || occupied < 2) return nan;
+    const double P = in_species / total;
+    double s2 = 0;
+    for (std::size_t k = 0; k < n.size(); ++k)
+        if (n[k] > 0) {
+            const double c = of_species[k] / n[k];
+            s2 += n[k] * (c - P) * (c - P);
+        }
+    s2 /= total;
+    const double s0 = P * (1 - P), sr = s0 / (total / occupied);
+    return (s0 - s2) / (s0 - sr);
 }
 
 }  // namespace efdem::dem

@@ -27,6 +27,8 @@ double pressure_drop(const System& system);
 /// Bed weight per unit area, sum_i m_i g / (lx ly) [rho_s g d_p]: the plateau of Delta P(U_s)
 /// once the bed is fluidized (43.633 for the paper's bed). `g` in units of g.
 double weight_per_area(const Particles& p, const Domain& domain, double g = 1.0);
+/// The same with the g of the system's gravity effect (1 without one).
+double weight_per_area(const System& system);
 
 /**
  * \brief Bed height: the height below which `fraction` of the particle volume lies (exact
@@ -49,5 +51,26 @@ double center_of_mass_height(const Particles& p, int species = -1);
  * Allocates: a diagnostic, not for every step (the gas effect reads System::slab_fields()).
  */
 std::vector<double> solid_fraction_profile(const Particles& p, const Domain& domain, double dz);
+
+/// The same profile on exactly `slabs` slabs [0, slabs dz): a fixed layout for a time series.
+/// Volume above slabs dz is left out; slabs above the highest particle read 0. \pre slabs > 0.
+std::vector<double> solid_fraction_profile(const Particles& p, const Domain& domain, double dz,
+                                           std::size_t slabs);
+
+/**
+ * \brief Lacey mixing index of `species` over horizontal layers of thickness `layer` from the
+ *        floor (a particle belongs to the layer of its centre) [-].
+ *
+ *   M = (s0^2 - s^2) / (s0^2 - sr^2),  s^2 = sum_k n_k (c_k - P)^2 / N,
+ *   s0^2 = P (1 - P),  sr^2 = P (1 - P) / n_mean,
+ *
+ * with n_k the particles in layer k, c_k the fraction of them of `species`, P that fraction in
+ * the whole bed and n_mean = N / (occupied layers). M = 0 for a bed whose layers each hold one
+ * species (complete segregation), about 1 for a random mixture (s^2 is then the binomial
+ * variance sr^2). Layers, not a 3D grid: the model is homogeneous across the periodic
+ * cross-section (the gas is 1D), so segregation is vertical only. NaN when it is undefined
+ * (no particle of `species` or only such particles, or a single occupied layer). \pre layer > 0.
+ */
+double lacey_mixing_index(const Particles& p, SpeciesId species, double layer);
 
 }  // namespace efdem::dem

@@ -14,8 +14,9 @@
 namespace efdem::mpi_driver {
 
 DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
-                               const RealizationOutput& output, bool restarting)
-    : system_(std::move(system)), observed_(observed), other_(other), output_(output) {
+                               const RealizationOutput& output, bool restarting,
+                               std::optional<dem::BedObservationSettings> bed)
+    : system_(std::move(system)), observed_(observed), other_(other), output_(output), bed_(bed) {
     const std::string stem = fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
     if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
     if (output_.thermo_every > 0) thermo_ = std::make_unique<dem::ThermoLog>(output_.directory / (stem + "_thermo.log"));
@@ -36,6 +37,7 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid, bool to
         o.mean_height += x.z;
     }
     if (!p.x().empty()) o.mean_height /= static_cast<double>(p.x().size());
+    if (bed_) o.bed = dem::observe_bed(system_, *bed_).pack();
     return o;
 }
 

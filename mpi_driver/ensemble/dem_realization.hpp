@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "dem/beds/bed_observation.hpp"
 #include "dem/io/thermo_log.hpp"
 #include "dem/io/vtk_writer.hpp"
 #include "dem/system.hpp"
@@ -31,8 +32,10 @@ public:
     /// `observed`: the species whose heights make the ICDF (colour 1); `other`: colour 0.
     /// `restarting`: the state will be restored from a checkpoint, so the per-realization
     /// outputs do not record the (discarded) initial state.
+    /// `bed`: also measure the bed quantities at every sample (Observation::bed).
     DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
-                   const RealizationOutput& output, bool restarting = false);
+                   const RealizationOutput& output, bool restarting = false,
+                   std::optional<dem::BedObservationSettings> bed = std::nullopt);
 
     long index() const override { return system_.realization(); }
     double time() const override { return system_.time(); }
@@ -56,6 +59,7 @@ private:
     dem::System system_;
     dem::SpeciesId observed_, other_;
     RealizationOutput output_;
+    std::optional<dem::BedObservationSettings> bed_;
     std::optional<dem::VtkSeriesWriter> vtk_;
     std::unique_ptr<dem::ThermoLog> thermo_;
 };

@@ -413,26 +413,59 @@ Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Ind
 }
 }  // namespace
 
+namespace {
+/// Rows of packed dem::BedObservation, as the recorders see them.
+BedRecord bed_record(const Eigen::MatrixXd& packed, const dem::BedObservationSettings& settings) {
+    const Eigen::Index n = packed.rows();
+    BedRecord b;
+    b.pressure_drop.resize(n);
+    b.pressure_drop_ratio.resize(n);
+    b.height.resize(n);
+    b.mixing_index.resize(n);
+    b.species_height.resize(n, static_cast<Eigen::Index>(settings.species));
+    b.solid_fraction.resize(n, static_cast<Eigen::Index>(settings.profile_slabs));
+    for (Eigen::Index r = 0; r < n; ++r) {
+        const Eigen::VectorXd row = packed.row(r).transpose();
+        const dem::BedObservation o =
+            dem::BedObservation::unpack({row.data(), static_cast<std::size_t>(row.size())}, settings);
+        b.pressure_drop[r] = o.pressure_drop;
+        b.pressure_drop_ratio[r] = o.pressure_drop_ratio;
+        b.height[r] = o.height;
+        b.mixing_index[r] = o.mixing_index;
+        b.species_height.row(r) = Eigen::Map<const Eigen::RowVectorXd>(o.species_height.data(), b.species_height.cols());
+        b.solid_fraction.row(r) = Eigen::Map<const Eigen::RowVectorXd>(o.solid_fraction.data(), b.solid_fraction.cols());
+    }
+    return b;
+}
+}  // namespace
+
 void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     const double start = MPI_Wtime();
     const auto m = static_cast<Eigen::Index>(grid_.values().size());
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    std::vector<Eigen::VectorXd> icdf, top_icdf, scalars;
+    const auto bed_width = settings_.bed ? static_cast<Eigen::Index>(dem::BedObservation::packed_size(*settings_.bed)) : 0;
+    std::vector<Eigen::VectorXd> icdf, top_icdf, scalars, bed;
     for (const auto& r : local_) {
         if (!is_active(*r)) {  // dropped: a row of NaN in the record, not in the means
             icdf.push_back(Eigen::VectorXd::Constant(m, nan));
             if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
             scalars.push_back(Eigen::Vector4d::Constant(nan));
+            if (bed_width > 0) bed.push_back(Eigen::VectorXd::Constant(bed_width, nan));
             continue;
         }
         Observation o = r->observe(grid_, top);
         icdf.push_back(std::move(o.icdf));
         if (top) top_icdf.push_back(std::move(o.top));
         scalars.push_back(Eigen::Vector4d(o.com, o.z_min, o.z_max, o.mean_height));
+        if (bed_width > 0) {
+            EFDEM_ASSERT(static_cast<Eigen::Index>(o.bed.size()) == bed_width);
+            bed.push_back(Eigen::Map<const Eigen::VectorXd>(o.bed.data(), bed_width));
+        }
     }
     const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
     const Eigen::MatrixXd all_top_rows = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
     const Eigen::MatrixXd all_scalar_rows = layout_.gather_rows(scalars);
+    const Eigen::MatrixXd all_bed_rows = bed_width > 0 ? layout_.gather_rows(bed) : Eigen::MatrixXd();
     if (!layout_.is_root()) {
         overhead_.restrict_seconds += MPI_Wtime() - start;
         ++overhead_.samples;
@@ -452,6 +485,10 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     rec.mean = coarse::ensemble_mean(used_icdf);
     rec.variance = coarse::ensemble_variance(used_icdf, rec.mean);
     rec.com = all_scalar_rows.col(0);
+    if (settings_.bed) {
+        rec.bed = bed_record(all_bed_rows, *settings_.bed);
+        rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(), *settings_.bed);
+    }
     rec.top_mean = top ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
     const Eigen::VectorXd x = observable_->restrict_ensemble(used_icdf, all_top);

@@ -31,6 +31,7 @@
 /// redoes the step exactly as the uninterrupted run did it.
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -45,6 +46,7 @@
 #include "mpi_driver/ensemble/failure_policy.hpp"
 #include "mpi_driver/ensemble/injected_failure.hpp"
 #include "mpi_driver/output/progress.hpp"
+#include "dem/beds/bed_observation.hpp"
 #include "mpi_driver/ensemble/realization.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
 
@@ -60,6 +62,8 @@ struct StepperSettings {
     /// Root: an observable evaluated at every sample only to be recorded (e.g. the compact
     /// (A,B,C,D) of a direct run, for comparison with a compact CPI run); null for none.
     coarse::EnsembleObservable* recorded = nullptr;
+    /// observe.bed: how the realizations measure the bed (their Observation::bed); none: not gathered.
+    std::optional<dem::BedObservationSettings> bed;
 };
 
 class EnsembleStepper final : public coarse::CoarseStepper {

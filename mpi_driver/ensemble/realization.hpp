@@ -31,6 +31,8 @@ struct Observation {
     double mean_height = 0;
     double z_min = 0;      ///< lowest particle centre
     double z_max = 0;      ///< highest particle centre
+    /// The packed dem::BedObservation (observe.bed = true; empty otherwise).
+    std::vector<double> bed;
 };
 
 /// Data moved for a lift: reals and bytes (either may be empty).

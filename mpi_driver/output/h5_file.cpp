@@ -1,6 +1,7 @@
 #include "mpi_driver/output/h5_file.hpp"
 
 #include <algorithm>
+#include <hdf5_hl.h>
 
 #include <fmt/format.h>
 
@@ -210,6 +211,37 @@ void H5File::write(const std::string& name, std::span<const std::int64_t> data, 
 
 void H5File::write_bytes(const std::string& name, std::span<const std::uint8_t> data) {
     write_fixed(*this, name, H5T_NATIVE_UINT8, data.data(), {static_cast<hsize_t>(data.size())});
+}
+
+void H5File::write_texts(const std::string& name, const std::vector<std::string>& texts) {
+    std::vector<const char*> p;
+    for (const auto& t : texts) p.push_back(t.c_str());
+    const hid_t t = string_type();
+    write_fixed(*this, name, t, p.data(), {static_cast<hsize_t>(p.size())});
+    H5Tclose(t);
+}
+
+void H5File::document(const std::string& name, const std::string& units, const std::string& description,
+                      const std::vector<std::string>& labels, const std::vector<std::string>& scales) {
+    attribute(name, "units", units);
+    attribute(name, "description", description);
+    if (labels.empty()) return;
+    const hid_t d = check_id(H5Dopen2(file_, name.c_str(), H5P_DEFAULT), "open " + name);
+    herr_t status = 0;
+    for (std::size_t i = 0; i < labels.size() && status >= 0; ++i) {
+        const auto dim = static_cast<unsigned>(i);
+        status = H5DSset_label(d, dim, labels[i].c_str());
+        if (status < 0 || i >= scales.size() || scales[i].empty()) continue;
+        if (scales[i] == name) {
+            status = H5DSset_scale(d, labels[i].c_str());
+        } else if (exists(scales[i])) {
+            const hid_t scale = H5Dopen2(file_, scales[i].c_str(), H5P_DEFAULT);
+            status = scale < 0 ? -1 : H5DSis_scale(scale) > 0 ? H5DSattach_scale(d, scale, dim) : 0;
+            if (scale >= 0) H5Dclose(scale);
+        }
+    }
+    H5Dclose(d);
+    check(status, "dimension scales of " + name);
 }
 
 bool H5File::exists(const std::string& name) const { return H5Lexists(file_, name.c_str(), H5P_DEFAULT) > 0; }

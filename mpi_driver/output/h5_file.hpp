@@ -75,6 +75,13 @@ public:
     /// Fixed datasets of 64-bit integers and of bytes (row-major; any shape may have a zero).
     void write(const std::string& name, std::span<const std::int64_t> data, std::vector<hsize_t> shape);
     void write_bytes(const std::string& name, std::span<const std::uint8_t> data);
+    /// A 1D dataset of variable-length strings.
+    void write_texts(const std::string& name, const std::vector<std::string>& texts);
+    /// Makes `name` self-describing: attributes `units` and `description`, a label on each
+    /// dimension (HDF5 dimension scales), and the axis dataset `scales[i]` attached to dimension
+    /// i where it is non-empty and exists; `scales[i] == name` makes `name` itself that axis.
+    void document(const std::string& name, const std::string& units, const std::string& description,
+                  const std::vector<std::string>& labels, const std::vector<std::string>& scales);
     void flush();
 
     // Reading (checkpoints): RuntimeFailure naming the file and object on any failure.

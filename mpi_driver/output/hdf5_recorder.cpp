@@ -1,6 +1,8 @@
 #include "mpi_driver/output/hdf5_recorder.hpp"
 
 #include <cerrno>
+#include <cmath>
+#include <limits>
 #include <chrono>
 #include <ctime>
 #include <fcntl.h>
@@ -9,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/io_error.hpp"
+#include "mpi_driver/output/run_file_schema.hpp"
 
 #include <fmt/format.h>
 
@@ -50,7 +53,8 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
       reserve_(make_reserve(path_)),
       file_(resume ? H5File::open(path_, true) : H5File::create(path_)),
       realizations_(p.realizations),
-      m_(p.p_grid.size()), dim_(coarse_dimension) {
+      m_(p.p_grid.size()), dim_(coarse_dimension),
+      species_(p.species_names.size()), slabs_(static_cast<std::size_t>(p.profile_slabs)) {
     if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
         file_.attribute("/", "ranks", std::int64_t{p.ranks});
         file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
@@ -73,19 +77,101 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
     file_.attribute("/", "scene_file", p.scene_file);
     file_.attribute("/", "overrides", p.overrides);
     file_.write_text("/scene", p.scene_text);
+    document("/scene");
     file_.write_text("/parameters", p.parameters);
+    document("/parameters");
     file_.write("/p", as_span(p.p_grid), {static_cast<hsize_t>(m_)});
+    document("/p");
+    std::vector<std::int64_t> index(static_cast<std::size_t>(realizations_));
+    for (std::size_t k = 0; k < index.size(); ++k) index[k] = static_cast<std::int64_t>(k);
+    file_.write("/realization", index, {static_cast<hsize_t>(index.size())});
+    document("/realization");
     file_.create_group("/samples");
-    if (p.mode == "cpi") file_.create_group("/cpi");
+    if (p.mode == "cpi") {
+        file_.create_group("/cpi");
+        std::vector<std::int64_t> node(static_cast<std::size_t>(dim_));
+        for (std::size_t k = 0; k < node.size(); ++k) node[k] = static_cast<std::int64_t>(k);
+        file_.write("/cpi/coarse_node", node, {static_cast<hsize_t>(node.size())});
+        document("/cpi/coarse_node");
+    }
+    if (species_ > 0) {
+        file_.create_group("/bed");
+        file_.create_group("/bed/mean");
+        file_.attribute("/bed", "weight_per_area", p.weight_per_area);
+        file_.attribute("/bed", "profile_dz", p.profile_dz);
+        file_.attribute("/bed", "mixing_layer", p.mixing_layer);
+        file_.attribute("/bed", "mixing_species", p.observed_species);
+        std::vector<double> z(slabs_);
+        for (std::size_t j = 0; j < slabs_; ++j) z[j] = (static_cast<double>(j) + 0.5) * p.profile_dz;
+        file_.write("/bed/z", z, {static_cast<hsize_t>(slabs_)});
+        document("/bed/z");
+        file_.write_texts("/bed/species", p.species_names);
+        document("/bed/species");
+    }
     file_.flush();
+}
+
+void Hdf5Recorder::document(const std::string& name) {
+    const DatasetDoc& d = dataset_doc(name);
+    std::vector<std::string> labels, scales;
+    for (std::string_view dim : d.dims) {
+        labels.emplace_back(dim);
+        scales.emplace_back(dimension_scale(dim));
+    }
+    file_.document(name, std::string(d.units), std::string(d.description), labels, scales);
 }
 
 H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type) {
     auto it = series_.find(name);
-    if (it == series_.end())
-        it = series_.emplace(name, file_.exists(name) ? H5Series::open(file_, name, type)
-                                                      : H5Series(file_, name, std::move(row_shape), type)).first;
+    if (it == series_.end()) {
+        const bool existing = file_.exists(name);  // a restarted run appends; documented when made
+        it = series_.emplace(name, existing ? H5Series::open(file_, name, type)
+                                            : H5Series(file_, name, std::move(row_shape), type)).first;
+        if (!existing) document(name);
+    }
     return it->second;
+}
+
+void Hdf5Recorder::bed_sample(const SampleRecord& s) {
+    using T = H5Series::Type;
+    const auto r = static_cast<hsize_t>(realizations_), k = static_cast<hsize_t>(species_),
+               n = static_cast<hsize_t>(slabs_);
+    if (initial_height_.size() == 0) {
+        // Expansion is relative to the run's first sample; a restarted run reads it back.
+        initial_height_ = s.bed.height;
+        if (file_.exists("/bed/height") && file_.shape("/bed/height")[0] > 0) {
+            const auto first = file_.read_doubles("/bed/height", 0, 1);
+            initial_height_ = Eigen::Map<const Eigen::VectorXd>(first.data(), static_cast<Eigen::Index>(first.size()));
+        }
+    }
+    auto rows = [&](const std::string& group, const BedRecord& b, hsize_t members) {
+        const std::vector<hsize_t> per = members > 1 || group == "/bed" ? std::vector<hsize_t>{members} : std::vector<hsize_t>{};
+        series(group + "/pressure_drop", per, T::real).append(as_span(b.pressure_drop));
+        series(group + "/pressure_drop_ratio", per, T::real).append(as_span(b.pressure_drop_ratio));
+        series(group + "/height", per, T::real).append(as_span(b.height));
+        series(group + "/mixing_index", per, T::real).append(as_span(b.mixing_index));
+        const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> sh = b.species_height, phi = b.solid_fraction;
+        auto with = [&](hsize_t last) {
+            std::vector<hsize_t> shape = per;
+            shape.push_back(last);
+            return shape;
+        };
+        series(group + "/species_height", with(k), T::real).append(std::span<const double>(sh.data(), static_cast<std::size_t>(sh.size())));
+        series(group + "/solid_fraction", with(n), T::real).append(std::span<const double>(phi.data(), static_cast<std::size_t>(phi.size())));
+    };
+    rows("/bed", s.bed, r);
+    rows("/bed/mean", s.bed_mean, 1);
+    const Eigen::VectorXd expansion = s.bed.height.cwiseQuotient(initial_height_);
+    series("/bed/expansion", {r}, T::real).append(as_span(expansion));
+    // The mean's expansion: the mean height over the mean initial height of the realizations
+    // now in the ensemble (NaN initial heights are those of no realization).
+    double h0 = 0, used = 0;
+    for (Eigen::Index i = 0; i < initial_height_.size(); ++i)
+        if (std::isfinite(s.bed.height[i]) && std::isfinite(initial_height_[i])) {
+            h0 += initial_height_[i];
+            used += 1;
+        }
+    series("/bed/mean/expansion", {}, T::real).append(used > 0 ? s.bed_mean.height[0] / (h0 / used) : std::numeric_limits<double>::quiet_NaN());
 }
 
 void Hdf5Recorder::sample(const SampleRecord& s) {
@@ -104,6 +190,7 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
         series("/samples/compact", {4}, T::real).append(as_span(s.compact));
         series("/samples/compact_status", {}, T::integer).append_integer(s.compact_status);
     }
+    if (species_ > 0 && !s.bed.empty()) bed_sample(s);
     file_.flush();
 }
 
@@ -195,7 +282,10 @@ void Hdf5Recorder::finish(const RunSummary& s) {
     file_.attribute("/", "coarse_steps", std::int64_t{s.coarse_steps});
     file_.attribute("/", "restrict_seconds", s.restrict_seconds);
     file_.attribute("/", "lift_seconds", s.lift_seconds);
-    if (!s.controller.empty()) file_.write_text("/cpi/controller_summary", s.controller);
+    if (!s.controller.empty()) {
+        file_.write_text("/cpi/controller_summary", s.controller);
+        document("/cpi/controller_summary");
+    }
     file_.flush();
 }
 

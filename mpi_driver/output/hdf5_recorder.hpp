@@ -3,26 +3,13 @@
 /// Hdf5Recorder: the complete record of a run in `<prefix>.h5`, written by the root as the run
 /// goes (flushed after every sample and step, so a killed run leaves a readable file).
 ///
-/// Layout (times in sqrt(d_p/g), heights in d_p):
-///   /                     attributes: format_version, efdem_version, git_hash, build, date,
-///                         mode, ranks, realizations, realizations_per_rank, seed,
-///                         observed_species, scene_file, overrides; at the end: end_status,
-///                         simulated_time, dem_time, wall_seconds, particle_steps, coarse_steps,
-///                         restrict_seconds, lift_seconds (root wall time in the coarse layer)
-///   /scene                the scene text as read;  /parameters  every parameter with its origin
-///   /p                    the p-grid (m)
-///   /samples/time (n), mean (n x m), variance (n x m), icdf (n x R x m), com (n x R)
-///   /samples/top_mean (n x m), compact (n x 4), compact_status (n)
-///                         [cpi.observable = compact or observe.compact = true]
-///   /cpi/t_start, burst_length, healing, window, dt_requested, dt, period, periods, t_end (n)
-///   /cpi/status (text), message (text), slope, x_end, x_projected (n x dim)
-///   /cpi/slope_standard_error (n x dim): SE_i = std_r(s_r,i) / sqrt(R) of the slope, from
-///                         each realization's own slope over the same window [d_p per
-///                         sqrt(d_p/g)]; NaN where unavailable (R = 1, compact observable,
-///                         no slope)
-///   /cpi/repair_max_adjustment, repair_clipped, repair_non_monotone (n)
-///   /cpi/stability_assessed, stability_stable, stability_rate, stability_amplification (n)
-///   /cpi/lift_changed (n x R), lift_max_deviation (n x R), lift_message (text, per step)
+/// Every dataset carries the attributes `units` and `description` and named dimensions (HDF5
+/// dimension scales: /samples/time, /realization, /p, /cpi/t_start, ... are the axes), from the
+/// table of run_file_schema.cpp; the layout in prose: docs/output.md. The file's attributes:
+/// format_version, efdem_version, git_hash, build, date, mode, ranks, realizations,
+/// realizations_per_rank, seed, observed_species, scene_file, overrides; at the end:
+/// end_status, simulated_time, dem_time, wall_seconds, particle_steps, coarse_steps,
+/// restrict_seconds, lift_seconds.
 
 #include <map>
 #include <string>
@@ -32,7 +19,8 @@
 
 namespace efdem::mpi_driver {
 
-inline constexpr std::int64_t kRunFileFormatVersion = 1;
+/// 2: units, descriptions and dimension scales on every dataset; /realization; /bed (observe.bed).
+inline constexpr std::int64_t kRunFileFormatVersion = 2;
 
 class Hdf5Recorder final : public RunRecorder {
 public:
@@ -48,6 +36,9 @@ public:
 
 private:
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
+    /// Writes `name`'s units, description and dimension scales (run_file_schema.hpp).
+    void document(const std::string& name);
+    void bed_sample(const SampleRecord& s);
 
     std::filesystem::path path_;
     /// PATH.reserve: space held for finishing the run file on a full disk (finish() frees it
@@ -58,6 +49,8 @@ private:
     Eigen::Index m_;
     Eigen::Index dim_;
     std::map<std::string, H5Series> series_;
+    std::size_t species_ = 0, slabs_ = 0;  ///< observe.bed: the axes of /bed
+    Eigen::VectorXd initial_height_;       ///< each realization's bed height at the first sample
 };
 
 }  // namespace efdem::mpi_driver

@@ -15,6 +15,18 @@
 
 namespace efdem::mpi_driver {
 
+/// The bed quantities of an ensemble sample (observe.bed; dem/beds/bed_observation.hpp): one
+/// row per realization (NaN rows for dropped ones), or a single row for the ensemble mean.
+struct BedRecord {
+    Eigen::VectorXd pressure_drop;        ///< Delta P [rho_s g d_p]
+    Eigen::VectorXd pressure_drop_ratio;  ///< Delta P / (W / A) [-]
+    Eigen::VectorXd height;               ///< bed height (99 % of the particle volume below) [d_p]
+    Eigen::VectorXd mixing_index;         ///< Lacey index of the observed species [-]
+    Eigen::MatrixXd species_height;       ///< rows x species: mean centre height [d_p]
+    Eigen::MatrixXd solid_fraction;       ///< rows x slabs: phi(z) [-]
+    bool empty() const { return pressure_drop.size() == 0; }
+};
+
 /// One ensemble sample, as the root sees it. Heights in d_p, time in sqrt(d_p/g).
 struct SampleRecord {
     double time = 0;
@@ -22,6 +34,10 @@ struct SampleRecord {
     Eigen::VectorXd variance;      ///< unbiased ensemble variance per node (zeros when R = 1)
     Eigen::MatrixXd realizations;  ///< R x m: each realization's ICDF
     Eigen::VectorXd com;           ///< R: centre-of-mass height of each realization
+    /// observe.bed: each realization's bed quantities and their mean over the realizations in
+    /// the ensemble; empty otherwise.
+    BedRecord bed;
+    BedRecord bed_mean;
     Eigen::VectorXd top_mean;      ///< ensemble-mean ICDF of the N/2 highest particles, when gathered
     Eigen::VectorXd compact;       ///< (A, B, C, D) of the mean y(p), when used (else empty)
     int compact_status = 0;        ///< 0 ok; otherwise the fit's status code
@@ -90,6 +106,12 @@ struct RunProvenance {
     std::uint64_t seed = 1;
     Eigen::VectorXd p_grid;
     std::string observed_species;
+    /// observe.bed: what the bed quantities' axes are (empty names: not recorded).
+    std::vector<std::string> species_names;
+    double profile_dz = 0;       ///< phi(z) slab thickness [d_p]
+    long profile_slabs = 0;      ///< phi(z) slabs from the floor
+    double mixing_layer = 0;     ///< Lacey layer thickness [d_p]
+    double weight_per_area = 0;  ///< W / A of realization 0 [rho_s g d_p]
 };
 
 }  // namespace efdem::mpi_driver

@@ -27,6 +27,12 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     const std::string observed = observe.get_or_choice("species", names.front(), names);
     s.observe.species = static_cast<dem::SpeciesId>(scene.species.find(observed));
     s.observe.other = s.observe.species == 0 ? 1 : 0;
+    s.observe.bed = observe.get_or<bool>("bed", false);
+    if (s.observe.bed) {  // read only when on, so that a scene without it has nothing to explain
+        s.observe.profile_dz = observe.get_or<double>("profile_dz", 1.0, Bounds::open_closed(0.0, 1e3));
+        s.observe.profile_height = observe.get_or<double>("profile_height", 0.0, Bounds::closed(0.0, 1e6));
+        s.observe.mixing_layer = observe.get_or<double>("mixing_layer", 2.0, Bounds::open_closed(0.0, 1e3));
+    }
 
     const Params run = root.scope("run");
     s.duration = run.get<double>("duration", Bounds::open_closed(0.0, 1e9));

@@ -22,6 +22,12 @@
 /// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19      |
 /// | observe.compact                | also record (A,B,C,D) of y = Q_top - Q_L at every   | false   |
 /// |                                | sample (a direct reference for a compact CPI run)   |         |
+/// | observe.bed                    | also record the bed quantities at every sample:     | false   |
+/// |                                | Delta P, H, species heights, Lacey index, phi(z)    |         |
+/// | observe.profile_dz             | slab thickness of the recorded phi(z)                | 1       |
+/// | observe.profile_height         | top of the recorded phi(z) (0: 3 x the bed's solid  | 0       |
+/// |                                | height, dem::default_profile_slabs)                 |         |
+/// | observe.mixing_layer           | layer thickness of the Lacey mixing index           | 2       |
 /// | cpi.observable                 | the coarse variable: `icdf` (the ICDF nodes) or     | icdf    |
 /// |                                | `compact` ((A,B,C,D)); coarse/demixing/observable_table |     |
 /// | cpi.*                          | the coarse run loop: coarse_run_settings.hpp        |         |
@@ -56,6 +62,10 @@ struct ObserveSettings {
     bool compact = false;        ///< record (A,B,C,D) at every sample
     dem::SpeciesId species = 0;  ///< the observed ("light") species
     dem::SpeciesId other = 1;    ///< the other species (colour 0), binary mixtures
+    bool bed = false;            ///< record dem::BedObservation at every sample
+    double profile_dz = 1.0;     ///< phi(z) slabs [d_p]
+    double profile_height = 0;   ///< top of phi(z) [d_p]; 0: dem::default_profile_slabs
+    double mixing_layer = 2.0;   ///< Lacey layers [d_p]
 };
 
 struct OutputSettings {

@@ -1,0 +1,121 @@
+#include "mpi_driver/output/run_file_schema.hpp"
+
+#include <algorithm>
+
+#include "core/contracts.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+using D = std::vector<std::string_view>;
+const D scalar{}, sample{"sample"}, sample_node{"sample", "node"}, sample_r{"sample", "realization"},
+    sample_r_node{"sample", "realization", "node"}, step{"step"}, step_coarse{"step", "coarse_node"},
+    step_r{"step", "realization"}, failure{"failure"};
+}  // namespace
+
+const std::vector<DatasetDoc>& run_file_schema() {
+    static const std::vector<DatasetDoc> table = {
+        // Fixed datasets: the run's set-up and axes.
+        {"/scene", "text", "the scene file as read", scalar},
+        {"/parameters", "text", "every parameter the run used: 'key = value   [origin]' lines (origin: file:line, <command line> or default)", scalar},
+        {"/p", "1", "the ICDF's probability nodes p_i = i/(m+1) (observe.quantiles = m)", {"node"}},
+        {"/realization", "1", "global index of each realization (its seed stream and rank-independent order)", {"realization"}},
+        // /samples: one row per ensemble sample (every observe.interval of DEM time).
+        {"/samples/time", "sqrt(d_p/g)", "time of the sample", sample},
+        {"/samples/mean", "d_p", "ensemble-mean ICDF of the observed species' heights (the realizations in the ensemble)", sample_node},
+        {"/samples/variance", "d_p^2", "unbiased ensemble variance of the ICDF per node (0 when R = 1)", sample_node},
+        {"/samples/icdf", "d_p", "each realization's ICDF of the observed species' heights (NaN rows: dropped after a failure)", sample_r_node},
+        {"/samples/com", "d_p", "each realization's mass-weighted centre-of-mass height (the travelling-wave phase signal)", sample_r},
+        {"/samples/realizations_used", "1", "realizations in the means (R less those dropped)", sample},
+        {"/samples/top_mean", "d_p", "ensemble-mean ICDF of the N/2 highest particles regardless of species", sample_node},
+        {"/samples/compact", "d_p", "(A, B, C, D) of the compact fit of y(p) = Q_top - Q_L of the ensemble mean", {"sample", "compact_parameter"}},
+        {"/samples/compact_status", "1", "status of the compact fit (0 ok)", sample},
+        // /bed: observe.bed = true.
+        {"/bed/z", "d_p", "centre height of each slab of the solid-fraction profile", {"slab"}},
+        {"/bed/species", "text", "species names, in the order of the species axis", {"species"}},
+        {"/bed/pressure_drop", "rho_s g d_p", "gas pressure drop across the bed, sum_j dz (-dp/dz)_j", sample_r},
+        {"/bed/pressure_drop_ratio", "1", "pressure drop / (bed weight per area): 1 for a bed the gas fully supports", sample_r},
+        {"/bed/height", "d_p", "bed height: 99 % of the particle volume lies below it", sample_r},
+        {"/bed/expansion", "1", "bed height / bed height at the run's first sample", sample_r},
+        {"/bed/mixing_index", "1", "Lacey mixing index of the observed species over horizontal layers (observe.mixing_layer): 1 random mixture, 0 segregated", sample_r},
+        {"/bed/species_height", "d_p", "number-weighted mean centre height of each species", {"sample", "realization", "species"}},
+        {"/bed/solid_fraction", "1", "solid volume fraction phi of each slab (exact partial sphere volumes)", {"sample", "realization", "slab"}},
+        {"/bed/mean/pressure_drop", "rho_s g d_p", "ensemble mean of /bed/pressure_drop", sample},
+        {"/bed/mean/pressure_drop_ratio", "1", "ensemble mean of /bed/pressure_drop_ratio", sample},
+        {"/bed/mean/height", "d_p", "ensemble mean of /bed/height", sample},
+        {"/bed/mean/expansion", "1", "ensemble-mean bed height / its value at the run's first sample", sample},
+        {"/bed/mean/mixing_index", "1", "ensemble mean of /bed/mixing_index", sample},
+        {"/bed/mean/species_height", "d_p", "ensemble mean of /bed/species_height", {"sample", "species"}},
+        {"/bed/mean/solid_fraction", "1", "ensemble mean of /bed/solid_fraction", {"sample", "slab"}},
+        // /cpi: one row per attempted coarse step (a rejected step of adaptive CPI has a row too).
+        {"/cpi/coarse_node", "1", "component index of the coarse vector (cpi.observable = icdf: the node of /p)", {"coarse_node"}},
+        {"/cpi/t_start", "sqrt(d_p/g)", "time at which the step's burst began", step},
+        {"/cpi/burst_length", "sqrt(d_p/g)", "DEM time of the step's burst (healing + window)", step},
+        {"/cpi/healing", "sqrt(d_p/g)", "healing part of the burst (not used for the slope)", step},
+        {"/cpi/window", "sqrt(d_p/g)", "window over which the slope was fitted", step},
+        {"/cpi/dt_requested", "sqrt(d_p/g)", "projective step DT asked for (by cpi.dt, the period rule or the controller)", step},
+        {"/cpi/dt", "sqrt(d_p/g)", "projective step DT taken (0: no jump)", step},
+        {"/cpi/period", "sqrt(d_p/g)", "travelling-wave period estimated in the burst (NaN: none)", step},
+        {"/cpi/periods", "1", "wave periods per step (cpi.projection = periods)", step},
+        {"/cpi/t_end", "sqrt(d_p/g)", "time after the jump", step},
+        {"/cpi/status", "text", "what the step did: projected, burst_only, stopped_unstable, too_few_periods, invalid_burst, infeasible_projection or rejected", step},
+        {"/cpi/message", "text", "why, where the status needs a reason", step},
+        {"/cpi/slope", "d_p/sqrt(d_p/g)", "slope of the coarse vector fitted over the window", step_coarse},
+        {"/cpi/slope_standard_error", "d_p/sqrt(d_p/g)", "standard error of the slope (ensemble spread of the realizations' own slopes / sqrt(R))", step_coarse},
+        {"/cpi/x_end", "d_p", "coarse vector at the end of the burst", step_coarse},
+        {"/cpi/x_projected", "d_p", "coarse vector after the jump (before repair)", step_coarse},
+        {"/cpi/repair_max_adjustment", "d_p", "largest change the monotone repair made to the projected ICDF", step},
+        {"/cpi/repair_clipped", "1", "nodes clipped into the heights the particles occupy", step},
+        {"/cpi/repair_non_monotone", "1", "1 if the projected ICDF was not monotone", step},
+        {"/cpi/stability_assessed", "1", "1 if the stability monitor could assess the step", step},
+        {"/cpi/stability_stable", "1", "1 if the projective step's amplification is below 1 for the estimated decay rate", step},
+        {"/cpi/stability_rate", "1/sqrt(d_p/g)", "fastest decay rate the monitor estimated", step},
+        {"/cpi/stability_amplification", "1", "amplification factor of the projective step at that rate", step},
+        {"/cpi/controller/accepted", "1", "1 if the adaptive step was accepted", step},
+        {"/cpi/controller/steps", "1", "accepted steps so far", step},
+        {"/cpi/controller/tolerance", "d_p", "cpi.tolerance: error a step may add (RMS over the coarse vector)", step},
+        {"/cpi/controller/error_statistical", "d_p", "estimated statistical error of the step: DT x s.e. of the slope (RMS)", step},
+        {"/cpi/controller/error_truncation", "d_p", "estimated truncation error of the step (RMS)", step},
+        {"/cpi/controller/predicted_truncation", "d_p", "truncation error the controller predicted for the DT it chose", step},
+        {"/cpi/controller/dt_tolerance", "sqrt(d_p/g)", "largest DT within tolerance", step},
+        {"/cpi/controller/dt_tolerance_2r", "sqrt(d_p/g)", "the same with 2 R realizations", step},
+        {"/cpi/controller/dt_tolerance_4r", "sqrt(d_p/g)", "the same with 4 R realizations", step},
+        {"/cpi/controller/limited_by", "text", "what limited DT: tolerance, dt_max, first burst, stability, end of run, fixed, ...", step},
+        {"/cpi/controller/error_statistical_nodes", "d_p", "statistical error per coarse component", step_coarse},
+        {"/cpi/controller/error_truncation_nodes", "d_p", "truncation error per coarse component", step_coarse},
+        {"/cpi/controller_summary", "text", "what the controller did and what more realizations would buy", scalar},
+        {"/cpi/lift_changed", "1", "labels lifting changed in each realization", step_r},
+        {"/cpi/lift_max_deviation", "d_p", "largest |achieved - target| of the lifted ICDF per realization", step_r},
+        {"/cpi/lift_message", "text", "realizations whose target was repaired or clipped, and why", step},
+        // /failures: one row per realization failure the run survived.
+        {"/failures/time", "sqrt(d_p/g)", "when the realization failed", failure},
+        {"/failures/realization", "1", "the failed realization", failure},
+        {"/failures/action", "text", "dropped, replaced or fatal", failure},
+        {"/failures/reason", "text", "the failure's message", failure},
+        {"/failures/donor", "1", "replaced: the realization whose state it was rebuilt from (-1: none)", failure},
+        {"/failures/resumed_at", "sqrt(d_p/g)", "cpi: where the interrupted coarse step was redone from", failure},
+        {"/failures/realizations_left", "1", "realizations in the ensemble after it", failure},
+    };
+    return table;
+}
+
+const DatasetDoc& dataset_doc(std::string_view path) {
+    const auto& t = run_file_schema();
+    const auto it = std::find_if(t.begin(), t.end(), [&](const DatasetDoc& d) { return d.path == path; });
+    EFDEM_EXPECTS(it != t.end());
+    return *it;
+}
+
+std::string_view dimension_scale(std::string_view dim) {
+    if (dim == "sample") return "/samples/time";
+    if (dim == "realization") return "/realization";
+    if (dim == "node") return "/p";
+    if (dim == "step") return "/cpi/t_start";
+    if (dim == "coarse_node") return "/cpi/coarse_node";
+    if (dim == "species") return "/bed/species";
+    if (dim == "slab") return "/bed/z";
+    if (dim == "failure") return "/failures/time";
+    return "";
+}
+
+}  // namespace efdem::mpi_driver
