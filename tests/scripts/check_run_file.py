@@ -3,7 +3,13 @@
 shapes consistent, times increasing, every ICDF (mean and per realization) non-decreasing in p
 and inside the bed, variances non-negative, provenance present, cpi records consistent.
 
-    /usr/bin/python3 check_run_file.py RUN.h5 [--mode cpi|direct] [--realizations R]
+    /usr/bin/python3 check_run_file.py RUN.h5 [--mode cpi|direct] [--realizations R] [--bed]
+
+Every run file is also checked to be self-describing: every dataset has non-empty `units` and
+`description` attributes, every dimension a label, and the sample, realization, node and step
+axes are attached as dimension scales (/samples/time, /realization, /p, /cpi/t_start).
+--bed: the run recorded observe.bed = true; /bed is checked (shapes, ranges, and the solid-
+fraction profile holds the particles' whole volume when the bed lies below its top).
 """
 import argparse
 import sys
@@ -12,12 +18,65 @@ import h5py
 import numpy as np
 
 
+AXES = {"sample": "/samples/time", "realization": "/realization", "node": "/p", "step": "/cpi/t_start",
+        "species": "/bed/species", "slab": "/bed/z", "failure": "/failures/time", "coarse_node": "/cpi/coarse_node"}
+
+
+def check_self_describing(f, check):
+    def visit(name, obj):
+        if not isinstance(obj, h5py.Dataset):
+            return
+        for key in ("units", "description"):
+            value = obj.attrs.get(key)
+            check(value is not None and len(str(value)) > 0, f"/{name} has no {key}")
+        for k, dim in enumerate(obj.dims):
+            check(len(dim.label) > 0, f"/{name} dimension {k} has no name")
+            axis = AXES.get(dim.label)
+            if axis and axis != "/" + name and axis.lstrip("/") in f:
+                scales = [s.name for s in dim.values()]
+                check(axis in scales, f"/{name} dimension {k} ({dim.label}) has no {axis} scale attached")
+    f.visititems(visit)
+
+
+def check_bed(f, check, n, R, particles, area):
+    if "bed" not in f:
+        check(False, "no /bed group")
+        return
+    b = f["bed"]
+    for name in ("pressure_drop", "pressure_drop_ratio", "height", "expansion", "mixing_index"):
+        check(b[name].shape == (n, R), f"/bed/{name} shape {b[name].shape} != {(n, R)}")
+        check(b["mean/" + name].shape == (n,), f"/bed/mean/{name} shape {b['mean/' + name].shape}")
+    S, J = len(b["species"]), len(b["z"])
+    check(b["species_height"].shape == (n, R, S), f"/bed/species_height shape {b['species_height'].shape}")
+    check(b["solid_fraction"].shape == (n, R, J), f"/bed/solid_fraction shape {b['solid_fraction'].shape}")
+    phi = b["solid_fraction"][:]
+    # A sphere fills at most pi/6 of the cube around it; random packings reach 0.64, and a slab
+    # cutting through a layer of touching spheres can read up to about 0.9 of its volume.
+    check(np.all(phi >= 0) and np.all(phi < 0.95), f"solid fraction outside [0, 0.95): {phi.min()}..{phi.max()}")
+    check(np.all(b["height"][:] > 0), "a bed height <= 0")
+    ratio = b["pressure_drop_ratio"][:]
+    check(np.all(ratio >= 0) and np.all(ratio < 2), f"pressure_drop_ratio outside [0, 2): {ratio.min()}..{ratio.max()}")
+    check(np.allclose(b["mean/height"][:], b["height"][:].mean(axis=1), rtol=1e-12), "/bed/mean/height is not the mean")
+    check(np.allclose(b["expansion"][0], 1.0), "expansion at the first sample is not 1")
+    if particles and area:
+        # The exact partial volumes put every sphere's whole volume into the slabs (the floor
+        # overlap in slab 0): sum_j phi_j dz A = N pi/6 to round-off while the bed lies below
+        # the profile's top (its last slab empty: no particle reaches it).
+        dz = float(b.attrs["profile_dz"])
+        below = phi[:, :, -1] == 0
+        held = phi.sum(axis=2) * dz * area / (particles * np.pi / 6)
+        check(np.allclose(held[below], 1.0, rtol=1e-9), f"phi(z) holds {held[below].min()}..{held[below].max()} of the particle volume")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("run")
     ap.add_argument("--mode")
     ap.add_argument("--realizations", type=int)
     ap.add_argument("--min-samples", type=int, default=2)
+    ap.add_argument("--bed", action="store_true")
+    ap.add_argument("--particles", type=int, help="particles per realization (the --bed volume check)")
+    ap.add_argument("--area", type=float, help="lx * ly (the --bed volume check)")
     a = ap.parse_args(argv)
     errors = []
 
@@ -75,6 +134,9 @@ def main(argv=None):
                     check(len(c["controller"][name]) == k, f"/cpi/controller/{name} has {len(c['controller'][name])} rows, expected {k}")
                 acc = c["controller/accepted"][:]
                 check(all(acc[i] == 0 for i, x in enumerate(status) if x == "rejected"), "a rejected step marked accepted")
+        check_self_describing(f, check)
+        if a.bed:
+            check_bed(f, check, n, R, a.particles, a.area)
     if errors:
         print(f"check_run_file: {a.run}: " + "; ".join(errors))
         return 1
