@@ -18,6 +18,9 @@ mkdir -p "$EFDEM_VALIDATION_OUT"
 filter=${EFDEM_VALIDATION_FILTER:-[.validation]}
 status=0
 "$EFDEM_BUILD_DIR/tests/efdem_physics_tests" "$filter" --durations yes || status=$?
+# Whole-program validation checks (ctest label validation): the recorded pressure drop.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+(cd "$EFDEM_BUILD_DIR" && ctest --output-on-failure -V -L validation) || status=1
 # Plot with Debian's matplotlib (python3-matplotlib), not whatever python3 comes first on PATH.
 /usr/bin/python3 "$src/scripts/plot_validation.py" "$EFDEM_VALIDATION_OUT" "$src/docs/validation"
 echo "run_validation: numbers in $EFDEM_VALIDATION_OUT/numbers.txt, figures in docs/validation/"
