@@ -41,3 +41,14 @@ if errors:
     sys.exit(1)
 print("bed_observables: ok")
 PY
+# The plot script: a PNG from the run, exit 2 with a message for a file without /bed.
+/usr/bin/python3 "$here/../../scripts/plot_bed.py" "$work/bed.h5" -o "$work/bed.png"
+test -s "$work/bed.png"
+"$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=0.5 \
+  output.directory="$work" output.prefix=nobed > "$work/log_nobed" 2>&1 || { cat "$work/log_nobed"; exit 1; }
+set +e
+/usr/bin/python3 "$here/../../scripts/plot_bed.py" "$work/nobed.h5" -o "$work/nobed.png" 2> "$work/err"
+rc=$?
+set -e
+[ "$rc" = 2 ] && grep -q "observe.bed=true" "$work/err" || { echo "plot_bed.py on a run without /bed: rc $rc: $(cat "$work/err")"; exit 1; }
+echo "bed_observables: plot ok"
