@@ -127,6 +127,19 @@ std::string ParamTable::closest_key(std::string_view key, bool among_queried) co
     return best;
 }
 
+void ParamTable::declare(const std::string& key, const std::string& expected, const std::string* fallback) const {
+    auto it = std::find_if(declarations_.begin(), declarations_.end(), [&](const KeyDeclaration& d) { return d.key == key; });
+    if (it == declarations_.end()) {
+        declarations_.push_back({key, expected, fallback ? *fallback : std::string(), fallback == nullptr});
+        return;
+    }
+    if (!expected.empty()) it->expected = expected;
+    if (fallback) {
+        it->fallback = *fallback;
+        it->required = false;
+    }
+}
+
 std::vector<const ParamEntry*> ParamTable::unused_entries() const {
     std::vector<const ParamEntry*> out;
     for (const auto& e : entries_)
@@ -202,6 +215,7 @@ void Params::fail_missing(const std::string& full, const std::string& expected) 
 template <class T>
 T Params::get(std::string_view key, const Bounds& bounds) const {
     const std::string full = full_key(key);
+    table_->declare(full, param_value_expected<T>(bounds), nullptr);
     const ParamEntry* e = lookup(key);
     if (!e) fail_missing(full, param_value_expected<T>(bounds));
     std::string problem;
@@ -214,6 +228,8 @@ T Params::get(std::string_view key, const Bounds& bounds) const {
 
 template <class T>
 T Params::get_or(std::string_view key, const T& fallback, const Bounds& bounds) const {
+    const std::string shown = show_param_value<T>(fallback);
+    table_->declare(full_key(key), param_value_expected<T>(bounds), &shown);
     if (!table_->contains(full_key(key))) {
         lookup(key);
         table_->record(full_key(key), show_param_value<T>(fallback), "default");
@@ -230,6 +246,7 @@ EFDEM_PARAM_VALUE_TYPES(EFDEM_PARAMS_INSTANTIATE)
 
 std::string Params::get_choice(std::string_view key, const std::vector<std::string>& allowed) const {
     const std::string word = get<std::string>(key);
+    table_->declare(full_key(key), "one of: " + comma_list(allowed), nullptr);
     if (std::find(allowed.begin(), allowed.end(), word) == allowed.end())
         fail(key, "is not a known choice", comma_list(allowed));
     return word;
@@ -237,7 +254,12 @@ std::string Params::get_choice(std::string_view key, const std::vector<std::stri
 
 std::string Params::get_or_choice(std::string_view key, const std::string& fallback,
                                   const std::vector<std::string>& allowed) const {
-    if (!contains(key)) return get_or<std::string>(key, fallback);
+    table_->declare(full_key(key), "one of: " + comma_list(allowed), &fallback);
+    if (!contains(key)) {
+        const std::string word = get_or<std::string>(key, fallback);
+        table_->declare(full_key(key), "one of: " + comma_list(allowed), nullptr);
+        return word;
+    }
     return get_choice(key, allowed);
 }
 
@@ -252,6 +274,8 @@ std::filesystem::path Params::get_path(std::string_view key) const {
 
 std::filesystem::path Params::get_or_path(std::string_view key,
                                           const std::filesystem::path& fallback) const {
+    const std::string shown = fallback.string();
+    table_->declare(full_key(key), "", &shown);
     if (!contains(key)) return get_or<std::string>(key, fallback.string());
     return get_path(key);
 }

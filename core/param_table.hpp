@@ -49,6 +49,16 @@ struct ResolvedParam {
     std::string origin;  ///< "scene.cfg:12", "<command line>" or "default"
 };
 
+/// A key as the code declares it when it reads it: what it accepts and its default. Collected
+/// for every key queried (present in the scene or not), so that `efdem --list-keys` prints the
+/// keys a scene's set-up reads, and a test checks docs/scene_reference.md against them.
+struct KeyDeclaration {
+    std::string key;
+    std::string expected;  ///< "a real number > 0", "one of: direct, cpi", ...
+    std::string fallback;  ///< the default as text; empty when required
+    bool required = true;
+};
+
 /// Returns a hint sentence for an unused key ("is 'gas_drag' listed in 'effects'?") or "".
 using UnusedKeyHint = std::function<std::string(const ParamEntry&)>;
 
@@ -85,6 +95,8 @@ public:
     const std::vector<std::string>& overrides() const { return overrides_; }
     /// Every parameter read so far with its value and origin, in the order first read.
     const std::vector<ResolvedParam>& resolved() const { return resolved_; }
+    /// Every key queried so far, in the order first queried.
+    const std::vector<KeyDeclaration>& declarations() const { return declarations_; }
     /// All entries in file order (overrides last).
     const std::vector<ParamEntry>& entries() const { return entries_; }
 
@@ -93,6 +105,8 @@ private:
     ParamTable() = default;
     void record(const std::string& key, const std::string& value, const std::string& origin);
     void note_query(const std::string& key) const { queried_.emplace(key, true); }
+    /// Records what `key` accepts; a later call refines it (a choice list, a default).
+    void declare(const std::string& key, const std::string& expected, const std::string* fallback) const;
     std::string closest_key(std::string_view key, bool among_queried) const;
 
     std::string text_;
@@ -103,6 +117,7 @@ private:
     std::map<std::string, std::size_t, std::less<>> index_;
     std::vector<ResolvedParam> resolved_;
     mutable std::map<std::string, bool, std::less<>> queried_;
+    mutable std::vector<KeyDeclaration> declarations_;
 };
 
 /**

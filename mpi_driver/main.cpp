@@ -279,7 +279,8 @@ int main(int argc, char** argv) {
 
     // Set-up: every rank reads the same scene and builds its realizations. Failures are agreed
     // on collectively, so that all ranks stop together and the root prints one message.
-    const bool check = options.action == RunOptions::Action::check;
+    const bool list_keys = options.action == RunOptions::Action::list_keys;
+    const bool check = options.action == RunOptions::Action::check || list_keys;
     int code = kExitOk;
     std::string message;
     std::optional<ParamTable> table;
@@ -359,8 +360,12 @@ int main(int argc, char** argv) {
         }
     }
     if (check) {
-        if (mpi.is_root())
+        if (mpi.is_root() && list_keys) {
+            for (const auto& d : table->declarations())
+                std::printf("%s\t%s\t%s\n", d.key.c_str(), d.expected.c_str(), d.required ? "required" : d.fallback.c_str());
+        } else if (mpi.is_root()) {
             std::printf("%s", check_report(*table, *settings, systems.front(), mpi.size()).c_str());
+        }
         return kExitOk;
     }
     std::optional<RestartData> restart;

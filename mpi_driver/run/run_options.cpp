@@ -13,6 +13,7 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
         else if (arg == "--version") o.action = Action::version;
         else if (arg == "--list-effects") o.action = Action::list_effects;
         else if (arg == "--check") o.action = Action::check;
+        else if (arg == "--list-keys") o.action = Action::list_keys;
         else if (arg.rfind("--", 0) == 0)
             throw InputError(where, "unknown option '" + arg + "'; see efdem --help");
         else if (arg.rfind("restart=", 0) == 0) {
@@ -24,7 +25,7 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
             throw InputError(where, "a second scene file '" + arg + "' was given after '" + o.scene +
                                         "'; give one scene and key=value overrides");
     }
-    if ((o.action == Action::run || o.action == Action::check) && o.scene.empty())
+    if ((o.action == Action::run || o.action == Action::check || o.action == Action::list_keys) && o.scene.empty())
         throw InputError(where, "no scene file given; usage: efdem [--check] SCENE [key=value ...]");
     return o;
 }
@@ -38,6 +39,9 @@ usage:
   efdem --check SCENE [key=value ...]         read the scene, build one realization, report the
                                               active effects and everything derived from the
                                               inputs, run zero steps
+  efdem --list-keys SCENE [key=value ...]     as --check, then every key the scene's set-up read
+                                              (tab-separated: key, what it accepts, default or
+                                              'required'); all keys: docs/scene_reference.md
   efdem --list-effects                        the effects a scene can list, with a summary
   efdem --version                             version, git hash, build
   efdem --help                                this text

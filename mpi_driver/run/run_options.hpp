@@ -13,7 +13,7 @@
 namespace efdem::mpi_driver {
 
 struct RunOptions {
-    enum class Action { run, check, help, version, list_effects } action = Action::run;
+    enum class Action { run, check, list_keys, help, version, list_effects } action = Action::run;
     std::string scene;                   ///< path of the scene file
     std::vector<std::string> overrides;  ///< "key=value"
     std::string restart;                 ///< `restart=FILE`: the checkpoint to continue from
