@@ -7,7 +7,10 @@
 ///   /                     attributes: format_version, efdem_version, git_hash, build, date,
 ///                         mode, ranks, realizations, realizations_per_rank, seed,
 ///                         observed_species, scene_file, overrides; at the end: end_status,
-///                         simulated_time, dem_time, wall_seconds, particle_steps, coarse_steps,
+///                         simulated_time, dem_time, wall_seconds (the run loop only),
+///                         settling_wall_seconds (building and settling the beds),
+///                         total_wall_seconds (start-up to end, settling included),
+///                         particle_steps, coarse_steps,
 ///                         restrict_seconds, lift_seconds (root wall time in the coarse layer)
 ///   /scene                the scene text as read;  /parameters  every parameter with its origin
 ///   /p                    the p-grid (m)
