@@ -14,11 +14,11 @@
 namespace efdem::dem {
 
 Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& root,
-                    const RealizationSpec& spec) {
+                    const RealizationSpec& spec, const SettlingReport& settling) {
     Particles p;
     if (bed.source == BedSpec::Source::lattice) {
         p = lattice_bed(bed, scene, spec);
-        if (bed.settle && !spec.skip_settling) p = settle_bed(std::move(p), bed, scene, root, spec);
+        if (bed.settle && !spec.skip_settling) p = settle_bed(std::move(p), bed, scene, root, spec, settling);
     } else {
         p = read_lammps_data(bed.file, scene.species, scene.domain);
     }
@@ -53,13 +53,13 @@ void check_initial_state(const System& sys, const BedSpec& bed, const Params& be
 }
 }  // namespace
 
-System build_system(const Params& root, const RealizationSpec& spec) {
+System build_system(const Params& root, const RealizationSpec& spec, const SettlingReport& settling) {
     DemScene scene = DemScene::from_params(root);
     auto effects = make_effects(scene, root);
     const std::string warning = check_time_step(scene, root, effects);
     if (!warning.empty() && spec.realization == 0) log::warn("{}", warning);
     const BedSpec bed = BedSpec::from_params(root.scope("bed"), scene);
-    Particles particles = build_bed(bed, scene, root, spec);
+    Particles particles = build_bed(bed, scene, root, spec, settling);
     SystemOptions options;
     options.dt = scene.dt;
     options.skin = scene.skin;

@@ -1,5 +1,6 @@
 // efdem: wiring only. Parse the command line, read the scene collectively, build this rank's
 // realizations, then hand over to the driver of the chosen mode.
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -38,6 +39,7 @@
 #include "mpi_driver/run/run_options.hpp"
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_settings.hpp"
+#include "mpi_driver/run/settling_progress.hpp"
 #include "mpi_driver/ensemble/scene_input.hpp"
 #include "mpi_driver/ensemble/stop_signal.hpp"
 
@@ -59,6 +61,21 @@ std::optional<dem::BedObservationSettings> bed_settings(const RunSettings& s, co
     b.species = any.species().size();
     return b;
 }
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// The root's wall clock outside the run loop: since start-up, and the set-up's settling.
+struct SetupWall {
+    Clock::time_point start = Clock::now();
+    double settling_seconds = 0;
+
+    void fill(RunSummary& s) const {
+        s.settling_wall_seconds = settling_seconds;
+        s.total_wall_seconds = seconds_since(start);
+    }
+};
 
 RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
                          const dem::System& any) {
@@ -87,7 +104,7 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
 /// Runs the scene: the root drives (direct or cpi loop) and records; the other ranks serve.
 /// `restart`: the checkpoint to continue from (null: a new run).
 int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
-        std::vector<dem::System> systems, const RestartData* restart) {
+        std::vector<dem::System> systems, const RestartData* restart, const SetupWall& wall) {
     const RunProvenance prov = provenance(mpi, table, s, systems.front());
     const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
     const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
@@ -192,6 +209,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     try {
         summary = s.is_cpi() ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(), progress, control)
                              : run_direct(stepper, s, progress, control);
+        wall.fill(summary);
         recorders->finish(summary);
     } catch (const RunFailed& e) {
         summary.end_status = std::string("failed: ") + e.what();
@@ -199,6 +217,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         summary.dem_time = stepper.micro_time();
         summary.particle_steps = stepper.particle_steps();
         summary.wall_seconds = progress.elapsed_seconds();
+        wall.fill(summary);
         try {
             recorders->finish(summary);
         } catch (const std::exception& again) {
@@ -210,15 +229,18 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         // A failure on the root (e.g. its run file on a full disk): mark the run file if it can
         // be (finish() frees its reserve first), then end every rank.
         summary.end_status = std::string("failed: ") + e.what();
+        wall.fill(summary);
         try {
             recorders->finish(summary);
         } catch (const std::exception&) {
         }
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
-    log::info("{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall, {:.3e} particle-steps",
-              summary.end_status, summary.simulated_time, summary.dem_time,
-              format_duration(summary.wall_seconds), summary.particle_steps);
+    log::info("{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall ({} settling the beds, {} the run), "
+              "{:.3e} particle-steps",
+              summary.end_status, summary.simulated_time, summary.dem_time, format_duration(summary.total_wall_seconds),
+              format_duration(summary.settling_wall_seconds), format_duration(summary.wall_seconds),
+              summary.particle_steps);
     if (summary.stop_signal != 0) {
         if (summary.checkpoint.empty()) {
             std::fprintf(stderr, "efdem: stopped by %s; nothing could be saved (no HDF5)\n",
@@ -247,6 +269,7 @@ void print_effects() {
 
 int main(int argc, char** argv) {
     MpiSession mpi(&argc, &argv);
+    SetupWall wall;
     log::configure(mpi.rank(), mpi.size(), log::Level::info);
     // From here on a stop signal is held until the run reaches a safe point (stop_signal.hpp).
     install_stop_signal_handlers();
@@ -286,6 +309,7 @@ int main(int argc, char** argv) {
     std::optional<ParamTable> table;
     std::optional<RunSettings> settings;
     std::vector<dem::System> systems;
+    const Clock::time_point settling_start = Clock::now();
     try {
         table.emplace(read_scene(mpi, options.scene, options.overrides));
         Params root = table->root();
@@ -293,9 +317,13 @@ int main(int argc, char** argv) {
         settings = RunSettings::from_params(root, scene);
         settings->check_ensemble(root, mpi.size() * settings->realizations_per_rank);
         const int k = check ? 1 : settings->realizations_per_rank;
+        // Settling a paper-size bed takes minutes: the root says how its own realizations go
+        // (the other ranks settle theirs at the same time).
+        SettlingProgressLine settling_line(5.0);
+        const dem::SettlingReport settling = mpi.is_root() ? settling_line.report() : dem::SettlingReport{};
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;
-            systems.push_back(dem::build_system(root, {settings->seed, realization, check}));
+            systems.push_back(dem::build_system(root, {settings->seed, realization, check}, settling));
         }
         table->check_all_used(
             [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
@@ -333,6 +361,8 @@ int main(int argc, char** argv) {
         message = std::string("unexpected failure during set-up: ") + e.what();
     }
     const Agreement agreed = agree_on_failure(mpi.comm(), code, message);
+    // Every rank has built (and settled) its realizations: the set-up's wall time, almost all settling.
+    wall.settling_seconds = seconds_since(settling_start);
     if (agreed.exit_code != kExitOk) {
         if (mpi.is_root()) log::error("{}", agreed.message);
         return agreed.exit_code;
@@ -379,5 +409,5 @@ int main(int argc, char** argv) {
             return loaded.exit_code;
         }
     }
-    return run(mpi, *table, *settings, std::move(systems), restart ? &*restart : nullptr);
+    return run(mpi, *table, *settings, std::move(systems), restart ? &*restart : nullptr, wall);
 }

@@ -4,7 +4,9 @@
 usage: /usr/bin/python3 scripts/plot_validation.py DATA_DIR FIGURE_DIR
 
 Reads the CSV files the [.validation] tests wrote to DATA_DIR ($EFDEM_VALIDATION_OUT) and writes
-PNG figures to FIGURE_DIR. Uses Debian's matplotlib (python3-matplotlib), not a virtualenv's.
+PNG figures to FIGURE_DIR. A figure whose CSV is missing is skipped with a line; no arguments,
+a DATA_DIR that is not a folder, none of the CSVs there, or a CSV without the columns a figure
+needs: a message and exit 2. Uses Debian's matplotlib (python3-matplotlib), not a virtualenv's.
 """
 import csv
 import sys
@@ -14,6 +16,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+import run_files  # noqa: E402  (scripts/run_files.py: exit 2 with a message)
 
 
 def rows(path):
@@ -119,16 +123,33 @@ def randomization(data, out):
     fig.savefig(out / "randomization.png", dpi=110)
 
 
-def main():
-    data, out = Path(sys.argv[1]), Path(sys.argv[2])
+USAGE = "usage: /usr/bin/python3 scripts/plot_validation.py DATA_DIR FIGURE_DIR"
+
+
+def main(argv):
+    if len(argv) != 2:
+        run_files.fail("plot_validation", f"expected 2 arguments, got {len(argv)}\n{USAGE}")
+    data, out = Path(argv[0]), Path(argv[1])
+    if not data.is_dir():
+        run_files.fail("plot_validation", f"DATA_DIR {data}: not a folder (the [.validation] tests write their "
+                                          f"CSV files to $EFDEM_VALIDATION_OUT)\n{USAGE}")
     out.mkdir(parents=True, exist_ok=True)
+    written = 0
     for plot in (dp_sweep, rz_profiles, waves, spacetime, randomization):
         try:
             plot(data, out)
             print(f"plot_validation: {plot.__name__} written")
+            written += 1
         except FileNotFoundError as e:
             print(f"plot_validation: {plot.__name__} skipped ({e.filename} missing)")
+        except (KeyError, IndexError, ValueError) as e:
+            run_files.fail("plot_validation", f"{plot.__name__}: a CSV in {data} lacks what the figure needs "
+                                              f"({type(e).__name__}: {e}); was it written by the [.validation] tier?")
+    if written == 0:
+        run_files.fail("plot_validation", f"no validation CSV files in {data} (dp_sweep_light.csv, rz_profiles.csv, "
+                                          "waves_u*.csv, spacetime_u*.csv, randomization_icdf.csv)")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main(sys.argv[1:]))

@@ -50,11 +50,11 @@ SCENES = [
             "wall_contact.gamma_n=100", "pair_contact.tangential=none", "-pair_contact.restitution",
             "-pair_contact.mu"]),
     (TINY, ["effects=gravity pair_contact wall_contact gas_drag viscous_damping", "viscous_damping.gamma=0.1"]),
-    (TINY, ["bed.settle=true"]),
+    (TINY, ["bed.settle=true", "gas_drag.A=0.114939"]),
 ]
 # A key read in the source: get<T>("kn"), get_or(...), get_choice(...), contains("x"), and the
 # contact laws' real_or_fallback(p, fb, "kn", ...) (wall_contact falls back to pair_contact).
-CALL = re.compile(r"\b(?:get\w*|contains|\w+_or_fallback)\s*(?:<[^>]*>)?\s*\((?:\s*\w+\s*,)*\s*\"([a-z_0-9.]+)\"")
+CALL = re.compile(r"\b(?:get\w*|contains|\w+_or_fallback)\s*(?:<[^>]*>)?\s*\((?:\s*\w+\s*,)*\s*\"([A-Za-z_0-9.]+)\"")
 
 
 def list_keys(efdem):

@@ -66,6 +66,7 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
         }
         const ProjectiveStepRecord rec = integrator_->step(stepper_);
         ++state_.coarse_steps;
+        if (rec.status == StepStatus::projected && rec.dt > 0) ++out.jumps;
         for (auto* o : observers_) o->step_done(*this, rec);
         if (rec.advanced()) {
             state_.without_progress = 0;
@@ -96,6 +97,20 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
     if (out.fell_back && out.end_status == "completed")
         out.end_status = fmt::format("completed ({} observable fell back to {})", primary_.name,
                                      fallback_ ? fallback_->name : std::string{"?"});
+    const bool saw_every_step = !resume || resume->coarse_steps == 0;
+    if (out.jumps == 0 && saw_every_step && out.end_status.rfind("completed", 0) == 0) {
+        const std::string why =
+            out.coarse_steps == 0
+                ? fmt::format("the {:.4g} time units after the warm-up were less than one burst ({:.4g})",
+                              t_end_ - stepper_.time(), burst)
+                : fmt::format("{} coarse step(s), each a burst only", out.coarse_steps);
+        out.end_status += fmt::format(" (no projective jump: {}; all {:.4g} time units were direct simulation)", why,
+                                      out.simulated_time);
+        log::warn("cpi run made no projective jump: {}; all {:.4g} time units were direct simulation. A cpi run "
+                  "gains only when run.duration leaves room for jumps after cpi.warmup (and a steady warm-up) "
+                  "and the controller takes them (each coarse step's status and message say why it did not jump)",
+                  why, out.simulated_time);
+    }
     return out;
 }
 

@@ -14,7 +14,13 @@
 ///   steps without a jump (the run would silently have become a direct run);
 /// * observable fallback: when a step is rejected as invalid_burst and a fallback coarse
 ///   variable exists (e.g. the compact (A,B,C,D) fit failed; the full ICDF is always defined),
-///   the stepper is switched to it and the run continues on it for good.
+///   the stepper is switched to it and the run continues on it for good;
+/// * a run without a projective jump (every coarse step was a burst only: the run was shorter
+///   than warm-up + one burst + anything to jump, the warm-up ran to the end, the adaptive
+///   controller declined every jump, period bursts were extended to the end) is a direct run
+///   in disguise: a warning, and its end status says so ("completed (no projective jump: ...)").
+///   Known for a run whose every coarse step this call saw (a new run, or one resumed before
+///   its first coarse step): the loop state does not count earlier jumps.
 ///
 /// What happens around the steps (recording, progress, checkpoints) is done by observers that
 /// the caller plugs in (ProjectiveRunObserver). The loop's own state (ProjectiveRunState) is
@@ -92,10 +98,11 @@ class ProjectiveRunObserver {
 
 /// How a run ended.
 struct ProjectiveRunOutcome {
-    /// "completed", "completed (<primary> observable fell back to <fallback>)", or
-    /// "stopped at t = ...: <status> (<message>)".
+    /// "completed", "completed (<primary> observable fell back to <fallback>)",
+    /// "completed (no projective jump: ...)", or "stopped at t = ...: <status> (<message>)".
     std::string end_status;
     long coarse_steps = 0;
+    long jumps = 0;             ///< projective jumps (DT > 0, accepted) made by this call of run()
     double simulated_time = 0;  ///< stepper time at the end minus t_origin
     bool fell_back = false;
 };

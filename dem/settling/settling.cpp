@@ -16,7 +16,7 @@
 namespace efdem::dem {
 
 Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& scene,
-                     const Params& root, const RealizationSpec& spec) {
+                     const Params& root, const RealizationSpec& spec, const SettlingReport& report) {
     for (const char* needed : {"pair_contact", "wall_contact"}) {
         bool listed = false;
         for (const auto& n : scene.effect_names) listed |= n == needed;
@@ -42,20 +42,50 @@ Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& sc
     options.realization = spec.realization;
     System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
     const auto steps = [&](double t) { return static_cast<long>(std::ceil(t / scene.dt)); };
-
-    sys.run(steps(settle_free_fall_time(top)));  // the top layer reaches the bed
-    damping->set_gamma(bed.settle_damping);
-    sys.run(steps(bed.settle_damped_time));
-    damping->set_gamma(0.0);
-    const double threshold = bed.settle_ke_threshold * scene.species.min_mass();
     const long chunk = std::max(1L, steps(0.5));
+    const double threshold = bed.settle_ke_threshold * scene.species.min_mass();
+    const auto ke_per_particle = [&] {
+        return sys.translational_kinetic_energy() / static_cast<double>(sys.particles().size());
+    };
+    SettlingProgress progress;
+    progress.realization = spec.realization;
+    progress.ke_threshold = threshold;
+    const auto tell = [&](SettlingProgress::Stage stage, double stage_end, double ke) {
+        if (!report) return;
+        progress.stage = stage;
+        progress.time = sys.time();
+        progress.steps = sys.step_count();
+        progress.stage_end = stage_end;
+        progress.ke_per_particle = ke;
+        report(progress);
+    };
+    // A stage of n steps, run in chunks so that the caller hears of it (chunks change nothing:
+    // System::run(a); run(b) is run(a + b)).
+    const auto run_stage = [&](SettlingProgress::Stage stage, long n) {
+        const double stage_end = sys.time() + static_cast<double>(n) * scene.dt;
+        for (long done = 0; done < n;) {
+            const long k = std::min(chunk, n - done);
+            sys.run(k);
+            done += k;
+            if (report) tell(stage, stage_end, ke_per_particle());
+        }
+    };
+
+    const long free_fall = steps(settle_free_fall_time(top));  // the top layer reaches the bed
+    tell(SettlingProgress::Stage::free_fall, static_cast<double>(free_fall) * scene.dt, ke_per_particle());  // the start
+    run_stage(SettlingProgress::Stage::free_fall, free_fall);
+    damping->set_gamma(bed.settle_damping);
+    run_stage(SettlingProgress::Stage::damped, steps(bed.settle_damped_time));
+    damping->set_gamma(0.0);
     const double t_start = sys.time();
     double ke = 0;
     while (true) {
-        ke = sys.translational_kinetic_energy() / static_cast<double>(sys.particles().size());
+        ke = ke_per_particle();
         if (ke < threshold || sys.time() - t_start >= bed.settle_max_time) break;
+        tell(SettlingProgress::Stage::relaxing, t_start + bed.settle_max_time, ke);
         sys.run(chunk);
     }
+    tell(SettlingProgress::Stage::done, sys.time(), ke);
     if (ke >= threshold)
         log::warn("realization {}: settling stopped after {:.4g} time units with kinetic energy {:.3g} "
                   "per particle, above bed.settle.ke_threshold x m_min g d = {:.3g}",

@@ -90,8 +90,11 @@ void CsvRecorder::coarse_step(const coarse::ProjectiveStepRecord& r, const LiftR
 
 void CsvRecorder::finish(const RunSummary& s) {
     written(icdf_, icdf_path_, [&] {
-        fmt::print(icdf_, "# end: {}; simulated time {:.6g}, DEM time {:.6g}, wall {:.3f} s, {:.4e} particle-steps\n",
-                   s.end_status, s.simulated_time, s.dem_time, s.wall_seconds, s.particle_steps);
+        fmt::print(icdf_,
+                   "# end: {}; simulated time {:.6g}, DEM time {:.6g}, wall {:.3f} s, {:.4e} particle-steps; "
+                   "settling wall {:.3f} s, total wall {:.3f} s\n",
+                   s.end_status, s.simulated_time, s.dem_time, s.wall_seconds, s.particle_steps,
+                   s.settling_wall_seconds, s.total_wall_seconds);
     });
 }
 

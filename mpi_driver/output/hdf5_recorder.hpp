@@ -8,8 +8,9 @@
 /// table of run_file_schema.cpp; the layout in prose: docs/output.md. The file's attributes:
 /// format_version, efdem_version, git_hash, build, date, mode, ranks, realizations,
 /// realizations_per_rank, seed, observed_species, scene_file, overrides; at the end:
-/// end_status, simulated_time, dem_time, wall_seconds, particle_steps, coarse_steps,
-/// restrict_seconds, lift_seconds.
+/// end_status, simulated_time, dem_time, wall_seconds (the run loop only),
+/// settling_wall_seconds (building and settling the beds), total_wall_seconds (start-up to
+/// end, settling included), particle_steps, coarse_steps, restrict_seconds, lift_seconds.
 
 #include <map>
 #include <string>

@@ -67,7 +67,11 @@ struct LiftRecord {
 struct RunSummary {
     double simulated_time = 0;   ///< time covered by the ensemble
     double dem_time = 0;         ///< time actually simulated by the DEM (per realization)
-    double wall_seconds = 0;
+    double wall_seconds = 0;     ///< wall time of the run loop (direct or cpi), not of the set-up
+    /// Root wall time from building the realizations to every rank having built its own: the
+    /// settling of the beds, nearly all of it (also on a restart, which builds them again).
+    double settling_wall_seconds = 0;
+    double total_wall_seconds = 0;  ///< root wall time from start-up to the end of the run
     double particle_steps = 0;   ///< summed over all realizations
     long coarse_steps = 0;
     std::string end_status;      ///< "completed", "interrupted: ...", "failed: ...", or why it stopped

@@ -46,12 +46,15 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.observable = cpi.get_or_choice("observable", observables.front(), observables);
     s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval, s.is_cpi());
     if (s.is_cpi()) {
+        // After cpi.warmup and one burst something must be left to jump over: a run of exactly
+        // warm-up + one burst is a direct run (ProjectiveRun warns of the cases only the run
+        // itself can tell: a steady warm-up to the end, a controller that declines every jump).
         const double least = s.cpi.warmup + s.cpi.burst();
-        if (s.duration < least - 1e-9 * least)
+        if (s.duration <= least + 1e-9 * least)
             run.fail("duration",
-                     fmt::format("is shorter than cpi.warmup + one burst (cpi.healing + cpi.window) = {:g}: the cpi "
-                                 "run could not make a single coarse step", least),
-                     fmt::format("run.duration >= {:g} (several bursts and jumps to gain anything), or mode = direct",
+                     fmt::format("leaves nothing to jump after cpi.warmup + one burst (cpi.healing + cpi.window) = "
+                                 "{:g}: the cpi run could not make a single projective jump", least),
+                     fmt::format("run.duration > {:g} (several bursts and jumps to gain anything), or mode = direct",
                                  least));
         if (scene.species.size() != 2)
             root.fail("mode", fmt::format("cpi lifts by swapping the labels of two species, but "

@@ -122,12 +122,47 @@ TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the war
     CHECK(run.end_time() == 100.0);
 }
 
-TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step", "[unit][coarse][run]") {
+TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step, and says so", "[unit][coarse][run]") {
     auto toy = slow_toy();
     ProjectiveRun run(fixed_settings(10.0), toy, variable("x"));
     const ProjectiveRunOutcome out = run.run(11.0);  // 1 time unit left after warm-up < burst 2
     CHECK(out.coarse_steps == 0);
+    CHECK(out.jumps == 0);
     CHECK(toy.time() == Approx(10.0).margin(1e-9));
+    CHECK(out.end_status ==
+          "completed (no projective jump: the 1 time units after the warm-up were less than one burst (2); all 10 "
+          "time units were direct simulation)");
+}
+
+TEST_CASE("a run of exactly warm-up plus one burst makes one burst and no jump, and says so", "[unit][coarse][run]") {
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(10.0), toy, variable("x"));
+    const ProjectiveRunOutcome out = run.run(12.0);  // warm-up 10, burst 2, nothing left to jump
+    CHECK(out.coarse_steps == 1);
+    CHECK(out.jumps == 0);
+    CHECK(toy.lifts == 0);
+    CHECK(out.end_status.rfind("completed (no projective jump: 1 coarse step(s), each a burst only;", 0) == 0);
+}
+
+TEST_CASE("a run that jumps ends plain 'completed'; a resumed run does not judge the jumps it did not see",
+          "[unit][coarse][run]") {
+    // Warm-up to 2, two cycles of burst 2 + jump 8 to 22, a last burst to 24 with nothing left to jump.
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
+    Recorder<test::LinearToyStepper> seen;
+    seen.stepper = &toy;
+    seen.at = 2;  // the state before the third step: 2 jumps done, 2 time units left (one burst)
+    run.add_observer(seen);
+    ProjectiveRunOutcome out = run.run(24.0);
+    CHECK(out.jumps == 2);
+    CHECK(out.end_status == "completed");
+    // Resumed before the last step (a burst only, no jump left): no jump in this call, but two
+    // before it, which the loop state does not count, so no claim about jumps.
+    REQUIRE(seen.snapshot);
+    auto again = *seen.snapshot;
+    ProjectiveRun resumed(fixed_settings(2.0), again, variable("x"));
+    out = resumed.run(24.0, seen.snapshot_state);
+    CHECK(out.jumps == 0);
     CHECK(out.end_status == "completed");
 }
 

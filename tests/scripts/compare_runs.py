@@ -11,7 +11,8 @@ import sys
 import h5py
 import numpy as np
 
-SKIP_ATTRS = {"ranks", "realizations_per_rank", "date", "wall_seconds", "restrict_seconds", "lift_seconds",
+SKIP_ATTRS = {"ranks", "realizations_per_rank", "date", "wall_seconds", "settling_wall_seconds", "total_wall_seconds",
+              "restrict_seconds", "lift_seconds",
               "overrides", "git_hash", "build"}
 
 

@@ -33,8 +33,10 @@ check dt "[1e-09, 1)" dt=1e-12
 check cpi.tolerance "(0, 1000000]" mode=cpi cpi.projection=adaptive cpi.tolerance=1e300
 check output.prefix "1 to 200 characters" output.prefix=$long
 check mode "direct, cpi" mode=$long
-# A cpi run too short for one coarse step.
+# A cpi run too short for one coarse step, and one of exactly cpi.warmup + one burst (0.5 + 1.5
+# in tiny_scene.cfg): nothing left to jump.
 check run.duration "or mode = direct" mode=cpi run.duration=1
+check run.duration "run.duration > 2" mode=cpi run.duration=2
 # LAMMPS' dt: a direct run does not check the (unused) cpi defaults against observe.interval...
 out=$("$mpiexec" -n 1 "${launcher[@]}" "$efdem" --check "$scene" mode=direct dt=1.8e-4 observe.interval=0.09 run.duration=0.9 2>&1)
 if [ $? -eq 0 ]; then echo "PASS: direct run with dt = 1.8e-4, observe.interval = 0.09 accepted"

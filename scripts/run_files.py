@@ -1,0 +1,54 @@
+"""Reading efdem run files (<prefix>.h5, mpi_driver/output/hdf5_recorder.hpp) in the plot and
+summary scripts, with a message instead of a traceback when a file is not what they need.
+
+    import run_files
+    try:
+        f = run_files.open_run(path, ["samples/time", "samples/mean"])
+    except run_files.UsageError as e:
+        run_files.fail("plot_icdf", e)          # prints "plot_icdf: <message>", exits 2
+
+Exit code 2 is efdem's for an input error; the scripts use it for a bad file or argument.
+"""
+import os
+import sys
+
+EXIT_USAGE = 2
+
+
+class UsageError(Exception):
+    """A file or argument the script cannot use; the message names it and what is wrong."""
+
+
+def fail(script, error):
+    print(f"{script}: error: {error}", file=sys.stderr)
+    sys.exit(EXIT_USAGE)
+
+
+def text(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def open_run(path, datasets=()):
+    """Opens `path` read-only as an efdem run file (h5py.File) that holds `datasets` with at least
+    one row each; UsageError otherwise."""
+    import h5py
+
+    if not os.path.exists(path):
+        raise UsageError(f"{path}: no such file (an efdem run writes <output.directory>/<output.prefix>.h5)")
+    if os.path.isdir(path):
+        raise UsageError(f"{path}: is a directory, not an efdem run file (<prefix>.h5)")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as e:
+        raise UsageError(f"{path}: not an HDF5 file, so not an efdem run file ({e})") from None
+    if "mode" not in f.attrs or "format_version" not in f.attrs:
+        f.close()
+        raise UsageError(f"{path}: an HDF5 file but not an efdem run file (no 'mode' and 'format_version' "
+                         "attributes; a checkpoint, *_ckpt_*.h5, is not a run file either)")
+    for name in datasets:
+        if name not in f or len(f[name]) == 0:
+            status = text(f.attrs.get("end_status", "?"))
+            f.close()
+            raise UsageError(f"{path}: the run file has no {'/' + name if name not in f else 'rows in /' + name} "
+                             f"(end_status '{status}': a run that ended before its first sample?)")
+    return f

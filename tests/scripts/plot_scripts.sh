@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# The scripts that read files (scripts/plot_icdf.py, scripts/demo_summary.py,
+# scripts/plot_validation.py) on real small run files and on bad input:
+# * good input: exit 0; plot_icdf writes the PNG and names each run's mode and line style, and
+#   the CPI run's last projective jump where the run file's /cpi records put it; demo_summary
+#   prints its labelled lines, and its numbers are facts of constructed pairs (a CPI file whose
+#   means equal the direct ones: RMS 0, 100 % inside; shifted by 1 d_p: RMS 1.000) and of the
+#   run file (speed-up = simulated_time / dem_time);
+# * bad input (no arguments, a missing file, a file that is not HDF5, an HDF5 file that is not
+#   a run file, a run file without samples, the runs in the wrong order, a folder without the
+#   validation CSVs, a CSV without its columns): exit 2 and a message naming the problem, no
+#   traceback.
+#   plot_scripts.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+source "$(dirname "$0")/lib.sh" "$@"
+src=$(cd "$here/../.." && pwd)
+py=/usr/bin/python3
+failures=0
+pass() { echo "PASS: $*"; }
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# Two small runs of the tiny scene: direct, and cpi with one jump (warm-up 0.5, burst 1.5 to
+# t = 2, jump 1.5 to 3.5, last burst to 5).
+for mode in direct cpi; do
+  "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=$mode run.duration=5 \
+    output.directory="$work" output.prefix=$mode > "$work/$mode.log" 2>&1 \
+    || { cat "$work/$mode.log"; echo "FAIL: the $mode run"; exit 1; }
+done
+
+expect() {  # expect CODE MESSAGE_SUBSTRING DESCRIPTION COMMAND...
+  local code=$1 message=$2 what=$3; shift 3
+  local out got
+  out=$("$@" 2>&1); got=$?
+  if [ $got -eq "$code" ] && grep -qF -- "$message" <<< "$out" && ! grep -q Traceback <<< "$out"; then
+    pass "$what: exit $got, '$message'"
+  else
+    fail "$what: exit $got (want $code), output: $(tail -5 <<< "$out")"
+  fi
+}
+
+# plot_icdf: good input.
+expect 0 "line style '--', last projective jump lands at t = 3.5" "plot_icdf direct + cpi" \
+  $py "$src/scripts/plot_icdf.py" "$work/direct.h5" "$work/cpi.h5" -o "$work/icdf.png"
+[ -s "$work/icdf.png" ] && pass "icdf.png written" || fail "icdf.png not written"
+expect 0 "direct: direct.h5 (R = 2, seed 11): line style '-'" "plot_icdf names the direct run" \
+  $py "$src/scripts/plot_icdf.py" "$work/direct.h5" -o "$work/direct.png"
+
+# Bad files, made here: text, HDF5 without the attributes, a run file without /samples/mean.
+echo "not a run file" > "$work/text.h5"
+$py - "$work" <<'PY' || fail "could not make the bad HDF5 files"
+import shutil, sys, h5py
+w = sys.argv[1]
+with h5py.File(f"{w}/other.h5", "w") as f:
+    f["x"] = [1.0]
+shutil.copy(f"{w}/direct.h5", f"{w}/nosamples.h5")
+with h5py.File(f"{w}/nosamples.h5", "a") as f:
+    del f["samples/mean"]
+PY
+expect 2 "required: runs" "plot_icdf without arguments" $py "$src/scripts/plot_icdf.py"
+expect 2 "missing.h5: no such file" "plot_icdf, missing file" $py "$src/scripts/plot_icdf.py" "$work/missing.h5"
+expect 2 "text.h5: not an HDF5 file" "plot_icdf, text file" $py "$src/scripts/plot_icdf.py" "$work/text.h5"
+expect 2 "other.h5: an HDF5 file but not an efdem run file" "plot_icdf, other HDF5" \
+  $py "$src/scripts/plot_icdf.py" "$work/other.h5"
+expect 2 "nosamples.h5: the run file has no /samples/mean" "plot_icdf, no samples" \
+  $py "$src/scripts/plot_icdf.py" "$work/nosamples.h5"
+expect 2 "cannot be written" "plot_icdf, output folder missing" \
+  $py "$src/scripts/plot_icdf.py" "$work/direct.h5" -o "$work/no/such/folder/x.png"
+
+# demo_summary: the real pair, then constructed pairs whose answers are known.
+out=$($py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/cpi.h5" 2>&1); code=$?
+for line in "RMS difference of the ensemble means" "inside the direct ensemble's 95 % band" \
+            "within 1.96 standard errors of the difference" "DEM-time speed-up of CPI (simulated / DEM time)" \
+            "wall-time ratio direct / CPI"; do
+  [ $code -eq 0 ] && grep -qF "$line" <<< "$out" && pass "demo_summary: '$line'" || fail "demo_summary lacks '$line': $out"
+done
+# The speed-up is simulated / DEM time of the cpi file, printed to 2 decimals.
+want=$($py -c "import h5py, sys; f = h5py.File(sys.argv[1]); print(f'{f.attrs[\"simulated_time\"] / f.attrs[\"dem_time\"]:.2f}x')" "$work/cpi.h5")
+grep -qF "speed-up of CPI (simulated / DEM time) $want" <<< "$out" && pass "speed-up $want" || fail "speed-up is not $want: $out"
+$py - "$work" <<'PY' || fail "could not make the constructed pairs"
+import shutil, sys, h5py
+w = sys.argv[1]
+for name, shift in (("same", 0.0), ("shifted", 1.0)):
+    shutil.copy(f"{w}/direct.h5", f"{w}/{name}.h5")
+    with h5py.File(f"{w}/{name}.h5", "a") as f:
+        f.attrs["mode"] = "cpi"
+        f["samples/mean"][...] = f["samples/mean"][...] + shift
+PY
+# Equal means: every difference is 0 (<= any band); shifted by 1 d_p everywhere: RMS exactly 1.
+expect 0 "RMS difference of the ensemble means (CPI - direct): 0.000 d_p" "demo_summary, equal means" \
+  $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
+expect 0 "95 % band of its mean: 100 % of points" "demo_summary, equal means inside" \
+  $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
+expect 0 "RMS difference of the ensemble means (CPI - direct): 1.000 d_p" "demo_summary, shifted by 1" \
+  $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/shifted.h5"
+expect 2 "expected 2 arguments" "demo_summary without arguments" $py "$src/scripts/demo_summary.py"
+expect 2 "cpi.h5: a cpi run; expected the direct run here" "demo_summary, runs swapped" \
+  $py "$src/scripts/demo_summary.py" "$work/cpi.h5" "$work/direct.h5"
+expect 2 "missing.h5: no such file" "demo_summary, missing file" \
+  $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/missing.h5"
+
+# plot_validation: no arguments, no folder, a folder without its CSVs, a CSV without its columns.
+mkdir -p "$work/empty" "$work/bad"
+printf 'a,b\n1,2\n' > "$work/bad/dp_sweep_light.csv"
+expect 2 "expected 2 arguments" "plot_validation without arguments" $py "$src/scripts/plot_validation.py"
+expect 2 "not a folder" "plot_validation, missing folder" $py "$src/scripts/plot_validation.py" "$work/nope" "$work/fig"
+expect 2 "no validation CSV files in" "plot_validation, empty folder" \
+  $py "$src/scripts/plot_validation.py" "$work/empty" "$work/fig"
+expect 2 "dp_sweep: a CSV in" "plot_validation, malformed CSV" \
+  $py "$src/scripts/plot_validation.py" "$work/bad" "$work/fig"
+
+[ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
