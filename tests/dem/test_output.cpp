@@ -13,6 +13,7 @@
 
 #include "dem/io/thermo_log.hpp"
 #include "dem/io/vtk_writer.hpp"
+#include "tests/support/csv_table.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;
@@ -109,8 +110,8 @@ TEST_CASE("the VTK series writes one .vtp per snapshot and a .pvd that lists the
         CHECK(appended_array<double>(vtp, name).size() == (std::string(name) == "mass" ? 3u : 9u));
 }
 
-TEST_CASE("the thermo log writes a header and one line per call", "[unit][io]") {
-    const auto file = std::filesystem::temp_directory_path() / "efdem_thermo_test.log";
+TEST_CASE("the thermo log is CSV as pandas reads it: column names first, one row per call", "[unit][io]") {
+    const auto file = std::filesystem::temp_directory_path() / "efdem_thermo_test.csv";
     System s = three_particles();
     {
         ThermoLog log(file);
@@ -118,23 +119,16 @@ TEST_CASE("the thermo log writes a header and one line per call", "[unit][io]") 
         s.run(100);
         log.write(s);
     }
-    std::ifstream in(file);
-    std::string line;
-    int header = 0, rows = 0;
-    long last_step = -1;
-    while (std::getline(in, line)) {
-        if (line.rfind("#", 0) == 0) {
-            ++header;
-            continue;
-        }
-        std::istringstream ss(line);
-        ss >> last_step;
-        ++rows;
-    }
-    CHECK(header == 2);
-    CHECK(rows == 2);
-    CHECK(last_step == 100);
-    CHECK_THROWS_AS(ThermoLog("/nonexistent_dir/x.log"), RuntimeFailure);
+    const test::CsvTable t = test::read_csv_table(file);
+    CHECK(t.header == std::vector<std::string>{"step", "time", "ke_trans_per_particle", "ke_rot_per_particle",
+                                               "contacts_per_particle", "wall_contacts", "max_overlap",
+                                               "neighbor_builds"});
+    REQUIRE(t.rows.size() == 2);
+    CHECK(t.ragged_rows() == 0);
+    CHECK(t.rows.back()[0] == "100");
+    // time = 100 steps of dt = 1e-4, printed with 10 significant digits.
+    CHECK(std::stod(t.rows.back()[1]) == Approx(0.01).epsilon(1e-9));
+    CHECK_THROWS_AS(ThermoLog("/nonexistent_dir/x.csv"), RuntimeFailure);
 }
 
 TEST_CASE("a full disk under the thermo log is a runtime failure that says no space left", "[unit][output]") {
