@@ -69,12 +69,19 @@ def run(args, name):
 
 
 def read_vtp(path):
-    """Positions and species of a .vtp file written by efdem (ASCII data arrays)."""
-    text = open(path).read()
+    """Positions and species of a .vtp file written by efdem: raw appended data, each block a
+    UInt64 byte count and the values (docs/output_vtk_csv.md), read without VTK."""
+    data = open(path, "rb").read()
+    start = data.index(b'<AppendedData encoding="raw">')
+    base = data.index(b"_", start) + 1
+    order = "<" if b'byte_order="LittleEndian"' in data[:start] else ">"
+    types = {"Float64": "f8", "Int32": "i4", "Int64": "i8"}
 
     def array(name):
-        m = re.search(rf'Name="{name}"[^>]*>\n(.*?)\n\s*</DataArray>', text, re.S)
-        return np.array(m.group(1).split(), dtype=float)
+        m = re.search(rf'type="(\w+)" Name="{name}"[^>]*offset="(\d+)"'.encode(), data[:start])
+        at = base + int(m.group(2))
+        size = int(np.frombuffer(data, order + "u8", 1, at)[0])
+        return np.frombuffer(data[at + 8:at + 8 + size], order + types[m.group(1).decode()])
 
     return array("position").reshape(-1, 3), array("species").astype(int)
 

@@ -5,8 +5,8 @@
 #   bash scripts/slurm_job.sh SCENE [KEY=VALUE...]
 #
 # * If the run's newest checkpoint exists (and its run is not complete), continues from it
-#   (restart=...); otherwise starts the run. A run whose CSV says "# end: completed" is not
-#   run again.
+#   (restart=...); otherwise starts the run. A run whose CSV sidecar (PREFIX_csv_meta.json)
+#   says end_status "completed" is not run again.
 # * The batch script asks Slurm for a warning signal, `#SBATCH --signal=B:USR1@600`: ten minutes
 #   before the time limit Slurm sends SIGUSR1 to the batch shell, which forwards it to the job
 #   step; srun delivers it to every rank; efdem stops at its next sample, writes a checkpoint and
@@ -30,7 +30,7 @@ run_file=$(sed -n 's/^run file: //p' <<< "$report")
 checkpoints=$(sed -n 's/^checkpoints: //p' <<< "$report")
 outdir=$(dirname "$run_file"); prefix=$(basename "$run_file" .h5); ckdir=$(dirname "$checkpoints")
 
-if [ -n "$run_file" ] && grep -q '^# end: completed' "$outdir/${prefix}_mean_icdf.csv" 2>/dev/null; then
+if [ -n "$run_file" ] && grep -q '^  "end_status": "completed",$' "$outdir/${prefix}_csv_meta.json" 2>/dev/null; then
   echo "slurm_job: $outdir/$prefix is complete; nothing to do"
   exit 0
 fi

@@ -11,17 +11,7 @@ BedTimeSeries::BedTimeSeries(const std::filesystem::path& file, const System& s)
     : file_(std::fopen(file.string().c_str(), "w")) {
     if (!file_)
         throw RuntimeFailure("cannot open the bed time series " + file.string() + " for writing");
-    fmt::print(file_,
-               "# efdem bed time series (dem/io/bed_time_series.hpp)\n"
-               "# units: length d_p, time sqrt(d_p/g), pressure rho_s g d_p, energy rho_s g d_p^4\n"
-               "# step: step count; time: simulated time\n"
-               "# pressure_drop: gas pressure drop across the bed (= vertical gas force / area; 0 "
-               "without gas_drag)\n"
-               "# weight_per_area: bed weight / area (the fluidized plateau of pressure_drop)\n"
-               "# bed_height: height below which 99 % of the particle volume lies\n"
-               "# z_com: centre-of-mass height of all particles; z_com_<name>: of one species\n"
-               "# ke_per_particle: translational + rotational kinetic energy per particle\n"
-               "step,time,pressure_drop,weight_per_area,bed_height,z_com");
+    fmt::print(file_, "step,time,pressure_drop,weight_per_area,bed_height,z_com");
     for (std::size_t k = 0; k < s.species().size(); ++k)
         fmt::print(file_, ",z_com_{}", s.species()[static_cast<SpeciesId>(k)].name);
     fmt::print(file_, ",ke_per_particle\n");

@@ -4,11 +4,13 @@
 /// per call, for plots of Delta P(t), H(t), the species' centre-of-mass heights and for the
 /// travelling-wave period (coarse::estimate_period on z_com).
 ///
-/// Format: `#` comment lines first (what the file is, units of every column), then one header
-/// row of column names, then comma-separated rows; e.g. pandas.read_csv(f, comment='#').
-/// Columns: step, time [sqrt(d_p/g)], pressure_drop [rho_s g d_p], weight_per_area
-/// [rho_s g d_p], bed_height (99 % of the particle volume) [d_p], z_com (all) [d_p],
-/// z_com_<species> [d_p] for every species, ke_per_particle [rho_s g d_p^4].
+/// Format: CSV that `pandas.read_csv(f)` reads as it is: one header row of column names, then
+/// comma-separated rows; no comment lines. Columns (efdem's reduced units): step, time
+/// [sqrt(d_p/g)], pressure_drop (gas pressure drop across the bed = vertical gas force / area;
+/// 0 without gas_drag) [rho_s g d_p], weight_per_area (the fluidized plateau of pressure_drop)
+/// [rho_s g d_p], bed_height (99 % of the particle volume lies below it) [d_p], z_com (all)
+/// [d_p], z_com_<species> [d_p] for every species, ke_per_particle (translational +
+/// rotational) [rho_s g d_p^4].
 
 #include <cstdio>
 #include <filesystem>

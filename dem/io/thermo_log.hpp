@@ -1,11 +1,13 @@
 #pragma once
 /// \file
-/// ThermoLog: one line per call with the state of a realization (LAMMPS `thermo` style), as a
-/// whitespace-separated table with a commented header, for scripts and for eyes.
+/// ThermoLog: one row per call with the state of a realization (LAMMPS `thermo` style), as CSV
+/// that `pandas.read_csv(file)` reads as it is: the first line names the columns, every other
+/// line is a row of numbers; no comment lines.
 ///
-/// Columns: step, time [sqrt(d_p/g)], ke_trans and ke_rot per particle [rho_s g d_p^4],
-/// contacts per particle, wall contacts, max overlap [fraction of the pair's diameter],
-/// neighbour-list builds so far.
+/// Columns (units are efdem's reduced units, docs/output_vtk_csv.md): `step`; `time`
+/// [sqrt(d_p/g)]; `ke_trans_per_particle`, `ke_rot_per_particle` [rho_s g d_p^4];
+/// `contacts_per_particle`; `wall_contacts`; `max_overlap` [fraction of the pair's diameter];
+/// `neighbor_builds` (neighbour-list builds so far).
 
 #include <cstdio>
 #include <filesystem>
@@ -16,7 +18,7 @@ namespace efdem::dem {
 
 class ThermoLog {
 public:
-    /// Opens (truncates) `file` and writes the header; RuntimeFailure if it cannot.
+    /// Opens (truncates) `file` and writes the header row; RuntimeFailure if it cannot.
     explicit ThermoLog(const std::filesystem::path& file);
     ~ThermoLog();
     ThermoLog(const ThermoLog&) = delete;

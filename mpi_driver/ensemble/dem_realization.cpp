@@ -19,7 +19,7 @@ DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem:
     : system_(std::move(system)), observed_(observed), other_(other), output_(output), bed_(bed) {
     const std::string stem = fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
     if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
-    if (output_.thermo_every > 0) thermo_ = std::make_unique<dem::ThermoLog>(output_.directory / (stem + "_thermo.log"));
+    if (output_.thermo_every > 0) thermo_ = std::make_unique<dem::ThermoLog>(output_.directory / (stem + "_thermo.csv"));
     if (!restarting) after_sample(0);
 }
 

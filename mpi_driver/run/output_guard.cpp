@@ -18,7 +18,7 @@ bool digits(std::string_view s) {
 }
 
 /// `name` (without a trailing .tmp) is a per-realization file of `prefix`: PREFIX_rNNNN.pvd,
-/// PREFIX_rNNNN_NNNNNN.vtp or PREFIX_rNNNN_thermo.log, with _contNNNNNNNN after rNNNN in a
+/// PREFIX_rNNNN_NNNNNN.vtp or PREFIX_rNNNN_thermo.csv, with _contNNNNNNNN after rNNNN in a
 /// restarted run's files.
 bool is_realization_file(std::string_view name, const std::string& prefix) {
     const std::string head = prefix + "_r";
@@ -28,14 +28,14 @@ bool is_realization_file(std::string_view name, const std::string& prefix) {
     if (end == 0 || end == std::string_view::npos) return false;
     rest = rest.substr(end);
     if (rest.substr(0, 5) == "_cont" && rest.size() > 13 && digits(rest.substr(5, 8))) rest = rest.substr(13);
-    if (rest == ".pvd" || rest == "_thermo.log") return true;
+    if (rest == ".pvd" || rest == "_thermo.csv") return true;
     return rest.size() > 5 && rest[0] == '_' && rest.substr(rest.size() - 4) == ".vtp" &&
            digits(rest.substr(1, rest.size() - 5));
 }
 
 bool is_run_file(std::string_view name, const std::string& prefix) {
     return name == prefix + ".h5" || name == prefix + ".h5.reserve" || name == prefix + "_mean_icdf.csv" ||
-           name == prefix + "_cpi_steps.csv";
+           name == prefix + "_cpi_steps.csv" || name == prefix + "_csv_meta.json";
 }
 
 void collect(const std::filesystem::path& dir, const std::string& prefix, bool checkpoints,

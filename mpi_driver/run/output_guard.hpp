@@ -18,8 +18,9 @@
 namespace efdem::mpi_driver {
 
 /// The files of a run with `settings`' prefix that exist: in output.directory the run file,
-/// the CSV files, every realization's VTK series (.pvd, .vtp) and thermo log; in
-/// checkpoint.directory its checkpoints; and the .tmp files of any of them. Sorted.
+/// the CSV files and their sidecar (_csv_meta.json), every realization's VTK series (.pvd,
+/// .vtp) and thermo log (_thermo.csv); in checkpoint.directory its checkpoints; and the .tmp
+/// files of any of them. Sorted.
 std::vector<std::filesystem::path> existing_run_files(const RunSettings& settings);
 
 /// Why `directory` cannot be written to (it or its nearest existing parent is not a writable

@@ -11,6 +11,7 @@
 #include "dem/beds/bed_diagnostics.hpp"
 #include "dem/beds/bed_observation.hpp"
 #include "dem/io/bed_time_series.hpp"
+#include "tests/support/csv_table.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;
@@ -59,7 +60,7 @@ TEST_CASE("bed height, centre-of-mass heights and phi(z) of a simple-cubic stack
     CHECK(bed_height(Particles{}) == 0.0);
 }
 
-TEST_CASE("the bed time series writes a commented header, column names and one row per call",
+TEST_CASE("the bed time series is CSV as pandas reads it: column names first, one row per call",
           "[unit][diagnostics][io]") {
     const auto file = std::filesystem::temp_directory_path() / "efdem_bed_series_test.csv";
     const auto species = test::binary_species();
@@ -72,30 +73,12 @@ TEST_CASE("the bed time series writes a commented header, column names and one r
         s.run(10);
         series.write(s);
     }
-    std::ifstream in(file);
-    std::string line, header;
-    int comments = 0, rows = 0;
-    std::vector<std::string> last;
-    while (std::getline(in, line)) {
-        if (line.rfind("#", 0) == 0) {
-            ++comments;
-            continue;
-        }
-        if (header.empty()) {
-            header = line;
-            continue;
-        }
-        ++rows;
-        last.clear();
-        std::stringstream ss(line);
-        for (std::string cell; std::getline(ss, cell, ',');) last.push_back(cell);
-    }
-    CHECK(comments >= 3);
-    CHECK(header ==
-          "step,time,pressure_drop,weight_per_area,bed_height,z_com,z_com_light,"
-          "z_com_heavy,ke_per_particle");
-    CHECK(rows == 2);
-    REQUIRE(last.size() == 9);
+    const test::CsvTable t = test::read_csv_table(file);
+    CHECK(t.header == std::vector<std::string>{"step", "time", "pressure_drop", "weight_per_area", "bed_height",
+                                               "z_com", "z_com_light", "z_com_heavy", "ke_per_particle"});
+    REQUIRE(t.rows.size() == 2);
+    CHECK(t.ragged_rows() == 0);
+    const auto& last = t.rows.back();
     CHECK(last[0] == "10");
     CHECK(std::stod(last[1]) == Approx(0.01));
     CHECK(std::stod(last[2]) == Approx(pressure_drop(s)).epsilon(1e-9));

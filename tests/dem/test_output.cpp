@@ -1,12 +1,19 @@
 // VTK series and thermo log: the files exist, are complete, and hold what was written.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "dem/io/thermo_log.hpp"
 #include "dem/io/vtk_writer.hpp"
+#include "tests/support/csv_table.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;
@@ -30,6 +37,29 @@ System three_particles() {
     fx.gravity().pair(test::paper_contact(), species).wall(test::paper_contact(), species);
     return test::make_system(species, {5, 5}, std::move(p), std::move(fx), 1e-4);
 }
+
+
+/// The values of array `name` of a .vtp file written with raw appended data and UInt64 block
+/// headers, read the way a VTK reader does: the DataArray's offset counts from the byte after
+/// the '_' that opens the appended data; there a UInt64 byte count precedes the values.
+template <class T>
+std::vector<T> appended_array(const std::string& vtp, const std::string& name) {
+    const std::size_t element = vtp.find("Name=\"" + name + "\"");
+    REQUIRE(element != std::string::npos);
+    const std::size_t at = vtp.find("offset=\"", element) + 8;
+    const std::size_t offset = std::stoul(vtp.substr(at, vtp.find('"', at) - at));
+    const std::size_t start = vtp.find("<AppendedData encoding=\"raw\">");
+    REQUIRE(start != std::string::npos);
+    const std::size_t block = vtp.find('_', start) + 1 + offset;
+    std::uint64_t bytes = 0;
+    REQUIRE(block + sizeof bytes <= vtp.size());
+    std::memcpy(&bytes, vtp.data() + block, sizeof bytes);
+    REQUIRE(bytes % sizeof(T) == 0);
+    REQUIRE(block + sizeof bytes + bytes <= vtp.size());
+    std::vector<T> values(bytes / sizeof(T));
+    std::memcpy(values.data(), vtp.data() + block + sizeof bytes, bytes);
+    return values;
+}
 }  // namespace
 
 TEST_CASE("the VTK series writes one .vtp per snapshot and a .pvd that lists them", "[unit][io]") {
@@ -46,17 +76,42 @@ TEST_CASE("the VTK series writes one .vtp per snapshot and a .pvd that lists the
     CHECK(pvd.find("file=\"bed_000000.vtp\"") != std::string::npos);
     CHECK(pvd.find("timestep=\"0.001\" part=\"0\" file=\"bed_000001.vtp\"") != std::string::npos);
     const std::string vtp = slurp(dir / "bed_000001.vtp");
-    CHECK(vtp.find("NumberOfPoints=\"3\"") != std::string::npos);
-    for (const char* name : {"velocity", "angular_velocity", "radius", "mass", "species", "tag"})
-        CHECK(vtp.find(std::string("Name=\"") + name + "\"") != std::string::npos);
-    CHECK(vtp.find("</VTKFile>") != std::string::npos);
-    // The tag array holds the permanent ids (in the current particle order).
-    CHECK(vtp.find("\n7\n") != std::string::npos);
-    CHECK(vtp.find("\n9\n") != std::string::npos);
+    const char* order = std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian";
+    CHECK(vtp.find(fmt::format("byte_order=\"{}\" header_type=\"UInt64\"", order)) != std::string::npos);
+    CHECK(vtp.find("NumberOfPoints=\"3\" NumberOfVerts=\"3\"") != std::string::npos);
+    CHECK(vtp.find("format=\"ascii\"") == std::string::npos);
+    CHECK(vtp.substr(vtp.size() - 30).find("</AppendedData>\n</VTKFile>\n") != std::string::npos);
+    // The tag array holds the permanent ids (7, 8, 9) in the current particle order; species
+    // the index into species_names (light, heavy); each particle is its own vertex cell.
+    const Particles& p = s.particles();
+    const auto tags = appended_array<std::int64_t>(vtp, "tag");
+    CHECK(std::vector<std::int64_t>(p.tag().begin(), p.tag().end()) == tags);
+    CHECK(std::is_permutation(tags.begin(), tags.end(), std::vector<std::int64_t>{7, 8, 9}.begin()));
+    CHECK(appended_array<std::int32_t>(vtp, "species") == std::vector<std::int32_t>(p.species().begin(), p.species().end()));
+    CHECK(appended_array<std::int64_t>(vtp, "connectivity") == std::vector<std::int64_t>{0, 1, 2});
+    CHECK(appended_array<std::int64_t>(vtp, "offsets") == std::vector<std::int64_t>{1, 2, 3});
+    const auto names = appended_array<char>(vtp, "species_names");
+    CHECK(std::string(names.begin(), names.end()) == std::string("light\0heavy\0", 12));
+    // Float64 values are the doubles themselves (no decimal rounding): the positions and time
+    // compare exactly with the System's.
+    const auto x = appended_array<double>(vtp, "position");
+    REQUIRE(x.size() == 9);
+    for (std::size_t i = 0; i < 3; ++i) {
+        CHECK(x[3 * i] == p.x()[i].x);
+        CHECK(x[3 * i + 2] == p.x()[i].z);
+    }
+    CHECK(appended_array<double>(vtp, "TimeValue") == std::vector<double>{s.time()});
+    const auto r = appended_array<double>(vtp, "radius");
+    const auto d = appended_array<double>(vtp, "diameter");
+    REQUIRE(r.size() == 3);
+    REQUIRE(d.size() == 3);
+    for (std::size_t i = 0; i < 3; ++i) CHECK(d[i] == 2 * r[i]);
+    for (const char* name : {"velocity", "angular_velocity", "mass"})
+        CHECK(appended_array<double>(vtp, name).size() == (std::string(name) == "mass" ? 3u : 9u));
 }
 
-TEST_CASE("the thermo log writes a header and one line per call", "[unit][io]") {
-    const auto file = std::filesystem::temp_directory_path() / "efdem_thermo_test.log";
+TEST_CASE("the thermo log is CSV as pandas reads it: column names first, one row per call", "[unit][io]") {
+    const auto file = std::filesystem::temp_directory_path() / "efdem_thermo_test.csv";
     System s = three_particles();
     {
         ThermoLog log(file);
@@ -64,23 +119,16 @@ TEST_CASE("the thermo log writes a header and one line per call", "[unit][io]") 
         s.run(100);
         log.write(s);
     }
-    std::ifstream in(file);
-    std::string line;
-    int header = 0, rows = 0;
-    long last_step = -1;
-    while (std::getline(in, line)) {
-        if (line.rfind("#", 0) == 0) {
-            ++header;
-            continue;
-        }
-        std::istringstream ss(line);
-        ss >> last_step;
-        ++rows;
-    }
-    CHECK(header == 2);
-    CHECK(rows == 2);
-    CHECK(last_step == 100);
-    CHECK_THROWS_AS(ThermoLog("/nonexistent_dir/x.log"), RuntimeFailure);
+    const test::CsvTable t = test::read_csv_table(file);
+    CHECK(t.header == std::vector<std::string>{"step", "time", "ke_trans_per_particle", "ke_rot_per_particle",
+                                               "contacts_per_particle", "wall_contacts", "max_overlap",
+                                               "neighbor_builds"});
+    REQUIRE(t.rows.size() == 2);
+    CHECK(t.ragged_rows() == 0);
+    CHECK(t.rows.back()[0] == "100");
+    // time = 100 steps of dt = 1e-4, printed with 10 significant digits.
+    CHECK(std::stod(t.rows.back()[1]) == Approx(0.01).epsilon(1e-9));
+    CHECK_THROWS_AS(ThermoLog("/nonexistent_dir/x.csv"), RuntimeFailure);
 }
 
 TEST_CASE("a full disk under the thermo log is a runtime failure that says no space left", "[unit][output]") {
@@ -105,7 +153,7 @@ TEST_CASE("a VTK frame that cannot be written leaves neither the frame nor its .
     const auto dir = std::filesystem::temp_directory_path() / "efdem_vtk_missing_dir_test";
     std::filesystem::remove_all(dir);
     const System sys = three_particles();
-    CHECK_THROWS_AS(write_vtp(dir / "frame.vtp", sys.particles()), RuntimeFailure);
+    CHECK_THROWS_AS(write_vtp(dir / "frame.vtp", sys), RuntimeFailure);
     CHECK_FALSE(std::filesystem::exists(dir / "frame.vtp"));
     CHECK_FALSE(std::filesystem::exists(dir / "frame.vtp.tmp"));
 }

@@ -42,8 +42,22 @@ status = h5py.File(os.path.join(out, "efdem.h5"), "r").attrs["end_status"]
 status = status.decode() if isinstance(status, bytes) else str(status)
 assert status.startswith("failed:") and "no space left" in status.lower(), status
 assert not glob.glob(os.path.join(out, "*.vtp.tmp")), "a partial VTK frame was left"
-for f in glob.glob(os.path.join(out, "*.vtp")) + glob.glob(os.path.join(out, "*.pvd")):
-    ET.parse(f)  # every frame and series file left is whole
+def vtp_is_whole(path):
+    """The XML part parses and every appended block (UInt64 byte count + bytes) lies inside the
+    file, which ends right after the last block with the closing tags."""
+    data = open(path, "rb").read()
+    start = data.index(b'<AppendedData encoding="raw">')
+    head = ET.fromstring(data[:start] + b"</VTKFile>")
+    base = data.index(b"_", start) + 1
+    end = base
+    for a in head.iter("DataArray"):
+        at = base + int(a.get("offset"))
+        end = max(end, at + 8 + int.from_bytes(data[at:at + 8], sys.byteorder))
+    return data[end:] == b"\n  </AppendedData>\n</VTKFile>\n"
+for f in glob.glob(os.path.join(out, "*.vtp")):
+    assert vtp_is_whole(f), f"{f} is cut short"  # every frame left is whole
+for f in glob.glob(os.path.join(out, "*.pvd")):
+    ET.parse(f)  # and every series file
 for f in glob.glob(os.path.join(ck, "*_ckpt_????????.h5")):
     with h5py.File(f, "r") as c:
         assert c.attrs["complete"] == 1, f

@@ -42,8 +42,8 @@ efd "$efdem" "$scene" mode=direct run.duration=1 seed=5 output.directory="$out" 
 code=$?
 seed=$(/usr/bin/python3 -c "import h5py; print(h5py.File('$out/efdem.h5', 'r').attrs['seed'])")
 if [ $code -eq 0 ] && [ -z "$(ls "$out" | grep -E '\.(vtp|pvd)$')" ] && [ "$seed" = "5" ] \
-   && grep -q "deleted the 8 file(s) of the earlier run" "$work/overwrite.log"; then
-  echo "PASS: output.overwrite = true replaced the earlier run (all 8 of its files, 5 VTK frames among them, were deleted first)"
+   && grep -q "deleted the 9 file(s) of the earlier run" "$work/overwrite.log"; then
+  echo "PASS: output.overwrite = true replaced the earlier run (all 9 of its files, 5 VTK frames and the CSV sidecar among them, were deleted first)"
 else
   grep -v "^t = " "$work/overwrite.log"; ls "$out"; fail "overwrite: exit $code, seed $seed"
 fi
@@ -73,7 +73,7 @@ efd "$efdem" "$scene" mode=direct run.duration=2 output.vtk_interval=0.5 output.
   output.directory="$work/cont" restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/cont2.log" 2>&1
 code=$?
 if [ $code -eq 0 ] && [ "$(cd "$work/cont" && sha256sum efdem_r0000* | grep -v _cont | sort)" = "$kept" ] \
-   && [ -f "$work/cont/efdem_r0000_cont00000004_000000.vtp" ] && [ -f "$work/cont/efdem_r0000_cont00000004_thermo.log" ]; then
+   && [ -f "$work/cont/efdem_r0000_cont00000004_000000.vtp" ] && [ -f "$work/cont/efdem_r0000_cont00000004_thermo.csv" ]; then
   echo "PASS: a restart's VTK frames and thermo log are new files (_cont00000004); the continued run's are unchanged"
 else
   grep -v "^t = " "$work/cont2.log"; ls "$work/cont"; fail "restart output files (exit $code)"
