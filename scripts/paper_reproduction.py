@@ -70,7 +70,7 @@ def run(args, name):
 
 def read_vtp(path):
     """Positions and species of a .vtp file written by efdem: raw appended data, each block a
-    UInt64 byte count and the values (docs/output_vtk_csv.md), read without VTK."""
+    UInt64 byte count and the values (docs/output.md), read without VTK."""
     data = open(path, "rb").read()
     start = data.index(b'<AppendedData encoding="raw">')
     base = data.index(b"_", start) + 1

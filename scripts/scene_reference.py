@@ -8,7 +8,8 @@ The keys: `efdem --list-keys` (every key a scene's set-up reads, with what it ac
 default, from the code's own declarations: core/param_table.hpp KeyDeclaration) on a matrix of
 scenes and overrides that switches on every mode and option (SCENES below). The check fails when
   * a key the code reads is not a row of the page,
-  * a row's `allowed` cell is not what the code accepts (its text, verbatim),
+  * a row's `allowed` cell is not what the code accepts (its text, verbatim; where that depends
+    on the scene, e.g. bounds from the box, a cell `depends on ...`),
   * a row's `default` cell is not the code's default (verbatim; `required` for a required key;
     a default the code derives from other keys is written `derived: ...`),
   * a row's meaning is empty, or a row names a key no scene reads and the source never names,
@@ -76,7 +77,9 @@ def list_keys(efdem):
                 sys.exit(f"scene_reference.py: {' '.join(cmd)} failed ({r.returncode}):\n{r.stderr}{r.stdout}")
             for line in r.stdout.splitlines():
                 key, expected, default = line.split("\t")
-                keys.setdefault(key, {"expected": expected, "defaults": set()})["defaults"].add(default)
+                entry = keys.setdefault(key, {"expected": set(), "defaults": set()})
+                entry["expected"].add(expected)
+                entry["defaults"].add(default)
     return keys
 
 
@@ -84,7 +87,7 @@ def page_rows(path):
     rows = {}
     with open(path, encoding="utf-8") as f:
         for n, line in enumerate(f, 1):
-            m = re.match(r"^\|\s*`([a-z_0-9.]+)`\s*\|(.*)\|\s*$", line)
+            m = re.match(r"^\|\s*`([A-Za-z_0-9.]+)`\s*\|(.*)\|\s*$", line)
             if not m:
                 continue
             cells = [c.strip() for c in m.group(2).split("|")]
@@ -117,21 +120,26 @@ def main():
     keys = list_keys(a.efdem)
     if a.keys:
         for k, v in keys.items():
-            print(f"{k}\t{v['expected']}\t{' | '.join(sorted(v['defaults']))}")
+            print(f"{k}\t{' | '.join(sorted(v['expected']))}\t{' | '.join(sorted(v['defaults']))}")
         return 0
     rows = page_rows(a.page)
     errors = []
     for k, v in keys.items():
         row = rows.get(k)
         if row is None:
-            errors.append(f"`{k}` is read by the code ({v['expected']}; default {' | '.join(sorted(v['defaults']))}) "
+            errors.append(f"`{k}` is read by the code ({' | '.join(sorted(v['expected']))}; default {' | '.join(sorted(v['defaults']))}) "
                           f"but has no row in {os.path.relpath(a.page, ROOT)}")
             continue
         where = f"{os.path.relpath(a.page, ROOT)}:{row['line']}: `{k}`"
         if not row["meaning"]:
             errors.append(f"{where}: no meaning")
-        if row["allowed"] != v["expected"]:
-            errors.append(f"{where}: allowed '{row['allowed']}', the code accepts '{v['expected']}'")
+        expected = v["expected"]
+        if len(expected) > 1:
+            if not row["allowed"].startswith("depends on"):
+                errors.append(f"{where}: what the code accepts depends on the scene ({' | '.join(sorted(expected))}): "
+                              "write it as 'depends on ...'")
+        elif row["allowed"] != next(iter(expected)):
+            errors.append(f"{where}: allowed '{row['allowed']}', the code accepts '{next(iter(expected))}'")
         defaults = v["defaults"]
         if row["default"].startswith("derived:"):
             pass

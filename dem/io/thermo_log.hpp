@@ -4,7 +4,7 @@
 /// that `pandas.read_csv(file)` reads as it is: the first line names the columns, every other
 /// line is a row of numbers; no comment lines.
 ///
-/// Columns (units are efdem's reduced units, docs/output_vtk_csv.md): `step`; `time`
+/// Columns (units are efdem's reduced units, docs/output.md): `step`; `time`
 /// [sqrt(d_p/g)]; `ke_trans_per_particle`, `ke_rot_per_particle` [rho_s g d_p^4];
 /// `contacts_per_particle`; `wall_contacts`; `max_overlap` [fraction of the pair's diameter];
 /// `neighbor_builds` (neighbour-list builds so far).
