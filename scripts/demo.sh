@@ -24,4 +24,6 @@ mpirun -np 2 --oversubscribe "$build/mpi_driver/efdem" "$scene" mode=cpi seed=2 
   --title "demo_small: light-particle heights, direct vs adaptive CPI (R = 4, independent seeds)"
 # The two compared at the same times, and the cost, each number labelled (scripts/demo_summary.py).
 /usr/bin/python3 "$src/scripts/demo_summary.py" "$out/direct.h5" "$out/cpi.h5"
-echo "plot: $out/icdf.png"
+# What the bed does meanwhile (observe.bed in the scene): pressure drop, height, mixing index, phi(z).
+/usr/bin/python3 "$src/scripts/plot_bed.py" "$out/direct.h5" "$out/cpi.h5" -o "$out/bed.png"
+echo "plots: $out/icdf.png, $out/bed.png"

@@ -20,12 +20,7 @@ using namespace efdem;
 using namespace efdem::dem;
 
 namespace {
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using test::slurp;
 
 System three_particles() {
     const auto species = test::binary_species();

@@ -15,12 +15,7 @@ using namespace efdem;
 using namespace efdem::mpi_driver;
 
 namespace {
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using test::slurp;
 
 RunProvenance cpi_provenance() {
     RunProvenance p;

@@ -11,7 +11,7 @@
 # * every `mpirun` line gets overrides appended that make it short (a smaller bed and run, short
 #   cpi bursts): the README's durations take minutes.
 # Asserted: the block has the commands the README promises (list, check, a direct and a cpi
-# run, the plot, the summary); every command exits 0 (so the output guard refuses none); every
+# run, the plots, the summary); every command exits 0 (so the output guard refuses none); every
 # run's file says 'completed'; the plot's PNG exists.
 #   quick_start.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 source "$(dirname "$0")/lib.sh" "$@"
@@ -32,7 +32,7 @@ export mpiexec
 
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-for want in "efdem --list-effects" "efdem --check" "mode=direct" "mode=cpi" "scripts/plot_icdf.py" "scripts/demo_summary.py"; do
+for want in "efdem --list-effects" "efdem --check" "efdem --list-keys" "scripts/plot_bed.py" "mode=direct" "mode=cpi" "scripts/plot_icdf.py" "scripts/demo_summary.py"; do
   grep -qF -- "$want" <<< "$block" || fail "the Quick start block has no command with '$want'"
 done
 
@@ -64,7 +64,10 @@ for prefix in $(grep -o 'output\.prefix=[^ ]*' <<< "$block" | cut -d= -f2); do
            "runs/demo_small/$prefix.h5" 2>&1 | tail -1)
   [[ $status == completed* ]] && echo "PASS: $prefix.h5: $status" || fail "runs/demo_small/$prefix.h5: $status"
 done
-png=$(grep -o -- '-o [^ ]*\.png' <<< "$block" | cut -c4-)
-[ -n "$png" ] && [ -s "$png" ] && echo "PASS: $png written" || fail "the plot '$png' was not written"
+pngs=$(grep -o -- '-o [^ ]*\.png' <<< "$block" | cut -c4-)
+[ -n "$pngs" ] || fail "the Quick start block writes no plot"
+for png in $pngs; do
+  [ -s "$png" ] && echo "PASS: $png written" || fail "the plot '$png' was not written"
+done
 
 [ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }

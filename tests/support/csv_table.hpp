@@ -23,6 +23,14 @@ struct CsvTable {
     }
 };
 
+/// The whole text of a file ("" if it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
 inline std::vector<std::string> csv_fields(const std::string& line) {
     std::vector<std::string> out;
     std::stringstream ss(line);
