@@ -1,0 +1,83 @@
+#include "coarse/equation_free/coarse_map.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include "coarse/equation_free/ensemble_statistics.hpp"
+#include "core/contracts.hpp"
+
+namespace efdem::coarse {
+
+CoarseMap::CoarseMap(CoarseStepper& stepper, const CoarseMapSettings& settings,
+                     std::function<void(double)> set_parameter)
+    : stepper_(stepper), settings_(settings), set_parameter_(std::move(set_parameter)) {
+    EFDEM_EXPECTS(settings_.tau > 0.0 && settings_.difference_step > 0.0);
+    EFDEM_EXPECTS(!settings_.common_random_numbers || stepper_.can_keep_state());
+}
+
+MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
+    EFDEM_EXPECTS(set_parameter_ || parameter == 0.0);
+    if (set_parameter_) set_parameter_(parameter);
+    stepper_.lift(x, stepper_.time());
+    BurstSamples burst;
+    stepper_.run(settings_.tau, burst);
+    EFDEM_ASSERT(burst.size() >= 1 && burst.x.back().size() == x.size());
+    micro_time_ += settings_.tau;
+    ++evaluations_;
+    MapEvaluation e;
+    e.x = x;
+    e.parameter = parameter;
+    e.phi = burst.x.back();
+    e.f = e.phi - x;
+    e.standard_error = Eigen::VectorXd::Zero(x.size());
+    if (!burst.members.empty()) {
+        const Eigen::MatrixXd& m = burst.members.back();
+        if (m.rows() >= 2)
+            e.standard_error =
+                (ensemble_variance(m, ensemble_mean(m)) / static_cast<double>(m.rows())).cwiseSqrt();
+    }
+    e.noise_norm = e.standard_error.norm();
+    return e;
+}
+
+const MapEvaluation& CoarseMap::begin(const Eigen::VectorXd& x, double parameter) {
+    EFDEM_EXPECTS(!has_base_);
+    if (settings_.common_random_numbers) stepper_.keep_state();
+    base_ = run_once(x, parameter);
+    has_base_ = true;
+    return base_;
+}
+
+void CoarseMap::rewind() {
+    if (!settings_.common_random_numbers) return;
+    stepper_.return_to_kept_state();
+    stepper_.keep_state();
+}
+
+MapEvaluation CoarseMap::evaluate_from_base(const Eigen::VectorXd& x, double parameter) {
+    EFDEM_EXPECTS(has_base_ && x.size() == base_.x.size());
+    rewind();
+    return run_once(x, parameter);
+}
+
+Eigen::VectorXd CoarseMap::derivative(const Eigen::VectorXd& v, double dparameter) {
+    EFDEM_EXPECTS(has_base_ && v.size() == base_.x.size());
+    const double length = std::sqrt(v.squaredNorm() + dparameter * dparameter);
+    if (length == 0.0) return Eigen::VectorXd::Zero(v.size());
+    const double h = settings_.difference_step;
+    const MapEvaluation e = evaluate_from_base(base_.x + (h / length) * v, base_.parameter + (h / length) * dparameter);
+    return (e.phi - base_.phi) * (length / h);
+}
+
+void CoarseMap::end() {
+    EFDEM_EXPECTS(has_base_);
+    if (settings_.common_random_numbers) stepper_.confirm_kept_state();
+    has_base_ = false;
+}
+
+MapEvaluation CoarseMap::evaluate(const Eigen::VectorXd& x, double parameter) {
+    EFDEM_EXPECTS(!has_base_);
+    return run_once(x, parameter);
+}
+
+}  // namespace efdem::coarse

@@ -1,0 +1,104 @@
+#pragma once
+/// \file
+/// The coarse time-tau map of equation-free steady-state computation (docs/steady_states.md):
+/// Phi_tau(X; lambda) = restrict(run tau(lift X)), the last sample of one burst, and
+/// F(X) = Phi_tau(X) - X, whose zeros are the coarse steady states. Directional derivatives
+/// are differences of two evaluations from the *same* micro state and random streams (common
+/// random numbers, CRN), so that most of the ensemble noise cancels in the difference.
+///
+/// The map keeps one *base* at a time: begin() keeps the micro state (CoarseStepper::
+/// keep_state) and evaluates Phi at the base point from it; evaluate_from_base() and
+/// derivative() evaluate other points from that same kept state; end() forgets it, and the
+/// micro model continues from where the last evaluation ended (a healed state for the next
+/// base). Every evaluation costs tau of micro time (times the ensemble size for an ensemble),
+/// counted in micro_time().
+///
+/// \code
+/// coarse::CoarseMap phi(stepper, {.tau = 40, .difference_step = 1e-2});
+/// const coarse::MapEvaluation& base = phi.begin(x);      // F = base.f, noise base.noise_norm
+/// const Eigen::VectorXd jv = phi.derivative(v) - v;      // J_F v with CRN
+/// phi.end();
+/// \endcode
+
+#include <functional>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/coarse_stepper.hpp"
+
+namespace efdem::coarse {
+
+struct CoarseMapSettings {
+    /// Micro time of one evaluation [sqrt(d_p/g)] (> 0; a multiple of the stepper's sampling
+    /// interval).
+    double tau = 1.0;
+    /// Length h of the difference step in the coarse space (> 0): J v is measured as
+    /// (Phi(X + h v/|v|) - Phi(X)) |v| / h. Round-off wants it large next to sqrt(machine eps)
+    /// |X|; the curvature of Phi wants it small; for an ensemble it must also be large next to
+    /// what CRN leaves of the noise.
+    double difference_step = 1e-6;
+    /// Evaluate derivatives and trial points from the base's kept micro state (requires
+    /// CoarseStepper::can_keep_state(), a contract). Off: from whatever micro state the
+    /// previous evaluation left, i.e. with fresh noise (kept only for comparisons).
+    bool common_random_numbers = true;
+};
+
+/// One evaluation of the map.
+struct MapEvaluation {
+    Eigen::VectorXd x;    ///< the lifted point
+    double parameter = 0;  ///< the parameter it was evaluated at (0 without a parameter hook)
+    Eigen::VectorXd phi;  ///< Phi_tau(x): the restricted sample at the end of the burst
+    Eigen::VectorXd f;    ///< F = phi - x
+    /// Standard error of each component of phi from the members' spread at the last sample
+    /// (sqrt(var/R)); zeros when the stepper reports no members or only one.
+    Eigen::VectorXd standard_error;
+    /// |standard_error|_2: the expected norm of the noise in phi (and F), what the stopping
+    /// rule compares |F| with.
+    double noise_norm = 0;
+};
+
+class CoarseMap {
+  public:
+    /// `set_parameter` (may be empty) is called with the parameter before every lift: the
+    /// map is then Phi_tau(X; lambda) (continuation). \pre settings.tau > 0,
+    /// settings.difference_step > 0, and can_keep_state() when common_random_numbers is on.
+    CoarseMap(CoarseStepper& stepper, const CoarseMapSettings& settings,
+              std::function<void(double)> set_parameter = {});
+
+    /// Keeps the micro state and evaluates Phi at (x, parameter) from it. \pre no base.
+    const MapEvaluation& begin(const Eigen::VectorXd& x, double parameter = 0.0);
+    /// Phi at another point from the base's kept micro state (with CRN). \pre a base.
+    MapEvaluation evaluate_from_base(const Eigen::VectorXd& x, double parameter);
+    /// dPhi(X; lambda) [v; dparameter] at the base by a one-sided difference from the base's
+    /// micro state; the step h is taken along (v, dparameter)/|(v, dparameter)|.
+    /// Zero for a zero direction (no evaluation). \pre a base; dparameter = 0 without a hook.
+    Eigen::VectorXd derivative(const Eigen::VectorXd& v, double dparameter = 0.0);
+    /// Forgets the kept state; the micro model continues from the last evaluation's end.
+    void end();
+    /// Phi at (x, parameter) from the current micro state, no base involved.
+    MapEvaluation evaluate(const Eigen::VectorXd& x, double parameter = 0.0);
+
+    bool has_base() const { return has_base_; }
+    const MapEvaluation& base() const { return base_; }
+    const CoarseMapSettings& settings() const { return settings_; }
+    bool has_parameter() const { return static_cast<bool>(set_parameter_); }
+    /// Micro time run by all evaluations so far [sqrt(d_p/g)] (per member of an ensemble).
+    double micro_time() const { return micro_time_; }
+    long evaluations() const { return evaluations_; }
+
+  private:
+    /// Lift, run tau, restrict: one evaluation from the current micro state.
+    MapEvaluation run_once(const Eigen::VectorXd& x, double parameter);
+    /// Back to the base's kept state, kept again for the next evaluation (CRN on).
+    void rewind();
+
+    CoarseStepper& stepper_;
+    CoarseMapSettings settings_;
+    std::function<void(double)> set_parameter_;
+    MapEvaluation base_;
+    bool has_base_ = false;
+    double micro_time_ = 0;
+    long evaluations_ = 0;
+};
+
+}  // namespace efdem::coarse

@@ -1,0 +1,93 @@
+#include "coarse/equation_free/newton_krylov.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "core/contracts.hpp"
+#include "core/log.hpp"
+
+namespace efdem::coarse {
+
+namespace {
+/// Armijo constant of the sufficient decrease |G(y + s d)| <= (1 - c s) |G(y)|: small, so that
+/// any real decrease along a descent direction is accepted (Kelley 2003, ch. 8).
+constexpr double kArmijo = 1e-4;
+/// The GMRES residual need not go below this fraction of the stopping threshold: the Newton
+/// step then lands within half of it, leaving the other half to the nonlinearity.
+constexpr double kKrylovFloor = 0.5;
+}  // namespace
+
+NewtonKrylov::NewtonKrylov(const NewtonKrylovSettings& settings) : settings_(settings) {
+    EFDEM_EXPECTS(settings_.max_iterations >= 0 && settings_.max_krylov >= 1 && settings_.forcing > 0.0 &&
+                  settings_.forcing < 1.0 && settings_.max_backtracks >= 0);
+}
+
+SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorXd& y0) const {
+    EFDEM_EXPECTS(y0.size() == system.dimension());
+    const long evaluations0 = system.evaluations();
+    const double micro0 = system.micro_time();
+    SteadySolveRecord rec;
+    Eigen::VectorXd y = y0;
+    while (true) {
+        const SystemEvaluation e = system.begin(y);
+        const double r = e.g.norm();
+        rec.add_iterate(y, r, e.noise_norm);
+        log::info("newton {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
+        if (settings_.stop.reached(r, e.noise_norm, rec.reason)) {
+            rec.message = fmt::format("{} after {} Newton step(s): |F| = {:.4e} <= {:.4e} (tolerance {:.3e}, "
+                                      "{} x noise {:.3e})",
+                                      to_string(rec.reason), rec.iterations, r,
+                                      settings_.stop.threshold(e.noise_norm), settings_.stop.tolerance,
+                                      settings_.stop.noise_factor, e.noise_norm);
+            system.end();
+            break;
+        }
+        if (rec.iterations >= settings_.max_iterations) {
+            rec.reason = SteadyStopReason::max_iterations;
+            rec.message = fmt::format("{} Newton steps done with |F| = {:.4e} above {:.4e} (noise {:.3e}); try "
+                                      "more iterations, a longer tau or more realizations",
+                                      rec.iterations, r, settings_.stop.threshold(e.noise_norm), e.noise_norm);
+            system.end();
+            break;
+        }
+        GmresSettings gs;
+        gs.max_iterations = settings_.max_krylov;
+        gs.relative_tolerance = settings_.forcing;
+        gs.absolute_tolerance = kKrylovFloor * settings_.stop.threshold(e.noise_norm);
+        const GmresResult lin =
+            gmres([&system](const Eigen::VectorXd& v) { return system.jacobian_times(v); }, -e.g, gs);
+        rec.krylov_iterations.push_back(lin.iterations);
+        double s = 1.0;
+        bool accepted = false;
+        double r_trial = r;
+        for (int b = 0; b <= settings_.max_backtracks; ++b, s *= 0.5) {
+            r_trial = system.trial(y + s * lin.x).g.norm();
+            if (r_trial <= (1.0 - kArmijo * s) * r) {
+                accepted = true;
+                break;
+            }
+        }
+        log::info("newton {:3d}: {} GMRES products (linear residual {:.3e}), step {:.4g}, trial |F| = {:.4e}",
+                  rec.iterations, lin.iterations, lin.residuals.back(), accepted ? s : 0.0, r_trial);
+        system.end();
+        if (!accepted) {
+            rec.reason = SteadyStopReason::line_search_failed;
+            rec.message = fmt::format(
+                "line search failed at Newton step {}: no step down to {:.3g} of the GMRES step decreased |F| = "
+                "{:.4e} (noise {:.3e}, {:.3g} x the noise){}",
+                rec.iterations, s, r, e.noise_norm, e.noise_norm > 0 ? r / e.noise_norm : 0.0,
+                lin.converged ? "" : "; GMRES did not converge: the derivatives may be too noisy (try a larger "
+                                     "difference step, more realizations)");
+            break;
+        }
+        rec.step_lengths.push_back(s);
+        ++rec.iterations;
+        y += s * lin.x;
+    }
+    rec.evaluations = system.evaluations() - evaluations0;
+    rec.micro_time = system.micro_time() - micro0;
+    return rec;
+}
+
+}  // namespace efdem::coarse

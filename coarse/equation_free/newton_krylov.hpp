@@ -1,0 +1,43 @@
+#pragma once
+/// \file
+/// Matrix-free Newton-GMRES with a backtracking line search on |G| (docs/steady_states.md):
+///
+///   at y_k: G_k = G(y_k) from a fresh micro state (kept: common random numbers);
+///   GMRES:  G'(y_k) d = -G_k, products by CRN differences, to |G_k + G' d| <=
+///           max(forcing |G_k|, half the stopping threshold);
+///   search: y_k + s d for s = 1, 1/2, ... from the same kept state, accepted at
+///           |G(y_k + s d)| <= (1 - 1e-4 s) |G_k| (Armijo on |G|);
+///   the micro model continues from the accepted trial, where y_{k+1} is evaluated afresh.
+///
+/// Stops at the noise level of the ensemble (SteadyStopRule), the iteration limit, or when the
+/// line search finds no decrease. Cost per Newton step: (1 + GMRES products + trials) bursts.
+
+#include "coarse/equation_free/gmres.hpp"
+#include "coarse/equation_free/newton_system.hpp"
+#include "coarse/equation_free/steady_solve_record.hpp"
+
+namespace efdem::coarse {
+
+struct NewtonKrylovSettings {
+    SteadyStopRule stop;
+    int max_iterations = 20;  ///< Newton steps
+    /// Most GMRES products per Newton step (at most the dimension is ever used).
+    int max_krylov = 30;
+    /// Relative GMRES tolerance (the forcing term): an inexact Newton step.
+    double forcing = 1e-3;
+    int max_backtracks = 6;  ///< halvings of the step before the line search gives up
+};
+
+class NewtonKrylov {
+  public:
+    explicit NewtonKrylov(const NewtonKrylovSettings& settings);
+    /// Solves G(y) = 0 from y0. Leaves no base on `system`. Never throws for a numerical
+    /// condition: the record says why it stopped.
+    SteadySolveRecord solve(NewtonSystem& system, const Eigen::VectorXd& y0) const;
+    const NewtonKrylovSettings& settings() const { return settings_; }
+
+  private:
+    NewtonKrylovSettings settings_;
+};
+
+}  // namespace efdem::coarse

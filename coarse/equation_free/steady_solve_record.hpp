@@ -1,0 +1,59 @@
+#pragma once
+/// \file
+/// What every steady-state solver (newton_krylov.hpp, fixed_point_iteration.hpp) shares: the
+/// stopping rule at the noise level of the ensemble, and the record of a solve (why it stopped,
+/// the residual history, the cost, the best iterate).
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace efdem::coarse {
+
+enum class SteadyStopReason {
+    converged,           ///< |F| <= the fixed tolerance (a deterministic stepper)
+    noise_level,         ///< |F| within noise_factor x the ensemble's noise: cannot improve further
+    line_search_failed,  ///< no step length gave enough decrease of |F|
+    max_iterations,      ///< the iteration limit came first
+};
+std::string to_string(SteadyStopReason reason);
+
+/// Stop when |F| <= max(tolerance, noise_factor * noise), noise = the norm of the standard
+/// error of F from the members' spread (MapEvaluation::noise_norm). A fixed 1e-8 would never be
+/// reached by an ensemble, whose F carries noise of order sigma/sqrt(R); pushing |F| below that
+/// noise only fits the noise of one evaluation.
+struct SteadyStopRule {
+    double tolerance = 1e-10;  ///< absolute floor in |F| (what a noise-free stepper stops at)
+    /// Multiple of the noise: 2 is rarely exceeded by pure noise (|e|^2/noise^2 is about
+    /// chi-squared over n: P(> 4n) < 2% for n >= 2).
+    double noise_factor = 2.0;
+
+    double threshold(double noise) const;
+    /// Whether r is small enough to stop; if so, `reason` says which bound it met.
+    bool reached(double r, double noise, SteadyStopReason& reason) const;
+};
+
+struct SteadySolveRecord {
+    SteadyStopReason reason = SteadyStopReason::max_iterations;
+    std::string message;  ///< why it stopped, with the numbers
+    Eigen::VectorXd x;    ///< the last iterate
+    Eigen::VectorXd best;  ///< the iterate with the smallest |F| seen
+    double best_residual = std::numeric_limits<double>::infinity();
+    std::vector<double> residuals;  ///< |F| at each iterate, the first included
+    std::vector<double> noise;      ///< the noise norm measured with each residual
+    std::vector<int> krylov_iterations;  ///< GMRES products per Newton step (empty: fixed point)
+    std::vector<double> step_lengths;    ///< line-search / damping factor per step
+    int iterations = 0;       ///< steps taken
+    long evaluations = 0;     ///< evaluations of the coarse map (each one burst of tau)
+    double micro_time = 0;    ///< micro time of those evaluations [sqrt(d_p/g)]
+
+    bool converged() const {
+        return reason == SteadyStopReason::converged || reason == SteadyStopReason::noise_level;
+    }
+    /// Adds an iterate and its residual, updating the best.
+    void add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm);
+};
+
+}  // namespace efdem::coarse
