@@ -1,0 +1,89 @@
+#pragma once
+/// \file
+/// Pseudo-arclength continuation of coarse steady states in one scalar parameter lambda
+/// (Keller 1977; docs/steady_states.md), on a CoarseMap whose hook sets the parameter on the
+/// micro model:
+///
+///   first point: Newton-Krylov on F(X; lambda_0) = 0; tangent t = (z, 1)/|(z, 1)| with
+///                F_X z = -F_lambda (GMRES on CRN differences), oriented by `direction`;
+///   predictor:   y_pred = y_k + ds t (t: the secant (y_k - y_{k-1})/|.| after the first step,
+///                which keeps its orientation through a fold);
+///   corrector:   Newton-Krylov on [F(X; lambda); t . (y - y_pred)] = 0 (ArclengthSystem);
+///   step size:   ds *= clamp(target / Newton steps, 1/2, 2) within [min_step, max_step];
+///                a failed corrector halves ds and tries again from the same point.
+///
+/// Each point's stability is the leading eigenvalue of dPhi/dX there (coarse_spectrum.hpp).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/coarse_map.hpp"
+#include "coarse/equation_free/coarse_spectrum.hpp"
+#include "coarse/equation_free/newton_krylov.hpp"
+
+namespace efdem::coarse {
+
+struct ContinuationSettings {
+    NewtonKrylovSettings corrector;
+    double step = 0.1;  ///< initial arclength step ds in (X, lambda) (> 0)
+    double min_step = 1e-4;
+    double max_step = 1.0;
+    int max_points = 50;  ///< branch points, the first included
+    /// The continuation stops after the first point outside [parameter_min, parameter_max].
+    double parameter_min = -1e300;
+    double parameter_max = 1e300;
+    int target_iterations = 3;  ///< Newton steps per corrector the step size aims at
+    bool stability = true;      ///< the leading eigenvalue at each point
+    SpectrumSettings spectrum = SpectrumSettings{1};  // the leading eigenvalue only
+};
+
+struct BranchPoint {
+    double parameter = 0;
+    Eigen::VectorXd x;
+    double residual = 0;  ///< |F| at the point
+    double noise = 0;     ///< the noise norm measured with it
+    int newton_iterations = 0;
+    double step = 0;  ///< the arclength step that reached it (0 for the first point)
+    bool has_leading = false;
+    CoarseEigenvalue leading;  ///< largest |mu| (if has_leading)
+    double micro_time = 0;     ///< micro time this point cost, its spectrum included
+};
+
+/// A fold between branch points: lambda has an extremum at point `at`.
+struct FoldEstimate {
+    std::size_t at = 0;
+    /// The vertex of the parabola lambda(s) through points at-1, at, at+1 (s the chord
+    /// arclength): error O(ds^3) for a smooth branch.
+    double parameter = 0;
+};
+
+struct Branch {
+    std::vector<BranchPoint> points;
+    std::string end_reason;
+    double micro_time = 0;
+    long evaluations = 0;
+    /// Where the parameter turns (consecutive differences change sign).
+    std::vector<FoldEstimate> folds() const;
+};
+
+class PseudoArclengthContinuation {
+  public:
+    /// \pre map has a parameter hook and no base; step sizes 0 < min_step <= step <= max_step.
+    PseudoArclengthContinuation(CoarseMap& map, const ContinuationSettings& settings);
+    /// From the guess x0 at lambda0, with lambda first increasing (direction > 0) or decreasing.
+    Branch run(const Eigen::VectorXd& x0, double lambda0, double direction);
+
+  private:
+    /// Stability and bookkeeping of a corrected point.
+    BranchPoint make_point(const SteadySolveRecord& rec, Eigen::Index n, double step, double micro_before);
+    /// The unit tangent at (x, lambda) from F_X z = -F_lambda.
+    Eigen::VectorXd first_tangent(const Eigen::VectorXd& x, double lambda, double direction);
+
+    CoarseMap& map_;
+    ContinuationSettings settings_;
+    NewtonKrylov newton_;
+};
+
+}  // namespace efdem::coarse
