@@ -51,7 +51,7 @@ std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::stri
 struct RealizationSpec {
     std::uint64_t seed = 1;       ///< master seed
     long realization = 0;         ///< global realization index
-    bool skip_settling = false;   ///< read every key but do not run the settling (efdem --check)
+    bool skip_settling = false;   ///< read every key but do not run the settling (efdem --check, a restart)
 };
 
 }  // namespace efdem::dem

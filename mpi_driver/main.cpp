@@ -321,9 +321,14 @@ int main(int argc, char** argv) {
         // (the other ranks settle theirs at the same time).
         SettlingProgressLine settling_line(5.0);
         const dem::SettlingReport settling = mpi.is_root() ? settling_line.report() : dem::SettlingReport{};
+        // A restart replaces every particle state by the checkpoint's (positions, velocities,
+        // species, neighbours, contact history, clock, random streams; a dropped realization is
+        // never advanced again), so its beds are built but not settled: settling them would only
+        // cost minutes on a paper-size bed and be thrown away.
+        const bool skip_settling = check || !options.restart.empty();
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;
-            systems.push_back(dem::build_system(root, {settings->seed, realization, check}, settling));
+            systems.push_back(dem::build_system(root, {settings->seed, realization, skip_settling}, settling));
         }
         table->check_all_used(
             [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });

@@ -2,7 +2,8 @@
 # A restarted run's output equals the uninterrupted run's bit for bit, in direct and cpi mode
 # (ICDF and compact observables; adaptive Adams-Bashforth 2 with a rejection before
 # the checkpoint, whose controller state is in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
-# realizations on 2 ranks.
+# realizations on 2 ranks; and a run from settled beds ("settled"), whose restart builds its beds
+# without settling them (the checkpoint replaces every particle state).
 # Compared: the run HDF5 file (compare_runs.py) and the CSV files (byte for byte: the wall time is in the sidecar, not compared).
 #   restart_equality.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 set -euo pipefail
@@ -30,7 +31,8 @@ same_output() {  # same_output PREFIX_A PREFIX_B
 # scene overrides. cpi-compact: the compact fit's warm start is part of the state.
 for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi" \
             "compact 1 00000002 4 mode=cpi,cpi.observable=compact,run.duration=8" \
-            "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24"; do
+            "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
+            "settled 4 00000008 2 mode=direct,bed.settle=true,bed.settle.ke_threshold=1e-3,bed.settle.max_time=20"; do
   read -r mode every from nps overrides <<< "$spec"
   IFS=, read -r -a extra <<< "$overrides"
   common=("${extra[@]}" output.directory="$work")
@@ -38,6 +40,9 @@ for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi
   run 2 "$work/$mode-ck.log" "$@" "$efdem" "$scene" "${common[@]}" ensemble.realizations_per_rank=2 \
     output.prefix=$mode-ck checkpoint.interval=$every checkpoint.keep=10
   same_output $mode-ref $mode-ck   # checkpointing itself changes nothing
+  if [ "$mode" = settled ] && ! grep -q "settling realization" "$work/$mode-ref.log"; then
+    echo "FAIL: the settled reference run printed no settling line"; exit 1
+  fi
   ckpt="$work/$mode-ck_ckpt_$from.h5"
   [ -f "$ckpt" ] || { echo "FAIL: no checkpoint $ckpt"; ls "$work"; exit 1; }
   for np in ${nps//,/ }; do
@@ -45,6 +50,10 @@ for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi
     run $np "$work/$mode-np$np.log" "$@" "$efdem" "$scene" "${common[@]}" ensemble.realizations_per_rank=$k \
       output.prefix=$mode-np$np restart="$ckpt"
     grep -q "restarted from" "$work/$mode-np$np.log" || { echo "FAIL: no restart in $mode-np$np.log"; exit 1; }
+    # A restart takes every particle state from the checkpoint: its beds are not settled again.
+    if grep -q "^efdem: settling\|settling realization" "$work/$mode-np$np.log"; then
+      echo "FAIL: the restart $mode-np$np settled its beds again"; exit 1
+    fi
     same_output $mode-ref $mode-np$np
     echo "PASS: $mode restarted from $(basename "$ckpt") (2 ranks x 2) on $np ranks x $k equals the uninterrupted run"
   done
