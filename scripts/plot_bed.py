@@ -15,8 +15,11 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import run_files  # noqa: E402
+
 try:
-    import h5py
+    import h5py  # noqa: F401  (run_files opens the files with it)
     import matplotlib
 
     matplotlib.use("Agg")
@@ -25,34 +28,17 @@ except ImportError as e:  # another python3 than Debian's
     sys.exit(f"plot_bed.py: {e}; run it with /usr/bin/python3 (Debian python3-matplotlib python3-h5py)")
 
 
-def fail(message):
-    print(f"plot_bed.py: {message}", file=sys.stderr)
-    sys.exit(2)
-
-
-def text(values):
-    return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
-
-
 def load(path):
-    if not os.path.isfile(path):
-        fail(f"{path}: no such file")
-    try:
-        f = h5py.File(path, "r")
-    except OSError as e:
-        fail(f"{path}: not an HDF5 file ({e})")
-    with f:
-        if "samples/time" not in f:
-            fail(f"{path}: not an efdem run file (no /samples/time)")
+    with run_files.open_run(path, ["samples/time"]) as f:
         if "bed" not in f:
-            fail(f"{path}: no /bed group: the run did not record the bed quantities "
-                 "(run it with observe.bed=true)")
+            raise run_files.UsageError(f"{path}: no /bed group: the run did not record the bed quantities "
+                                       "(run it with observe.bed=true)")
         b = f["bed"]
         return {
-            "name": os.path.basename(path), "mode": str(f.attrs.get("mode", "?")),
+            "name": os.path.basename(path), "mode": run_files.text(f.attrs["mode"]),
             "R": int(f.attrs.get("realizations", 1)), "t": f["samples/time"][:],
             "ratio": b["pressure_drop_ratio"][:], "height": b["height"][:], "mixing": b["mixing_index"][:],
-            "species_height": b["species_height"][:], "species": text(b["species"][:]),
+            "species_height": b["species_height"][:], "species": [run_files.text(v) for v in b["species"][:]],
             "phi": b["mean/solid_fraction"][:], "z": b["z"][:], "dz": float(b.attrs["profile_dz"]),
         }
 
@@ -70,7 +56,10 @@ def main(argv=None):
     ap.add_argument("-o", "--output", default="bed.png")
     ap.add_argument("--profiles", type=int, default=4, help="phi(z) at this many times (first run)")
     a = ap.parse_args(argv)
-    runs = [load(p) for p in a.runs]
+    try:
+        runs = [load(p) for p in a.runs]
+    except run_files.UsageError as e:
+        run_files.fail("plot_bed.py", e)
     fig, axes = plt.subplots(2, 3, figsize=(14, 7.5))
     ax_dp, ax_h, ax_mix, ax_sp, ax_phi, ax_exp = axes.ravel()
     styles = ["-", "--", ":", "-."]
