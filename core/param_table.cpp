@@ -254,13 +254,10 @@ std::string Params::get_choice(std::string_view key, const std::vector<std::stri
 
 std::string Params::get_or_choice(std::string_view key, const std::string& fallback,
                                   const std::vector<std::string>& allowed) const {
-    table_->declare(full_key(key), "one of: " + comma_list(allowed), &fallback);
-    if (!contains(key)) {
-        const std::string word = get_or<std::string>(key, fallback);
-        table_->declare(full_key(key), "one of: " + comma_list(allowed), nullptr);
-        return word;
-    }
-    return get_choice(key, allowed);
+    table_->declare(full_key(key), "", &fallback);  // the default, whether or not the scene sets the key
+    const std::string word = contains(key) ? get_choice(key, allowed) : get_or<std::string>(key, fallback);
+    table_->declare(full_key(key), "one of: " + comma_list(allowed), nullptr);  // after get_or's "one word"
+    return word;
 }
 
 std::filesystem::path Params::get_path(std::string_view key) const {
