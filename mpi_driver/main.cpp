@@ -77,8 +77,9 @@ struct SetupWall {
     }
 };
 
+/// `bed`: the run's bed_settings (the axes of /bed), if it records them.
 RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
-                         const dem::System& any) {
+                         const dem::System& any, const std::optional<dem::BedObservationSettings>& bed) {
     RunProvenance p;
     p.scene_file = table.file();
     p.scene_text = table.text();
@@ -91,7 +92,7 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
     p.seed = s.seed;
     p.p_grid = coarse::ProbabilityGrid(s.observe.quantiles).values();
     p.observed_species = any.species()[s.observe.species].name;
-    if (const auto bed = bed_settings(s, any)) {
+    if (bed) {
         for (std::size_t k = 0; k < bed->species; ++k) p.species_names.push_back(any.species()[static_cast<dem::SpeciesId>(k)].name);
         p.profile_dz = bed->profile_dz;
         p.profile_slabs = static_cast<long>(bed->profile_slabs);
@@ -105,9 +106,9 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
 /// `restart`: the checkpoint to continue from (null: a new run).
 int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         std::vector<dem::System> systems, const RestartData* restart, const SetupWall& wall) {
-    const RunProvenance prov = provenance(mpi, table, s, systems.front());
-    const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
     const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
+    const RunProvenance prov = provenance(mpi, table, s, systems.front(), bed);
+    const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
     RunObservables observables = RunObservables::from_settings(s);
 
     std::unique_ptr<RecorderList> recorders;

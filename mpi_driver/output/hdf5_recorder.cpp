@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <chrono>
 #include <ctime>
 #include <fcntl.h>
@@ -82,17 +83,11 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
     document("/parameters");
     file_.write("/p", as_span(p.p_grid), {static_cast<hsize_t>(m_)});
     document("/p");
-    std::vector<std::int64_t> index(static_cast<std::size_t>(realizations_));
-    for (std::size_t k = 0; k < index.size(); ++k) index[k] = static_cast<std::int64_t>(k);
-    file_.write("/realization", index, {static_cast<hsize_t>(index.size())});
-    document("/realization");
+    index_axis("/realization", realizations_);
     file_.create_group("/samples");
     if (p.mode == "cpi") {
         file_.create_group("/cpi");
-        std::vector<std::int64_t> node(static_cast<std::size_t>(dim_));
-        for (std::size_t k = 0; k < node.size(); ++k) node[k] = static_cast<std::int64_t>(k);
-        file_.write("/cpi/coarse_node", node, {static_cast<hsize_t>(node.size())});
-        document("/cpi/coarse_node");
+        index_axis("/cpi/coarse_node", dim_);
     }
     if (species_ > 0) {
         file_.create_group("/bed");
@@ -109,6 +104,13 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
         document("/bed/species");
     }
     file_.flush();
+}
+
+void Hdf5Recorder::index_axis(const std::string& name, Eigen::Index n) {
+    std::vector<std::int64_t> index(static_cast<std::size_t>(n));
+    std::iota(index.begin(), index.end(), std::int64_t{0});
+    file_.write(name, index, {static_cast<hsize_t>(n)});
+    document(name);
 }
 
 void Hdf5Recorder::document(const std::string& name) {

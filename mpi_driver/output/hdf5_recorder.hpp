@@ -39,6 +39,8 @@ private:
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
     /// Writes `name`'s units, description and dimension scales (run_file_schema.hpp).
     void document(const std::string& name);
+    /// A documented axis dataset 0, 1, ..., n-1 (/realization, /cpi/coarse_node).
+    void index_axis(const std::string& name, Eigen::Index n);
     void bed_sample(const SampleRecord& s);
 
     std::filesystem::path path_;
