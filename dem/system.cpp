@@ -1,5 +1,7 @@
 #include "dem/system.hpp"
 
+#include <utility>
+
 #include <algorithm>
 #include <cmath>
 
@@ -49,6 +51,10 @@ const Effect* System::find_effect(std::string_view name) const {
     for (const auto& e : effects_)
         if (e->name() == name) return e.get();
     return nullptr;
+}
+
+Effect* System::find_effect(std::string_view name) {
+    return const_cast<Effect*>(std::as_const(*this).find_effect(name));
 }
 
 ForceContext System::context() {

@@ -66,6 +66,8 @@ public:
     const SlabFields* slab_fields() const { return slabs_ ? &*slabs_ : nullptr; }
     const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
     const Effect* find_effect(std::string_view name) const;
+    /// The same, to change the effect between steps (e.g. GasDrag::set_superficial_velocity).
+    Effect* find_effect(std::string_view name);
     /// The union of what the effects need.
     Needs needs() const { return needs_; }
 

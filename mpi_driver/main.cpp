@@ -23,6 +23,7 @@
 #include "mpi_driver/output/csv_recorder.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
 #include "mpi_driver/run/driver.hpp"
+#include "mpi_driver/run/steady_driver.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #if EFDEM_HAVE_HDF5
@@ -171,12 +172,14 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.on_failure = s.on_failure;
     ss.recorded = observables.recorded.get();
     ss.bed = bed;
+    ss.parameter = s.steady.parameter;
     // The run's start (progress counts from there; on the non-root ranks it is not used).
     const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
     const ColourLifter lifter;
+    // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).
     EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter, recorders.get(),
-                            mpi.is_root() ? &progress : nullptr);
+                            mpi.is_root() && !s.is_steady() ? &progress : nullptr);
     RunControl control;
     if (resume) {
         stepper.restore_state(restart->header.stepper);
@@ -208,8 +211,9 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     }
     RunSummary summary;
     try {
-        summary = s.is_cpi() ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(), progress, control)
-                             : run_direct(stepper, s, progress, control);
+        summary = s.is_steady() ? run_steady(stepper, s, recorders.get(), progress)
+                  : s.is_cpi()  ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(), progress, control)
+                                : run_direct(stepper, s, progress, control);
         wall.fill(summary);
         recorders->finish(summary);
     } catch (const RunFailed& e) {
@@ -243,7 +247,12 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
               format_duration(summary.settling_wall_seconds), format_duration(summary.wall_seconds),
               summary.particle_steps);
     if (summary.stop_signal != 0) {
-        if (summary.checkpoint.empty()) {
+        if (s.is_steady()) {
+            std::fprintf(stderr, "efdem: stopped by %s; the iterates so far and the best one are in %s/%s.h5 (mode = "
+                                 "%s cannot be continued from a checkpoint)\n",
+                         signal_name(summary.stop_signal).c_str(), s.output.directory.c_str(), s.output.prefix.c_str(),
+                         s.mode_name());
+        } else if (summary.checkpoint.empty()) {
             std::fprintf(stderr, "efdem: stopped by %s; nothing could be saved (no HDF5)\n",
                          signal_name(summary.stop_signal).c_str());
         } else {
@@ -256,7 +265,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         std::fflush(stderr);
         return kExitInterrupted;
     }
-    return kExitOk;
+    return summary.unconverged ? kExitRuntimeFailure : kExitOk;
 }
 
 void print_effects() {
@@ -326,6 +335,11 @@ int main(int argc, char** argv) {
         // species, neighbours, contact history, clock, random streams; a dropped realization is
         // never advanced again), so its beds are built but not settled: settling them would only
         // cost minutes on a paper-size bed and be thrown away.
+        if (settings->is_steady() && !options.restart.empty())
+            throw InputError(SourceLocation{"<command line>", 0},
+                             fmt::format("restart = '{}': mode = {} cannot be continued from a checkpoint (a solve keeps "
+                                         "micro states in memory that a checkpoint does not hold)",
+                                         options.restart, settings->mode_name()));
         const bool skip_settling = check || !options.restart.empty();
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;

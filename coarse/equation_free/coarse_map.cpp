@@ -1,5 +1,6 @@
 #include "coarse/equation_free/coarse_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -18,7 +19,18 @@ CoarseMap::CoarseMap(CoarseStepper& stepper, const CoarseMapSettings& settings,
 MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
     EFDEM_EXPECTS(set_parameter_ || parameter == 0.0);
     if (set_parameter_) set_parameter_(parameter);
-    stepper_.lift(x, stepper_.time());
+    if (repair_) {
+        Eigen::VectorXd lifted = x;
+        const RepairReport report = repair_(lifted);
+        EFDEM_ASSERT(report.feasible);
+        if (report.changed()) {
+            ++repairs_;
+            largest_repair_ = std::max(largest_repair_, report.max_adjustment);
+        }
+        stepper_.lift(lifted, stepper_.time());
+    } else {
+        stepper_.lift(x, stepper_.time());
+    }
     BurstSamples burst;
     stepper_.run(settings_.tau, burst);
     EFDEM_ASSERT(burst.size() >= 1 && burst.x.back().size() == x.size());

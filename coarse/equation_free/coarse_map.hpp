@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/repair_report.hpp"
 
 namespace efdem::coarse {
 
@@ -78,6 +79,16 @@ class CoarseMap {
     /// Phi at (x, parameter) from the current micro state, no base involved.
     MapEvaluation evaluate(const Eigen::VectorXd& x, double parameter = 0.0);
 
+    /// Makes every lifted point liftable (e.g. an ICDF monotone and inside the heights the
+    /// particles occupy: IcdfObservable::repair_hook). The map is still Phi of the unrepaired
+    /// point (F = Phi - x with the solver's x); a repair changes what is lifted, so it biases a
+    /// difference it touches: repairs() counts the evaluations it changed, for the record.
+    /// A report with feasible == false is a contract violation (a non-finite iterate).
+    void set_repair(RepairHook repair) { repair_ = std::move(repair); }
+    long repairs() const { return repairs_; }
+    /// The largest change a repair made to a lifted point so far [unit of x].
+    double largest_repair() const { return largest_repair_; }
+
     bool has_base() const { return has_base_; }
     const MapEvaluation& base() const { return base_; }
     const CoarseMapSettings& settings() const { return settings_; }
@@ -95,6 +106,9 @@ class CoarseMap {
     CoarseStepper& stepper_;
     CoarseMapSettings settings_;
     std::function<void(double)> set_parameter_;
+    RepairHook repair_;
+    long repairs_ = 0;
+    double largest_repair_ = 0;
     MapEvaluation base_;
     bool has_base_ = false;
     double micro_time_ = 0;

@@ -57,7 +57,7 @@ BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec
         if (p.has_leading) p.leading = s.leading.front();
     }
     p.micro_time = map_.micro_time() - micro_before;
-    log::info("branch point: lambda = {:.6g}, |F| = {:.3e}, {} Newton step(s){}", p.parameter, p.residual,
+    log::info("branch point: parameter = {:.6g}, |F| = {:.3e}, {} Newton step(s){}", p.parameter * settings_.display_scale, p.residual,
               p.newton_iterations,
               p.has_leading ? fmt::format(", leading mu = {:.6g}{:+.3g}i", p.leading.mu.real(), p.leading.mu.imag())
                             : std::string{});
@@ -89,7 +89,8 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
     FixedPointSystem first(map_, n, lambda0);
     SteadySolveRecord rec = newton_.solve(first, x0);
     if (!rec.converged()) {
-        branch.end_reason = fmt::format("the first point at lambda = {:.6g} did not converge: {}", lambda0, rec.message);
+        branch.end_reason = fmt::format("the first point at parameter = {:.6g} did not converge: {}",
+                                        lambda0 * settings_.display_scale, rec.message);
     } else {
         SteadySolveRecord with_lambda = rec;
         with_lambda.x.conservativeResize(n + 1);
@@ -97,19 +98,27 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
         branch.points.push_back(make_point(with_lambda, n, 0.0, before));
         Eigen::VectorXd y(n + 1);
         y << branch.points.back().x, lambda0;
+        if (settings_.on_point) settings_.on_point(branch);
         Eigen::VectorXd t = first_tangent(branch.points.back().x, lambda0, direction);
         double ds = settings_.step;
+        if (settings_.parameter_step > 0.0)
+            ds = std::clamp(settings_.parameter_step / std::max(std::abs(t[n]), 1e-12), settings_.min_step,
+                            settings_.max_step);
         branch.end_reason = fmt::format("{} points (the limit)", settings_.max_points);
         while (static_cast<int>(branch.points.size()) < settings_.max_points) {
             before = map_.micro_time();
             const Eigen::VectorXd predicted = y + ds * t;
             ArclengthSystem system(map_, t, predicted);
             rec = newton_.solve(system, predicted);
+            if (rec.reason == SteadyStopReason::stopped) {
+                branch.end_reason = fmt::format("stopped after parameter = {:.6g}: {}", y[n] * settings_.display_scale, rec.message);
+                break;
+            }
             if (!rec.converged()) {
                 ds *= 0.5;
                 if (ds < settings_.min_step) {
-                    branch.end_reason = fmt::format("the step fell below {:.3g} after lambda = {:.6g}: {}",
-                                                    settings_.min_step, y[n], rec.message);
+                    branch.end_reason = fmt::format("the step fell below {:.3g} after parameter = {:.6g}: {}",
+                                                    settings_.min_step, y[n] * settings_.display_scale, rec.message);
                     break;
                 }
                 continue;
@@ -117,9 +126,11 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             t = (rec.x - y).normalized();
             y = rec.x;
             branch.points.push_back(make_point(rec, n, ds, before));
+            if (settings_.on_point) settings_.on_point(branch);
             if (y[n] < settings_.parameter_min || y[n] > settings_.parameter_max) {
-                branch.end_reason = fmt::format("left the parameter range [{:.6g}, {:.6g}] at lambda = {:.6g}",
-                                                settings_.parameter_min, settings_.parameter_max, y[n]);
+                const double k = settings_.display_scale;
+                branch.end_reason = fmt::format("left the parameter range [{:.6g}, {:.6g}] at {:.6g}",
+                                                settings_.parameter_min * k, settings_.parameter_max * k, y[n] * k);
                 break;
             }
             const double factor = std::clamp(static_cast<double>(settings_.target_iterations) /

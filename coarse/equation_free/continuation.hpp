@@ -14,6 +14,7 @@
 ///
 /// Each point's stability is the leading eigenvalue of dPhi/dX there (coarse_spectrum.hpp).
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,9 +26,16 @@
 
 namespace efdem::coarse {
 
+struct Branch;
+/// Called with the branch so far after each new point (e.g. to record it as the run goes).
+using BranchObserver = std::function<void(const Branch&)>;
+
 struct ContinuationSettings {
     NewtonKrylovSettings corrector;
     double step = 0.1;  ///< initial arclength step ds in (X, lambda) (> 0)
+    /// > 0: the first step's ds is chosen so that the predictor moves lambda by this much
+    /// (ds = parameter_step / |t_lambda|, within [min_step, max_step]); `step` is then unused.
+    double parameter_step = 0.0;
     double min_step = 1e-4;
     double max_step = 1.0;
     int max_points = 50;  ///< branch points, the first included
@@ -37,6 +45,10 @@ struct ContinuationSettings {
     int target_iterations = 3;  ///< Newton steps per corrector the step size aims at
     bool stability = true;      ///< the leading eigenvalue at each point
     SpectrumSettings spectrum = SpectrumSettings{1};  // the leading eigenvalue only
+    BranchObserver on_point;  ///< may be empty
+    /// lambda x display_scale is what the log and the end reason show (the scene's units when
+    /// the caller continues in a scaled parameter).
+    double display_scale = 1.0;
 };
 
 struct BranchPoint {

@@ -30,10 +30,18 @@ SteadySolveRecord FixedPointIteration::solve(CoarseMap& map, const Eigen::Vector
         const bool growing = r > rec.best_residual;
         rec.add_iterate(x, r, e.noise_norm);
         log::info("fixed point {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
+        // The observer sees every iterate (the last one too); a stop it asks for comes after
+        // the stopping rule, so a converged solve is never reported as stopped.
+        const std::string stop_asked = settings_.observer ? settings_.observer(rec) : std::string{};
         if (settings_.stop.reached(r, e.noise_norm, rec.reason)) {
             rec.message = fmt::format("{} after {} fixed-point iteration(s): |F| = {:.4e} <= {:.4e}",
                                       to_string(rec.reason), rec.iterations, r,
                                       settings_.stop.threshold(e.noise_norm));
+            break;
+        }
+        if (!stop_asked.empty()) {
+            rec.reason = SteadyStopReason::stopped;
+            rec.message = fmt::format("stopped after {} fixed-point iteration(s) with |F| = {:.4e}: {}", rec.iterations, r, stop_asked);
             break;
         }
         if (rec.iterations >= settings_.max_iterations) {

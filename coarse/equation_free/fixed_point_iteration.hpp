@@ -25,6 +25,8 @@ struct FixedPointSettings {
     int max_iterations = 100;
     double damping = 1.0;  ///< beta in (0, 1]
     int depth = 3;         ///< Anderson depth m (0: damped iteration)
+    /// Called at every iterate (may be empty); a non-empty answer stops the solve.
+    IterateObserver observer;
 };
 
 class FixedPointIteration {

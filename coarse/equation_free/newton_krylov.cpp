@@ -34,12 +34,21 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorX
         const double r = e.g.norm();
         rec.add_iterate(y, r, e.noise_norm);
         log::info("newton {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
+        // The observer sees every iterate (the last one too); a stop it asks for comes after
+        // the stopping rule, so a converged solve is never reported as stopped.
+        const std::string stop_asked = settings_.observer ? settings_.observer(rec) : std::string{};
         if (settings_.stop.reached(r, e.noise_norm, rec.reason)) {
             rec.message = fmt::format("{} after {} Newton step(s): |F| = {:.4e} <= {:.4e} (tolerance {:.3e}, "
                                       "{} x noise {:.3e})",
                                       to_string(rec.reason), rec.iterations, r,
                                       settings_.stop.threshold(e.noise_norm), settings_.stop.tolerance,
                                       settings_.stop.noise_factor, e.noise_norm);
+            system.end();
+            break;
+        }
+        if (!stop_asked.empty()) {
+            rec.reason = SteadyStopReason::stopped;
+            rec.message = fmt::format("stopped after {} Newton step(s) with |F| = {:.4e}: {}", rec.iterations, r, stop_asked);
             system.end();
             break;
         }
@@ -58,6 +67,7 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorX
         const GmresResult lin =
             gmres([&system](const Eigen::VectorXd& v) { return system.jacobian_times(v); }, -e.g, gs);
         rec.krylov_iterations.push_back(lin.iterations);
+        rec.gmres_residuals.push_back(lin.residuals);
         double s = 1.0;
         bool accepted = false;
         double r_trial = r;

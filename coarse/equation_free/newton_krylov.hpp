@@ -26,6 +26,8 @@ struct NewtonKrylovSettings {
     /// Relative GMRES tolerance (the forcing term): an inexact Newton step.
     double forcing = 1e-3;
     int max_backtracks = 6;  ///< halvings of the step before the line search gives up
+    /// Called at every iterate (may be empty); a non-empty answer stops the solve.
+    IterateObserver observer;
 };
 
 class NewtonKrylov {

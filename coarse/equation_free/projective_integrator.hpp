@@ -19,16 +19,6 @@
 
 namespace efdem::coarse {
 
-/**
- * \brief Called on the projected vector before lifting; may change it in place and reports
- *        what it did. A report with feasible == false stops the step before the lift.
- *
- * \code
- * RepairHook clip = [&](Eigen::VectorXd& x) { return repair_monotone(x, z_min, z_max); };
- * \endcode
- */
-using RepairHook = std::function<RepairReport(Eigen::VectorXd& projected)>;
-
 /// How an outer step ended. After every status the micro model is in a valid state: at the
 /// end of the burst (no jump), or lifted to the projected vector.
 enum class StepStatus {

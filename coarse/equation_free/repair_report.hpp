@@ -4,7 +4,10 @@
 /// coarse vector before it was lifted. Generic: the repair itself belongs to the coarse
 /// variable (coarse/demixing/monotone_repair.hpp for an ICDF).
 
+#include <functional>
 #include <string>
+
+#include <Eigen/Core>
 
 namespace efdem::coarse {
 
@@ -24,5 +27,15 @@ struct RepairReport {
 
     bool changed() const { return max_adjustment > 0.0; }
 };
+
+/**
+ * \brief Called on the projected (or perturbed) vector before lifting; may change it in place and reports
+ *        what it did. A report with feasible == false stops the step before the lift.
+ *
+ * \code
+ * RepairHook clip = [&](Eigen::VectorXd& x) { return repair_monotone(x, z_min, z_max); };
+ * \endcode
+ */
+using RepairHook = std::function<RepairReport(Eigen::VectorXd& projected)>;
 
 }  // namespace efdem::coarse

@@ -10,6 +10,7 @@ std::string to_string(SteadyStopReason reason) {
         case SteadyStopReason::noise_level: return "stopped at the noise level";
         case SteadyStopReason::line_search_failed: return "line search failed";
         case SteadyStopReason::max_iterations: return "iteration limit";
+        case SteadyStopReason::stopped: return "stopped";
     }
     return "?";
 }

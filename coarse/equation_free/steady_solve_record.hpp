@@ -4,6 +4,7 @@
 /// stopping rule at the noise level of the ensemble, and the record of a solve (why it stopped,
 /// the residual history, the cost, the best iterate).
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -17,8 +18,16 @@ enum class SteadyStopReason {
     noise_level,         ///< |F| within noise_factor x the ensemble's noise: cannot improve further
     line_search_failed,  ///< no step length gave enough decrease of |F|
     max_iterations,      ///< the iteration limit came first
+    stopped,             ///< the caller's observer asked to stop (e.g. a DEM-time budget spent)
 };
 std::string to_string(SteadyStopReason reason);
+
+struct SteadySolveRecord;
+
+/// Called after every iterate's residual is known (the record holds it as its last entry): to
+/// record or report the solve as it goes. Returning a non-empty string stops the solve there
+/// (SteadyStopReason::stopped, the string as the message): e.g. a budget of micro time spent.
+using IterateObserver = std::function<std::string(const SteadySolveRecord&)>;
 
 /// Stop when |F| <= max(tolerance, noise_factor * noise), noise = the norm of the standard
 /// error of F from the members' spread (MapEvaluation::noise_norm). A fixed 1e-8 would never be
@@ -44,6 +53,9 @@ struct SteadySolveRecord {
     std::vector<double> residuals;  ///< |F| at each iterate, the first included
     std::vector<double> noise;      ///< the noise norm measured with each residual
     std::vector<int> krylov_iterations;  ///< GMRES products per Newton step (empty: fixed point)
+    /// Per Newton step, the GMRES residual |G + G' d_j| before the first product and after each
+    /// product j (krylov_iterations[k] + 1 values; empty: fixed point).
+    std::vector<std::vector<double>> gmres_residuals;
     std::vector<double> step_lengths;    ///< line-search / damping factor per step
     int iterations = 0;       ///< steps taken
     long evaluations = 0;     ///< evaluations of the coarse map (each one burst of tau)

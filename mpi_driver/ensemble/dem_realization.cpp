@@ -9,7 +9,9 @@
 #include "coarse/demixing/colour_lifting.hpp"
 #include "coarse/dem_adapters/apply_colours.hpp"
 #include "coarse/dem_adapters/realization_observables.hpp"
+#include "core/contracts.hpp"
 #include "core/error.hpp"
+#include "dem/gas/gas_drag.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -57,6 +59,15 @@ void DemRealization::apply_lift(const LiftPayload& lifted) {
 void DemRealization::after_sample(long samples_taken) {
     if (vtk_ && samples_taken % output_.vtk_every == 0) vtk_->write(system_);
     if (thermo_ && samples_taken % output_.thermo_every == 0) thermo_->write(system_);
+}
+
+std::vector<std::string> continuation_parameters() { return {"gas_drag.superficial_velocity"}; }
+
+void DemRealization::set_parameter(const std::string& key, double value) {
+    EFDEM_EXPECTS(key == "gas_drag.superficial_velocity");
+    auto* gas = dynamic_cast<dem::GasDrag*>(system_.find_effect("gas_drag"));
+    if (!gas) throw RuntimeFailure(fmt::format("{} cannot be set: the scene does not list gas_drag in its effects", key));
+    gas->set_superficial_velocity(value);
 }
 
 RealizationState DemRealization::save_state() const {

@@ -6,6 +6,8 @@
 
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "dem/beds/bed_observation.hpp"
 #include "dem/io/thermo_log.hpp"
@@ -14,6 +16,9 @@
 #include "mpi_driver/ensemble/realization.hpp"
 
 namespace efdem::mpi_driver {
+
+/// The scene keys mode = continuation can continue in (DemRealization::set_parameter).
+std::vector<std::string> continuation_parameters();
 
 /// Per-realization output settings (intervals in samples; 0 = none).
 struct RealizationOutput {
@@ -48,6 +53,8 @@ public:
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
     void apply_lift(const LiftPayload& lifted) override;
     void after_sample(long samples_taken) override;
+    /// key: gas_drag.superficial_velocity (the gas_drag effect must be listed).
+    void set_parameter(const std::string& key, double value) override;
     RealizationState save_state() const override;
     /// RuntimeFailure if the state does not fit this realization (particle count, tags, history).
     void restore_state(const RealizationState& state) override;

@@ -241,6 +241,16 @@ void EnsembleStepper::return_to_kept_state() {
     do_go_back();
 }
 
+void EnsembleStepper::set_parameter(double value) {
+    broadcast({Command::set_parameter, value, false});
+    do_set_parameter(value);
+}
+
+void EnsembleStepper::do_set_parameter(double value) {
+    EFDEM_EXPECTS(!settings_.parameter.empty());
+    for (auto& r : local_) r->set_parameter(settings_.parameter, value);
+}
+
 void EnsembleStepper::confirm_kept_state() {
     broadcast({Command::confirm, 0.0, false});
     do_confirm();
@@ -293,6 +303,7 @@ void EnsembleStepper::serve() {
             case Command::mark: do_mark(); break;
             case Command::checkpoint_mark: do_checkpoint(std::lround(m.value), nullptr, true); break;
             case Command::rebuild: do_rebuild(m.top_half); break;
+            case Command::set_parameter: do_set_parameter(m.value); break;
             case Command::finish: finish_code_ = static_cast<int>(m.value); return;
         }
     }

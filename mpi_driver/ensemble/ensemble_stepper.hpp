@@ -62,6 +62,8 @@ struct StepperSettings {
     /// Root: an observable evaluated at every sample only to be recorded (e.g. the compact
     /// (A,B,C,D) of a direct run, for comparison with a compact CPI run); null for none.
     coarse::EnsembleObservable* recorded = nullptr;
+    /// mode = continuation: the scene key set_parameter() changes (continuation_parameters()).
+    std::string parameter;
     /// observe.bed: how the realizations measure the bed (their Observation::bed); none: not gathered.
     std::optional<dem::BedObservationSettings> bed;
 };
@@ -87,6 +89,9 @@ public:
     void keep_state() override;
     void return_to_kept_state() override;
     void confirm_kept_state() override;
+    /// Root: sets StepperSettings::parameter to `value` on every realization (every rank joins
+    /// through serve()): the continuation parameter, before a lift. Not part of the kept state.
+    void set_parameter(double value);
 
     /// Root: write a whole-ensemble checkpoint numbered `sequence` with the driver's state
     /// (every rank joins through serve()). Needs set_checkpoint_writer(). Returns its path.
@@ -168,7 +173,7 @@ public:
 private:
     enum class Command : int {
         run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7, mark = 8,
-        checkpoint_mark = 9, rebuild = 10
+        checkpoint_mark = 9, rebuild = 10, set_parameter = 11
     };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
@@ -211,6 +216,7 @@ private:
     std::vector<RealizationState> saved_realizations(const char* when) const;
     void do_go_back();
     void do_confirm();
+    void do_set_parameter(double value);
 
     const EnsembleLayout& layout_;
     std::vector<std::unique_ptr<Realization>> local_;

@@ -89,6 +89,12 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
         file_.create_group("/cpi");
         index_axis("/cpi/coarse_node", dim_);
     }
+    if (p.mode == "steady" || p.mode == "continuation") {
+        file_.create_group("/steady");
+        file_.create_group("/steady/iterate");
+        index_axis("/steady/coarse_node", dim_);
+        if (p.mode == "continuation") file_.create_group("/branch");
+    }
     if (species_ > 0) {
         file_.create_group("/bed");
         file_.create_group("/bed/mean");
@@ -268,6 +274,113 @@ void Hdf5Recorder::failure(const FailureRecord& f) {
     series("/failures/donor", {}, T::integer).append_integer(f.donor);
     series("/failures/resumed_at", {}, T::real).append(f.resumed_at);
     series("/failures/realizations_left", {}, T::integer).append_integer(f.realizations_left);
+    file_.flush();
+}
+
+void Hdf5Recorder::steady_iterate(const SteadyIterateRecord& it) {
+    using T = H5Series::Type;
+    series("/steady/iterate/dem_time", {}, T::real).append(it.dem_time);
+    series("/steady/iterate/solve", {}, T::integer).append_integer(it.solve);
+    series("/steady/iterate/iteration", {}, T::integer).append_integer(it.iteration);
+    series("/steady/iterate/residual", {}, T::real).append(it.residual);
+    series("/steady/iterate/noise", {}, T::real).append(it.noise);
+    series("/steady/iterate/parameter", {}, T::real).append(it.parameter);
+    series("/steady/iterate/x", {static_cast<hsize_t>(dim_)}, T::real).append(as_span(it.x));
+    file_.flush();
+}
+
+void Hdf5Recorder::branch_point(const coarse::BranchPoint& p) {
+    using T = H5Series::Type;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    series("/branch/parameter", {}, T::real).append(p.parameter);
+    series("/branch/x", {static_cast<hsize_t>(dim_)}, T::real).append(as_span(p.x));
+    series("/branch/residual", {}, T::real).append(p.residual);
+    series("/branch/noise", {}, T::real).append(p.noise);
+    series("/branch/mean_height", {}, T::real).append(coarse::mean_height(p.x));
+    series("/branch/mean_height_error", {}, T::real).append(coarse::mean_height_error_bound(p.noise, p.x.size()));
+    series("/branch/newton_steps", {}, T::integer).append_integer(p.newton_iterations);
+    series("/branch/arclength_step", {}, T::real).append(p.step);
+    series("/branch/leading_real", {}, T::real).append(p.has_leading ? p.leading.mu.real() : nan);
+    series("/branch/leading_imag", {}, T::real).append(p.has_leading ? p.leading.mu.imag() : nan);
+    series("/branch/leading_rate", {}, T::real).append(p.has_leading ? p.leading.rate : nan);
+    series("/branch/leading_residual", {}, T::real).append(p.has_leading ? p.leading.residual : nan);
+    series("/branch/dem_time", {}, T::real).append(p.micro_time);
+    file_.flush();
+}
+
+void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
+    const auto d = static_cast<hsize_t>(dim_);
+    auto vector = [&](const char* name, const Eigen::VectorXd& v) {
+        if (v.size() != dim_) return;  // e.g. no iterate before a signal
+        file_.write(name, as_span(v), {d});
+        document(name);
+    };
+    file_.attribute("/steady", "solver", o.solver);
+    file_.attribute("/steady", "tau", o.tau);
+    file_.attribute("/steady", "warmup_end", o.warmup_end);
+    file_.attribute("/steady", "evaluations", std::int64_t{o.evaluations});
+    file_.attribute("/steady", "dem_time", o.micro_time);
+    file_.attribute("/steady", "repairs", std::int64_t{o.repairs});
+    file_.attribute("/steady", "largest_repair", o.largest_repair);
+    file_.attribute("/steady", "converged", std::int64_t{o.converged ? 1 : 0});
+    file_.attribute("/steady", "end_status", o.end_status);
+    vector("/steady/x0", o.x0);
+    if (o.continuation) {
+        file_.attribute("/branch", "parameter", o.parameter);
+        file_.attribute("/branch", "scale", o.parameter_scale);
+        file_.attribute("/branch", "end_reason", o.branch.end_reason);
+        std::vector<double> folds;
+        for (const coarse::FoldEstimate& f : o.branch.folds()) folds.push_back(f.parameter * o.parameter_scale);
+        if (!folds.empty()) {
+            file_.write("/branch/fold_parameter", folds, {static_cast<hsize_t>(folds.size())});
+            document("/branch/fold_parameter");
+        }
+        file_.flush();
+        return;
+    }
+    const coarse::SteadySolveRecord& r = o.solve;
+    file_.attribute("/steady", "reason", coarse::to_string(r.reason));
+    file_.attribute("/steady", "message", r.message);
+    file_.attribute("/steady", "iterations", std::int64_t{r.iterations});
+    file_.attribute("/steady", "best_residual", r.best_residual);
+    vector("/steady/x", r.x);
+    vector("/steady/best", r.best);
+    if (r.best.size() == dim_) file_.attribute("/steady", "mean_height", coarse::mean_height(r.best));
+    auto reals = [&](const char* name, const std::vector<double>& v) {
+        file_.write(name, v, {static_cast<hsize_t>(v.size())});
+        document(name);
+    };
+    auto integers = [&](const char* name, const std::vector<std::int64_t>& v) {
+        file_.write(name, v, {static_cast<hsize_t>(v.size())});
+        document(name);
+    };
+    if (!r.step_lengths.empty()) reals("/steady/step_length", r.step_lengths);
+    if (!r.krylov_iterations.empty()) {
+        integers("/steady/krylov_products", std::vector<std::int64_t>(r.krylov_iterations.begin(), r.krylov_iterations.end()));
+        std::vector<double> res;
+        std::vector<std::int64_t> step;
+        for (std::size_t k = 0; k < r.gmres_residuals.size(); ++k)
+            for (double v : r.gmres_residuals[k]) {
+                res.push_back(v);
+                step.push_back(static_cast<std::int64_t>(k));
+            }
+        reals("/steady/gmres_residual", res);
+        integers("/steady/gmres_newton_step", step);
+    }
+    if (!o.spectrum.leading.empty()) {
+        std::vector<double> re, im, rate, residual;
+        for (const coarse::CoarseEigenvalue& e : o.spectrum.leading) {
+            re.push_back(e.mu.real());
+            im.push_back(e.mu.imag());
+            rate.push_back(e.rate);
+            residual.push_back(e.residual);
+        }
+        reals("/steady/eigenvalue_real", re);
+        reals("/steady/eigenvalue_imag", im);
+        reals("/steady/eigenvalue_rate", rate);
+        reals("/steady/eigenvalue_residual", residual);
+        file_.attribute("/steady", "eigenvalue_products", std::int64_t{o.spectrum.products});
+    }
     file_.flush();
 }
 

@@ -33,6 +33,9 @@ public:
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;
     void failure(const FailureRecord& f) override;
+    void steady_iterate(const SteadyIterateRecord& it) override;
+    void branch_point(const coarse::BranchPoint& point) override;
+    void steady_outcome(const coarse::SteadyRunOutcome& outcome) override;
     std::vector<std::filesystem::path> files() const override { return {path_}; }
 
 private:

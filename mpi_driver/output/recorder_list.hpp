@@ -22,6 +22,15 @@ public:
     void failure(const FailureRecord& f) override {
         for (auto& r : recorders_) r->failure(f);
     }
+    void steady_iterate(const SteadyIterateRecord& it) override {
+        for (auto& r : recorders_) r->steady_iterate(it);
+    }
+    void branch_point(const coarse::BranchPoint& point) override {
+        for (auto& r : recorders_) r->branch_point(point);
+    }
+    void steady_outcome(const coarse::SteadyRunOutcome& outcome) override {
+        for (auto& r : recorders_) r->steady_outcome(outcome);
+    }
     void finish(const RunSummary& summary) override {
         for (auto& r : recorders_) r->finish(summary);
     }

@@ -10,7 +10,9 @@ namespace {
 using D = std::vector<std::string_view>;
 const D scalar{}, sample{"sample"}, sample_node{"sample", "node"}, sample_r{"sample", "realization"},
     sample_r_node{"sample", "realization", "node"}, step{"step"}, step_coarse{"step", "coarse_node"},
-    step_r{"step", "realization"}, failure{"failure"};
+    step_r{"step", "realization"}, failure{"failure"}, iterate{"iterate"}, iterate_node{"iterate", "steady_node"},
+    steady_node{"steady_node"}, newton_step{"newton_step"}, gmres{"gmres_entry"}, eigen{"eigenvalue"},
+    point{"point"}, point_node{"point", "steady_node"}, fold{"fold"};
 }  // namespace
 
 const std::vector<DatasetDoc>& run_file_schema() {
@@ -87,6 +89,42 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/cpi/lift_changed", "1", "labels lifting changed in each realization", step_r},
         {"/cpi/lift_max_deviation", "d_p", "largest |achieved - target| of the lifted ICDF per realization", step_r},
         {"/cpi/lift_message", "text", "realizations whose target was repaired or clipped, and why", step},
+        // /steady: mode = steady | continuation. One row of /steady/iterate per iterate of
+        // every solve, as it comes; the rest at the end of the run.
+        {"/steady/coarse_node", "1", "component index of the coarse vector (cpi.observable = icdf: the node of /p)", steady_node},
+        {"/steady/iterate/dem_time", "sqrt(d_p/g)", "DEM time spent after the warm-up when the iterate's residual was known (per realization)", iterate},
+        {"/steady/iterate/solve", "1", "which solve: 0 the steady solve or the first branch point, k the k-th continuation corrector", iterate},
+        {"/steady/iterate/iteration", "1", "Newton step or fixed-point iteration within its solve (0: its start)", iterate},
+        {"/steady/iterate/residual", "d_p", "|F| = |Phi_tau(X) - X| at the iterate (a corrector: |G| of the extended system)", iterate},
+        {"/steady/iterate/noise", "d_p", "noise norm of F: |SE| of Phi_tau(X) from the realizations' spread", iterate},
+        {"/steady/iterate/parameter", "scene unit", "continuation: the parameter at the iterate (0 in mode = steady)", iterate},
+        {"/steady/iterate/x", "d_p", "the iterate's coarse vector", iterate_node},
+        {"/steady/x0", "d_p", "the initial guess: the ensemble mean at the end of the warm-up", steady_node},
+        {"/steady/x", "d_p", "mode = steady: the last iterate (the answer when the solve converged)", steady_node},
+        {"/steady/best", "d_p", "mode = steady: the iterate with the smallest |F| (saved also when the solve did not converge)", steady_node},
+        {"/steady/krylov_products", "1", "newton: GMRES products (J v, one burst each) per Newton step", newton_step},
+        {"/steady/step_length", "1", "line-search factor (newton) or damping (anderson) per step", newton_step},
+        {"/steady/gmres_residual", "d_p", "newton: GMRES residual |F + J d| before the first product and after each product", gmres},
+        {"/steady/gmres_newton_step", "1", "the Newton step each /steady/gmres_residual belongs to", gmres},
+        {"/steady/eigenvalue_real", "1", "real part of a leading eigenvalue mu of dPhi_tau/dX at the answer", eigen},
+        {"/steady/eigenvalue_imag", "1", "imaginary part of mu", eigen},
+        {"/steady/eigenvalue_rate", "1/sqrt(d_p/g)", "log|mu| / tau: the decay (< 0) or growth rate of the mode", eigen},
+        {"/steady/eigenvalue_residual", "1", "Arnoldi residual estimate of the Ritz pair: the uncertainty of mu", eigen},
+        // /branch: mode = continuation, one row per branch point, as it comes.
+        {"/branch/parameter", "scene unit", "the continuation parameter at the point (continuation.parameter)", point},
+        {"/branch/x", "d_p", "the steady coarse vector at the point", point_node},
+        {"/branch/residual", "d_p", "|F| at the point", point},
+        {"/branch/noise", "d_p", "noise norm of F at the point", point},
+        {"/branch/mean_height", "d_p", "segregation measure: the mean of the ICDF nodes, an estimate of the observed species' mean height", point},
+        {"/branch/mean_height_error", "d_p", "upper bound on the standard error of /branch/mean_height: noise / sqrt(nodes)", point},
+        {"/branch/newton_steps", "1", "Newton steps of the point's corrector", point},
+        {"/branch/arclength_step", "1", "arclength step that reached the point in (X [d_p], parameter / continuation.scale); 0 for the first", point},
+        {"/branch/leading_real", "1", "real part of the leading eigenvalue mu of dPhi_tau/dX at the point (NaN: not computed)", point},
+        {"/branch/leading_imag", "1", "imaginary part of the leading mu", point},
+        {"/branch/leading_rate", "1/sqrt(d_p/g)", "log|mu| / tau of the leading eigenvalue: > 0 an unstable steady state", point},
+        {"/branch/leading_residual", "1", "Arnoldi residual estimate of the leading eigenvalue", point},
+        {"/branch/dem_time", "sqrt(d_p/g)", "DEM time the point cost (its corrector and eigenvalue, per realization)", point},
+        {"/branch/fold_parameter", "scene unit", "where the parameter turns along the branch (vertex of a parabola through three points)", fold},
         // /failures: one row per realization failure the run survived.
         {"/failures/time", "sqrt(d_p/g)", "when the realization failed", failure},
         {"/failures/realization", "1", "the failed realization", failure},
@@ -115,6 +153,9 @@ std::string_view dimension_scale(std::string_view dim) {
     if (dim == "species") return "/bed/species";
     if (dim == "slab") return "/bed/z";
     if (dim == "failure") return "/failures/time";
+    if (dim == "steady_node") return "/steady/coarse_node";
+    if (dim == "iterate") return "/steady/iterate/dem_time";
+    if (dim == "point") return "/branch/parameter";
     return "";
 }
 

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/projective_integrator.hpp"
+#include "coarse/equation_free/steady_run.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -83,6 +84,20 @@ struct RunSummary {
     /// Adaptive CPI: what the controller did and what more realizations would buy (text lines;
     /// empty otherwise).
     std::string controller;
+    /// mode = steady | continuation: the solve did not reach its stopping rule (exit code 3;
+    /// the best iterate is in the run file).
+    bool unconverged = false;
+};
+
+/// mode = steady | continuation: one iterate of a solve, as it comes.
+struct SteadyIterateRecord {
+    long solve = 0;       ///< 0: the steady solve or the first branch point; k: the k-th corrector
+    long iteration = 0;   ///< Newton step / fixed-point iteration within the solve (0: the start)
+    double residual = 0;  ///< |F| (continuation correctors: |G| of the extended system)
+    double noise = 0;     ///< the noise norm measured with it
+    Eigen::VectorXd x;    ///< the iterate's coarse vector
+    double parameter = 0; ///< continuation: the parameter (scene units); 0 otherwise
+    double dem_time = 0;  ///< micro time spent since the warm-up ended (per realization)
 };
 
 class RunRecorder {
@@ -93,6 +108,12 @@ public:
     virtual void finish(const RunSummary& summary) = 0;
     /// A realization's failure that the run survived (drop, replace).
     virtual void failure(const FailureRecord& f) = 0;
+    /// mode = steady | continuation (default: not recorded): every iterate as it comes, every
+    /// new branch point, and the outcome at the end (also of a solve that did not converge or
+    /// was interrupted: what it found, with its best iterate).
+    virtual void steady_iterate(const SteadyIterateRecord& it) { (void)it; }
+    virtual void branch_point(const coarse::BranchPoint& point) { (void)point; }
+    virtual void steady_outcome(const coarse::SteadyRunOutcome& outcome) { (void)outcome; }
     /// The files this recorder writes (a checkpoint stores them whole, a restart puts them back).
     virtual std::vector<std::filesystem::path> files() const = 0;
 };

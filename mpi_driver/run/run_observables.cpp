@@ -19,7 +19,7 @@ std::unique_ptr<coarse::EnsembleObservable> make(std::string_view name, const co
 RunObservables RunObservables::from_settings(const RunSettings& s) {
     const coarse::ProbabilityGrid grid(s.observe.quantiles);
     RunObservables o;
-    o.primary = make(s.is_cpi() ? std::string_view(s.observable) : std::string_view("icdf"), grid);
+    o.primary = make(s.lifts() ? std::string_view(s.observable) : std::string_view("icdf"), grid);
     if (s.is_cpi() && o.primary->name() != "icdf") o.fallback = make("icdf", grid);
     if (s.observe.compact && o.primary->name() != "compact") o.recorded = make("compact", grid);
     return o;

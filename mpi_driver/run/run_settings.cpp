@@ -7,12 +7,14 @@
 #include "coarse/demixing/observable_table.hpp"
 #include "coarse/demixing/probability_grid.hpp"
 #include "core/whole_multiple.hpp"
+#include "mpi_driver/ensemble/dem_realization.hpp"
 
 namespace efdem::mpi_driver {
 
 RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& scene) {
     RunSettings s;
-    s.mode = root.get_or_choice("mode", "direct", {"direct", "cpi"}) == "cpi" ? Mode::cpi : Mode::direct;
+    const std::string mode = root.get_or_choice("mode", "direct", {"direct", "cpi", "steady", "continuation"});
+    s.mode = mode == "cpi" ? Mode::cpi : mode == "steady" ? Mode::steady : mode == "continuation" ? Mode::continuation : Mode::direct;
     s.seed = root.get_or<std::uint64_t>("seed", 1);
     s.realizations_per_rank =
         root.scope("ensemble").get_or<int>("realizations_per_rank", 1, Bounds::closed(1, 4096));
@@ -35,8 +37,13 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     }
 
     const Params run = root.scope("run");
-    s.duration = run.get<double>("duration", Bounds::open_closed(0.0, 1e9));
-    whole_multiple(run, "duration", s.duration, s.observe.interval, "observe.interval");
+    if (s.is_steady()) {
+        // A budget of DEM time, not a span to cover: the solve ends when it is spent.
+        s.duration = run.get_or<double>("duration", 0.0, Bounds::closed(0.0, 1e9));
+    } else {
+        s.duration = run.get<double>("duration", Bounds::open_closed(0.0, 1e9));
+        whole_multiple(run, "duration", s.duration, s.observe.interval, "observe.interval");
+    }
 
     // The cpi block is read in both modes (a direct run of a cpi scene is the reference the cpi
     // run is compared with, and its cpi.* keys are not "unused"), but checked against the
@@ -45,20 +52,36 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     const auto observables = coarse::observable_table().names();
     s.observable = cpi.get_or_choice("observable", observables.front(), observables);
     s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval, s.is_cpi());
-    if (s.is_cpi()) {
+    if (s.is_steady()) {
+        const auto* row = coarse::observable_table().find(s.observable);
+        const long dimension = row ? static_cast<long>(row->make(coarse::ProbabilityGrid(s.observe.quantiles))->dimension())
+                                   : s.observe.quantiles;
+        s.steady = coarse::SteadyRunSettings::from_params(
+            root, s.observe.interval, dimension, s.mode == Mode::continuation, continuation_parameters(),
+            [&](const std::string& key) {
+                const auto dot = key.find('.');
+                const std::string effect = key.substr(0, dot);
+                if (std::find(scene.effect_names.begin(), scene.effect_names.end(), effect) == scene.effect_names.end())
+                    root.scope("continuation").fail("parameter", fmt::format("names a key of {}, which the scene's effects do not list", effect),
+                                                    fmt::format("a key of a listed effect (add {} to effects)", effect));
+                // Read with the bounds its effect reads it with (dem/gas/gas_drag.cpp).
+                return root.scope(effect).get<double>(key.substr(dot + 1), Bounds::closed(0.0, 1e3));
+            });
+    }
+    if (s.lifts()) {
         // After cpi.warmup and one burst something must be left to jump over: a run of exactly
         // warm-up + one burst is a direct run (ProjectiveRun warns of the cases only the run
         // itself can tell: a steady warm-up to the end, a controller that declines every jump).
         const double least = s.cpi.warmup + s.cpi.burst();
-        if (s.duration <= least + 1e-9 * least)
+        if (s.is_cpi() && s.duration <= least + 1e-9 * least)
             run.fail("duration",
                      fmt::format("leaves nothing to jump after cpi.warmup + one burst (cpi.healing + cpi.window) = "
                                  "{:g}: the cpi run could not make a single projective jump", least),
                      fmt::format("run.duration > {:g} (several bursts and jumps to gain anything), or mode = direct",
                                  least));
         if (scene.species.size() != 2)
-            root.fail("mode", fmt::format("cpi lifts by swapping the labels of two species, but "
-                                          "species.names lists {}", scene.species.size()),
+            root.fail("mode", fmt::format("{} lifts by swapping the labels of two species, but "
+                                          "species.names lists {}", s.mode_name(), scene.species.size()),
                       "direct, or exactly two species");
         for (std::size_t k = 1; k < scene.species.size(); ++k)
             if (scene.species[static_cast<dem::SpeciesId>(k)].diameter != scene.species[0].diameter)
@@ -89,6 +112,12 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
 
     s.output.overwrite = output.get_or<bool>("overwrite", false);
     s.checkpoint = CheckpointSettings::from_params(root, s.output.directory);
+    if (s.is_steady() && s.checkpoint.enabled())
+        root.scope("checkpoint").fail("interval",
+                                      fmt::format("is not supported with mode = {}: a solve keeps micro states in "
+                                                  "memory that a checkpoint does not hold",
+                                                  s.mode_name()),
+                                      "0 (the default) with mode = steady or continuation");
     const Params debug = root.scope("debug");
     s.injected_failure.realization = debug.get_or<long>("fail_realization", -1, Bounds::closed(-1, 1e9));
     s.injected_failure.time = debug.get_or<double>("fail_time", 0.0, Bounds::closed(0.0, 1e9));
@@ -98,6 +127,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.on_failure.action = action == "drop"      ? FailurePolicy::Action::drop
                           : action == "replace" ? FailurePolicy::Action::replace
                                                 : FailurePolicy::Action::abort;
+    if (s.is_steady() && s.on_failure.action != FailurePolicy::Action::abort)
+        ensemble.fail("on_failure",
+                      fmt::format("is not supported with mode = {}: the derivatives compare evaluations of the same "
+                                  "ensemble, which a dropped or replaced realization would change", s.mode_name()),
+                      "abort with mode = steady or continuation");
     if (s.on_failure.action == FailurePolicy::Action::replace && !s.is_cpi())
         ensemble.fail("on_failure",
                       "= replace needs cpi mode: in a direct run a copy of a healthy realization would follow "
@@ -110,6 +144,16 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     return s;
 }
 
+const char* RunSettings::mode_name() const {
+    switch (mode) {
+        case Mode::direct: return "direct";
+        case Mode::cpi: return "cpi";
+        case Mode::steady: return "steady";
+        case Mode::continuation: return "continuation";
+    }
+    return "?";
+}
+
 void RunSettings::check_ensemble(const Params& root, int realizations) {
     // A run that measures the spread of the realizations' slopes needs two of them to the end.
     const bool spread = is_cpi() && cpi.projection == coarse::CoarseRunSettings::Projection::adaptive;
@@ -117,6 +161,20 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
     if (on_failure.max_failures < 0) on_failure.max_failures = std::max(1, realizations / 4);
     if (on_failure.action == FailurePolicy::Action::drop && on_failure.max_failures > realizations - on_failure.min_active)
         on_failure.max_failures = std::max(0, realizations - on_failure.min_active);
+    if (is_steady()) {
+        if (realizations < 2)
+            root.fail("mode",
+                      fmt::format("= {} stops its solve at the noise level of the ensemble, measured from the spread "
+                                  "of >= 2 realizations; this run has {} (ranks x ensemble.realizations_per_rank)",
+                                  mode_name(), realizations),
+                      "steady or continuation with >= 2 realizations (more ranks or ensemble.realizations_per_rank)");
+        const auto* row = coarse::observable_table().find(observable);
+        if (row && !row->make(coarse::ProbabilityGrid(observe.quantiles))->restricts_members())
+            root.scope("cpi").fail("observable",
+                                   fmt::format("cannot restrict a realization on its own, and mode = {} measures the "
+                                               "noise of F from the realizations' spread", mode_name()),
+                                   "icdf with mode = steady or continuation");
+    }
     if (!spread) return;
     const Params c = root.scope("cpi");
     if (realizations < 2)

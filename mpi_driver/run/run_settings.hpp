@@ -10,13 +10,16 @@
 ///
 /// | key                            | meaning                                             | default |
 /// |--------------------------------|-----------------------------------------------------|---------|
-/// | mode                           | `direct` (every realization runs the DEM) or `cpi`  | direct  |
+/// | mode                           | `direct` (every realization runs the DEM), `cpi`,   | direct  |
+/// |                                | `steady` or `continuation` (steady_run_settings.hpp) |         |
 /// | seed                           | master seed of every random stream                  | 1       |
 /// | ensemble.realizations_per_rank | k: the ensemble has R = P x k realizations          | 1       |
 /// | ensemble.on_failure            | abort, drop or replace (cpi) a failing realization   | abort   |
 /// |                                | (failure_policy.hpp)                                 |         |
 /// | ensemble.max_failures          | failures a drop/replace run survives                 | R/4, >= 1 |
-/// | run.duration                   | simulated time to cover (cpi: until reached)        | required|
+/// | run.duration                   | simulated time to cover (cpi: until reached);       | required|
+/// |                                | steady, continuation: most DEM time after the       | 0 (none)|
+/// |                                | warm-up (per realization; 0: no limit)              |         |
 /// | observe.interval               | time between ICDF samples (a multiple of dt)        | 0.5     |
 /// | observe.species                | species whose heights make the ICDF                 | first   |
 /// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19      |
@@ -47,6 +50,7 @@
 #include <string>
 
 #include "coarse/equation_free/coarse_run_settings.hpp"
+#include "coarse/equation_free/steady_run_settings.hpp"
 #include "core/param_table.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/checkpoint_settings.hpp"
@@ -77,7 +81,7 @@ struct OutputSettings {
 };
 
 struct RunSettings {
-    enum class Mode { direct, cpi } mode = Mode::direct;
+    enum class Mode { direct, cpi, steady, continuation } mode = Mode::direct;
     std::uint64_t seed = 1;
     int realizations_per_rank = 1;
     double duration = 0;
@@ -86,6 +90,8 @@ struct RunSettings {
     std::string observable = "icdf";
     /// The other cpi.* keys, read by the coarse layer.
     coarse::CoarseRunSettings cpi;
+    /// mode = steady | continuation: the steady.* and continuation.* keys.
+    coarse::SteadyRunSettings steady;
     OutputSettings output;
     CheckpointSettings checkpoint;
     /// debug.fail_*: a test-only injected failure.
@@ -95,8 +101,12 @@ struct RunSettings {
     FailurePolicy on_failure;
 
     bool is_cpi() const { return mode == Mode::cpi; }
-    /// "cpi" or "direct".
-    const char* mode_name() const { return is_cpi() ? "cpi" : "direct"; }
+    /// mode = steady or continuation (the coarse time-tau map, docs/steady_states.md).
+    bool is_steady() const { return mode == Mode::steady || mode == Mode::continuation; }
+    /// The run lifts coarse vectors onto the realizations (cpi, steady, continuation).
+    bool lifts() const { return mode != Mode::direct; }
+    /// "direct", "cpi", "steady" or "continuation".
+    const char* mode_name() const;
 
     /// Reads and cross-checks the run keys (dt and species come from the DEM scene).
     static RunSettings from_params(const Params& root, const dem::DemScene& scene);

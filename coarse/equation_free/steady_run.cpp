@@ -1,0 +1,117 @@
+#include "coarse/equation_free/steady_run.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "coarse/equation_free/fixed_point_iteration.hpp"
+#include "coarse/equation_free/fixed_point_system.hpp"
+#include "coarse/equation_free/newton_krylov.hpp"
+#include "core/contracts.hpp"
+#include "core/log.hpp"
+
+namespace efdem::coarse {
+
+double mean_height(const Eigen::VectorXd& x) { return x.size() > 0 ? x.mean() : 0.0; }
+
+double mean_height_error_bound(double noise_norm, Eigen::Index n) {
+    return n > 0 ? noise_norm / std::sqrt(static_cast<double>(n)) : 0.0;
+}
+
+SteadyRun::SteadyRun(const SteadyRunSettings& settings, CoarseStepper& stepper, RepairHook repair,
+                     std::function<void(double)> set_parameter)
+    : settings_(settings), stepper_(stepper), repair_(std::move(repair)), set_parameter_(std::move(set_parameter)) {
+    EFDEM_EXPECTS(settings_.warmup > 0.0);
+    EFDEM_EXPECTS(!settings_.continuation || set_parameter_);
+}
+
+SteadyRunOutcome SteadyRun::run() {
+    SteadyRunOutcome out;
+    out.continuation = settings_.continuation;
+    out.solver = settings_.solver == SteadyRunSettings::Solver::newton ? "newton" : "anderson";
+    out.tau = settings_.map.tau;
+    out.parameter = settings_.parameter;
+    out.parameter_scale = settings_.parameter_scale;
+    if (settings_.continuation) set_parameter_(settings_.parameter_start);
+    BurstSamples warm;
+    stepper_.run(settings_.warmup, warm);
+    EFDEM_ASSERT(warm.size() >= 1);
+    out.x0 = warm.x.back();
+    out.warmup_end = stepper_.time();
+    log::info("steady: warm-up of {:g} done at t = {:.6g}; initial guess: mean height {:.4g}", settings_.warmup,
+              out.warmup_end, mean_height(out.x0));
+
+    std::function<void(double)> hook;
+    if (settings_.continuation) {
+        const double scale = settings_.parameter_scale;
+        hook = [this, scale](double lambda) { set_parameter_(lambda * scale); };
+    }
+    CoarseMap map(stepper_, settings_.map, hook);
+    if (repair_) map.set_repair(repair_);
+    if (settings_.continuation)
+        continue_branch(map, out);
+    else
+        solve_steady(map, out);
+    out.repairs = map.repairs();
+    out.largest_repair = map.largest_repair();
+    out.evaluations = map.evaluations();
+    out.micro_time = map.micro_time();
+    if (out.repairs > 0)
+        log::warn("steady: the repair changed {} of {} lifted points (largest change {:.3g}): a difference it "
+                  "touched is biased; a smaller steady.difference_step keeps perturbed ICDFs monotone",
+                  out.repairs, out.evaluations, out.largest_repair);
+    return out;
+}
+
+void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
+    if (settings_.solver == SteadyRunSettings::Solver::newton) {
+        NewtonKrylovSettings ns = settings_.newton;
+        ns.observer = iterate_observer_;
+        FixedPointSystem system(map, out.x0.size());
+        out.solve = NewtonKrylov(ns).solve(system, out.x0);
+    } else {
+        FixedPointSettings fs = settings_.fixed_point;
+        fs.observer = iterate_observer_;
+        out.solve = FixedPointIteration(fs).solve(map, out.x0);
+    }
+    out.converged = out.solve.converged();
+    // The spectrum where the solve ended (also an unconverged one: the best iterate's
+    // neighbourhood is what the user gets, and the eigenvalues say why it was hard).
+    if (settings_.eigenvalues > 0 && out.converged) {
+        SpectrumSettings ss = settings_.spectrum;
+        ss.eigenvalues = settings_.eigenvalues;
+        out.spectrum = coarse_spectrum(map, out.solve.x, ss);
+        for (const CoarseEigenvalue& e : out.spectrum.leading)
+            log::info("steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual {:.2g})", e.mu.real(),
+                      e.mu.imag(), e.rate, e.residual);
+    }
+    out.end_status = out.converged
+                         ? fmt::format("completed: {}", out.solve.message)
+                         : fmt::format("not converged: {}; best |F| = {:.4e} (noise {:.3e} at the start)",
+                                       out.solve.message, out.solve.best_residual,
+                                       out.solve.noise.empty() ? 0.0 : out.solve.noise.front());
+}
+
+Branch SteadyRun::unscaled(const Branch& branch) const {
+    Branch b = branch;
+    for (BranchPoint& p : b.points) p.parameter *= settings_.parameter_scale;
+    return b;
+}
+
+void SteadyRun::continue_branch(CoarseMap& map, SteadyRunOutcome& out) {
+    ContinuationSettings cs = settings_.branch;
+    cs.corrector.observer = iterate_observer_;
+    if (point_observer_) cs.on_point = [this](const Branch& b) { point_observer_(unscaled(b)); };
+    PseudoArclengthContinuation continuation(map, cs);
+    const double direction = settings_.parameter_end >= settings_.parameter_start ? 1.0 : -1.0;
+    out.branch = unscaled(continuation.run(out.x0, settings_.parameter_start / settings_.parameter_scale, direction));
+    out.converged = !out.branch.points.empty();
+    const std::size_t n = out.branch.points.size();
+    out.end_status = out.converged ? fmt::format("completed: {} branch point(s) from {} = {:.4g} to {:.4g}; {}", n,
+                                                 out.parameter, out.branch.points.front().parameter,
+                                                 out.branch.points.back().parameter, out.branch.end_reason)
+                                   : fmt::format("not converged: {}", out.branch.end_reason);
+}
+
+}  // namespace efdem::coarse

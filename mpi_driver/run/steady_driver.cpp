@@ -1,0 +1,125 @@
+#include "mpi_driver/run/steady_driver.hpp"
+
+#include <string>
+
+#include <fmt/format.h>
+
+#include "coarse/equation_free/steady_run.hpp"
+#include "core/log.hpp"
+#include "mpi_driver/ensemble/stop_signal.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+/// What the observers saw, kept for the end of a run cut short (signal, failure).
+struct SolveTrace {
+    long solve = 0;             ///< the current solve
+    long last_iteration = -1;   ///< its last iterate seen
+    coarse::SteadySolveRecord latest;  ///< the current solve's record so far
+    coarse::Branch branch;      ///< continuation: the points so far
+};
+}  // namespace
+
+RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder, Progress& progress) {
+    const coarse::SteadyRunSettings& ss = s.steady;
+    coarse::EnsembleObservable& observable = stepper.observable();
+    coarse::SteadyRun run(ss, stepper, observable.repair_hook([&stepper] { return stepper.height_range(); }),
+                          [&stepper](double value) { stepper.set_parameter(value); });
+    const double micro_start = stepper.micro_time();
+    const double budget = s.duration;  // 0: none
+    double parameter = ss.continuation ? ss.parameter_start : 0.0;
+    SolveTrace trace;
+
+    run.set_iterate_observer([&](const coarse::SteadySolveRecord& rec) -> std::string {
+        const long iteration = static_cast<long>(rec.residuals.size()) - 1;
+        if (iteration <= trace.last_iteration) ++trace.solve;  // a new solve began
+        trace.last_iteration = iteration;
+        trace.latest = rec;
+        SteadyIterateRecord it;
+        it.solve = trace.solve;
+        it.iteration = iteration;
+        it.residual = rec.residuals.back();
+        it.noise = rec.noise.back();
+        const Eigen::Index n = stepper.observable().dimension();
+        it.x = rec.x.head(std::min<Eigen::Index>(n, rec.x.size()));
+        it.parameter = ss.continuation && rec.x.size() > n ? rec.x[n] * ss.parameter_scale : parameter;
+        it.dem_time = stepper.micro_time() - micro_start - ss.warmup;
+        if (recorder) recorder->steady_iterate(it);
+        const double rate = stepper.micro_time() > 0 ? stepper.particle_steps() / progress.elapsed_seconds() : 0.0;
+        log::info("steady: solve {} iterate {}: |F| = {:.4e} (noise {:.3e}, {:.2f} x noise){}; DEM time {:.4g}{} in "
+                  "{} wall ({:.3g} particle-steps/s)",
+                  it.solve, it.iteration, it.residual, it.noise, it.noise > 0 ? it.residual / it.noise : 0.0,
+                  ss.continuation ? fmt::format(" at {} = {:.5g}", ss.parameter, it.parameter) : std::string{},
+                  it.dem_time, budget > 0 ? fmt::format(" of {:.4g}", budget) : std::string{},
+                  format_duration(progress.elapsed_seconds()), rate);
+        if (stepper.interrupted()) return fmt::format("stopped by {}", signal_name(stepper.interrupted()));
+        if (budget > 0 && it.dem_time >= budget)
+            return fmt::format("the DEM-time budget run.duration = {:g} is spent ({:.4g} used)", budget, it.dem_time);
+        return {};
+    });
+    run.set_point_observer([&](const coarse::Branch& b) {
+        trace.branch = b;
+        parameter = b.points.back().parameter;
+        if (recorder) recorder->branch_point(b.points.back());
+    });
+
+    RunSummary sum;
+    coarse::SteadyRunOutcome out;
+    try {
+        out = run.run();
+    } catch (const RunInterrupted&) {
+        // Between two samples of an evaluation: what was found so far is what is saved.
+        out.continuation = ss.continuation;
+        out.solver = ss.solver == coarse::SteadyRunSettings::Solver::newton ? "newton" : "anderson";
+        out.tau = ss.map.tau;
+        out.parameter = ss.parameter;
+        out.parameter_scale = ss.parameter_scale;
+        out.solve = trace.latest;
+        out.solve.reason = coarse::SteadyStopReason::stopped;
+        out.solve.message = fmt::format("stopped by {}", signal_name(stepper.interrupted()));
+        out.branch = trace.branch;
+        out.branch.end_reason = out.solve.message;
+        out.end_status = fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
+                                     "continued; its best iterate is saved)",
+                                     signal_name(stepper.interrupted()), stepper.time());
+        sum.stop_signal = stepper.interrupted();
+    }
+    if (stepper.interrupted() && sum.stop_signal == 0) {
+        // The observer stopped the solve at an iterate.
+        sum.stop_signal = stepper.interrupted();
+        out.end_status = fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
+                                     "continued; its best iterate is saved)",
+                                     signal_name(stepper.interrupted()), stepper.time());
+    }
+    if (recorder) recorder->steady_outcome(out);
+    stepper.finish(sum.stop_signal ? kExitInterrupted : 0);
+    sum.end_status = out.end_status;
+    sum.unconverged = sum.stop_signal == 0 && !out.converged;
+    sum.simulated_time = stepper.micro_time() - micro_start;
+    sum.dem_time = stepper.micro_time();
+    sum.wall_seconds = progress.elapsed_seconds();
+    sum.particle_steps = stepper.particle_steps();
+    sum.restrict_seconds = stepper.overhead().restrict_seconds;
+    sum.lift_seconds = stepper.overhead().lift_seconds;
+    if (sum.unconverged) {
+        const coarse::SteadySolveRecord& r = out.solve;
+        std::string history;
+        for (std::size_t k = 0; k < r.residuals.size(); ++k)
+            history += fmt::format("{}{:.3e}", k ? ", " : "", r.residuals[k]);
+        log::error("{}", out.end_status);
+        if (!out.continuation)
+            log::error("residual history |F|: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is /steady/best in "
+                       "the run file. What to try: a longer steady.tau (slow modes then contract more per "
+                       "evaluation), more realizations (the noise falls as 1/sqrt(R)), a larger "
+                       "steady.difference_step when GMRES did not converge, steady.solver = anderson for a stable "
+                       "state",
+                       history, r.noise.empty() ? 0.0 : r.noise.back(), r.best_residual);
+        else
+            log::error("no branch point converged; the first point's residual history |F|: {}. What to try: a "
+                       "longer steady.tau, more realizations, a larger steady.difference_step",
+                       history);
+    }
+    return sum;
+}
+
+}  // namespace efdem::mpi_driver

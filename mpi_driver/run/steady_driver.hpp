@@ -1,0 +1,27 @@
+#pragma once
+/// \file
+/// mode = steady and mode = continuation on the EnsembleStepper (docs/steady_states.md): the
+/// coarse loop coarse::SteadyRun with the run's observers plugged in. Executed by the root (the
+/// other ranks serve the stepper); ends with EnsembleStepper::finish().
+///
+/// * every iterate is recorded as it comes (/steady/iterate) and logged with the DEM time it
+///   has cost; every branch point likewise (/branch);
+/// * run.duration > 0 is a budget of DEM time after the warm-up: the solve stops there, with
+///   its best iterate saved;
+/// * a solve that does not reach its stopping rule ends "not converged: ..." with what to try,
+///   the best iterate in the run file, and RunSummary::unconverged (exit code 3);
+/// * a stop signal ends the run at the next sample with the iterates so far recorded (no
+///   checkpoint: a solve holds kept micro states that a checkpoint does not).
+
+#include "coarse/demixing/ensemble_observable.hpp"
+#include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/output/progress.hpp"
+#include "mpi_driver/output/run_recorder.hpp"
+#include "mpi_driver/run/run_settings.hpp"
+
+namespace efdem::mpi_driver {
+
+RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& settings, RunRecorder* recorder,
+                      Progress& progress);
+
+}  // namespace efdem::mpi_driver
