@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Issue 18's DEM check on the demo bed (1,000 spheres, U_s = 0.41, R = 4 on 2 ranks):
+#   direct.h5  a direct ensemble with its own seeds over 300 time units, whose time average
+#              after complete demixing is the reference steady ICDF;
+#   newton.h5  mode = steady (Newton-GMRES, CRN derivatives) from a 60-unit warm-up.
+# Resumable: a run whose run file says it ended is skipped. Compare with
+#   /usr/bin/python3 bench/steady_compare.py runs/steady_study
+#   bash bench/steady_study.sh [OUT_DIR]      (default runs/steady_study; needs build/)
+set -euo pipefail
+src=$(cd "$(dirname "$0")/.." && pwd)
+out=${1:-$src/runs/steady_study}
+efdem=${EFDEM:-$src/build/mpi_driver/efdem}
+scene=$src/examples/demo_small/scene.cfg
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+mkdir -p "$out"
+ended() {  # the run file exists and is not 'running'
+  [ -f "$out/$1.h5" ] && /usr/bin/python3 -c "import h5py,sys; s=h5py.File(sys.argv[1])['/'].attrs['end_status']; sys.exit(0 if not str(s).startswith('running') else 1)" "$out/$1.h5"
+}
+run() {  # NAME overrides...
+  local name=$1; shift
+  if ended "$name"; then echo "skip $name (done)"; return; fi
+  echo "run $name: $*"
+  mpirun -n 2 --oversubscribe "$efdem" "$scene" output.directory="$out" output.prefix="$name" output.overwrite=true \
+    ensemble.realizations_per_rank=2 "$@" > "$out/$name.log" 2>&1 || echo "$name exited $?"
+}
+run direct mode=direct seed=101 run.duration=300
+run newton mode=steady seed=1 run.duration=0 steady.warmup=60 steady.tau=20 steady.max_krylov=6 \
+  steady.max_iterations=4 steady.eigenvalues=2 steady.eigenvalue_products=6

@@ -1,0 +1,111 @@
+#!/usr/bin/python3
+"""Plot what an efdem run of mode = steady or mode = continuation found (docs/steady_states.md).
+
+* steady: the residual |F| of every iterate against the DEM time it cost, with the noise
+  level the solve stops at; the initial guess and the answer (best iterate) as ICDFs;
+* continuation: the segregation measure (mean light-particle height) with its error bar and
+  the leading coarse eigenvalue's rate log|mu|/tau along the branch, against the parameter
+  (filled markers: stable, mu inside the unit circle; open: unstable).
+
+    /usr/bin/python3 scripts/plot_steady.py RUN.h5 -o steady.png
+
+Needs Debian's python3-matplotlib, python3-h5py and python3-numpy (run it with /usr/bin/python3).
+Exit code 2 with a message for a file that is missing, not a run file, or not of these modes.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import run_files  # noqa: E402
+
+try:
+    import h5py  # noqa: F401
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError as e:
+    sys.exit(f"plot_steady.py: {e}; run it with /usr/bin/python3 (Debian python3-matplotlib python3-h5py)")
+
+
+def plot_steady(f, name, out):
+    it = f["steady/iterate"]
+    fig, (ax_r, ax_x) = plt.subplots(1, 2, figsize=(11, 4.2))
+    t, r, noise = it["dem_time"][:], it["residual"][:], it["noise"][:]
+    ax_r.semilogy(t, r, "o-", label=r"$|F|$ at each iterate")
+    ax_r.semilogy(t, 2 * noise, "--", color="0.4", label=r"stopping level $2\,|SE(F)|$")
+    ax_r.set(xlabel=r"DEM time after the warm-up [$\sqrt{d_p/g}$]", ylabel=r"$|F| = |\Phi_\tau(X) - X|$ [$d_p$]",
+             title=f"{name}: {run_files.text(f['steady'].attrs.get('solver', '?'))} iterates")
+    p = f["p"][:]
+    if "x0" in f["steady"]:
+        ax_x.plot(p, f["steady/x0"][:], label="initial guess (end of warm-up)")
+    if "best" in f["steady"]:
+        ax_x.plot(p, f["steady/best"][:], lw=2, label="steady state (best iterate)")
+    ax_x.set(xlabel="p [-]", ylabel=r"light-particle height $Q_L(p)$ [$d_p$]", title="coarse steady state")
+    status = run_files.text(f["steady"].attrs.get("end_status", ""))
+    fig.suptitle(status[:140], fontsize=8)
+    for ax in (ax_r, ax_x):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def plot_branch(f, name, out):
+    b = f["branch"]
+    if "parameter" not in b or len(b["parameter"]) == 0:
+        raise run_files.UsageError(f"{name}: /branch has no points (end status "
+                                   f"'{run_files.text(f.attrs.get('end_status', '?'))}')")
+    lam = b["parameter"][:]
+    par = run_files.text(b.attrs.get("parameter", "parameter"))
+    fig, (ax_m, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
+    ax_m.errorbar(lam, b["mean_height"][:], yerr=b["mean_height_error"][:], fmt="o-", capsize=3,
+                  label="mean of the ICDF nodes (bound on its s.e.)")
+    ax_m.set(xlabel=f"{par} [scene unit]", ylabel=r"mean light-particle height [$d_p$]",
+             title=f"{name}: steady segregation along the branch")
+    rate = b["leading_rate"][:]
+    mu = np.hypot(b["leading_real"][:], b["leading_imag"][:])
+    stable = mu < 1
+    ax_e.plot(lam, rate, "-", color="C1")
+    ax_e.plot(lam[stable], rate[stable], "o", color="C1", label=r"stable ($|\mu| < 1$)")
+    ax_e.plot(lam[~stable], rate[~stable], "o", mfc="none", color="C1", label=r"unstable ($|\mu| \geq 1$)")
+    ax_e.axhline(0, color="0.5", lw=0.8)
+    ax_e.set(xlabel=f"{par} [scene unit]", ylabel=r"leading rate $\log|\mu|/\tau$ [$1/\sqrt{d_p/g}$]",
+             title="coarse stability of each point")
+    for ax in (ax_m, ax_e):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(run_files.text(b.attrs.get("end_reason", ""))[:140], fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("run")
+    ap.add_argument("-o", "--output", required=True)
+    a = ap.parse_args()
+    try:
+        with run_files.open_run(a.run) as f:
+            mode = run_files.text(f.attrs["mode"])
+            name = os.path.basename(a.run)
+            if mode == "continuation":
+                plot_branch(f, name, a.output)
+            elif mode == "steady":
+                if "steady/iterate/residual" not in f or len(f["steady/iterate/residual"]) == 0:
+                    raise run_files.UsageError(f"{a.run}: the steady run recorded no iterate")
+                plot_steady(f, name, a.output)
+            else:
+                raise run_files.UsageError(f"{a.run}: a run of mode = {mode}; this script plots mode = steady or "
+                                           "continuation (plot_icdf.py plots direct and cpi runs)")
+    except run_files.UsageError as e:
+        run_files.fail("plot_steady.py", e)
+    print(f"plot_steady.py: wrote {a.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

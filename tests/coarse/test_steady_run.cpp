@@ -1,0 +1,165 @@
+// The run loop of mode = steady | continuation (coarse/equation_free/steady_run.hpp) on toy
+// steppers, without DEM or MPI: warm-up, solve, spectrum, observers, the budget stop, the
+// repair count, and continuation in a scaled parameter reported in the scene's units.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/steady_run.hpp"
+#include "tests/coarse/steady_toy_steppers.hpp"
+
+using namespace efdem;
+using namespace efdem::coarse;
+
+namespace {
+/// x' = -0.1 (x - x*) in two components, exactly per interval 0.5: Phi_tau(X) = x* + e^{-0.1 tau}(X - x*).
+test::AffineToyStepper decaying(const Eigen::Vector2d& x_star) {
+    return {std::exp(-0.1 * 0.5) * Eigen::Matrix2d::Identity(), x_star, 0.5};
+}
+
+SteadyRunSettings newton_settings() {
+    SteadyRunSettings s;
+    s.warmup = 1.0;
+    s.map.tau = 4.0;
+    s.map.difference_step = 1e-6;
+    s.newton.stop.tolerance = 1e-10;
+    s.eigenvalues = 2;
+    s.spectrum.eigenvalues = 2;
+    s.spectrum.tolerance = 1e-8;
+    return s;
+}
+}  // namespace
+
+TEST_CASE("SteadyRun: warm-up, Newton solve and spectrum; every iterate observed", "[unit][steady]") {
+    const Eigen::Vector2d x_star(3.0, 5.0);
+    test::AffineToyStepper toy = decaying(x_star);
+    toy.lift(Eigen::Vector2d(0.0, 0.0), 0.0);
+    SteadyRun run(newton_settings(), toy, {});
+    long seen = 0;
+    run.set_iterate_observer([&](const SteadySolveRecord& rec) {
+        ++seen;
+        CHECK(static_cast<long>(rec.residuals.size()) == seen);  // one call per iterate, in order
+        return std::string{};
+    });
+    const SteadyRunOutcome out = run.run();
+    REQUIRE(out.converged);
+    CHECK(out.end_status.rfind("completed", 0) == 0);
+    // The initial guess is the warm-up's last sample: x* + e^{-0.1}(0 - x*).
+    CHECK((out.x0 - x_star * (1.0 - std::exp(-0.1))).norm() < 1e-12);
+    // An affine F: the answer within |J_F^-1| x 1e-10 = 1e-10 / (1 - e^{-0.4}) ~ 3e-10.
+    CHECK((out.solve.x - x_star).norm() < 1e-9);
+    CHECK(seen == static_cast<long>(out.solve.residuals.size()));
+    REQUIRE(out.spectrum.leading.size() == 2);
+    // Both eigenvalues are e^{-0.1 tau}; the rate log|mu|/tau recovers -0.1 (1e-7: the
+    // differences' round-off eps |X| / h ~ 1e-9, divided by mu tau).
+    for (const CoarseEigenvalue& e : out.spectrum.leading) CHECK(e.rate == Approx(-0.1).margin(1e-6));
+    CHECK(out.micro_time == Approx(out.tau * static_cast<double>(out.evaluations)).epsilon(1e-14));
+}
+
+TEST_CASE("SteadyRun: an observer's stop ends the solve unconverged with the best iterate kept",
+          "[unit][steady]") {
+    const Eigen::Vector2d x_star(3.0, 5.0);
+    test::AffineToyStepper toy = decaying(x_star);
+    SteadyRunSettings s = newton_settings();
+    s.solver = SteadyRunSettings::Solver::anderson;
+    s.map.common_random_numbers = false;
+    s.fixed_point.stop.tolerance = 1e-12;
+    s.fixed_point.depth = 0;  // damped iteration: |F| falls by e^{-0.4} = 0.67 per iteration
+    s.eigenvalues = 0;
+    toy.lift(Eigen::Vector2d(0.0, 0.0), 0.0);  // away from x*
+    SteadyRun run(s, toy, {});
+    run.set_iterate_observer([](const SteadySolveRecord& rec) {
+        return rec.residuals.size() >= 3 ? std::string("budget spent") : std::string{};
+    });
+    const SteadyRunOutcome out = run.run();
+    CHECK_FALSE(out.converged);
+    CHECK(out.solve.reason == SteadyStopReason::stopped);
+    CHECK(out.solve.message.find("budget spent") != std::string::npos);
+    CHECK(out.end_status.rfind("not converged", 0) == 0);
+    REQUIRE(out.solve.residuals.size() == 3);
+    // Plain iteration contracts: the best iterate is the last one, and it is saved.
+    CHECK(out.solve.best_residual == out.solve.residuals.back());
+    CHECK((out.solve.best - out.solve.x).norm() == 0.0);
+    CHECK(out.spectrum.leading.empty());
+}
+
+TEST_CASE("SteadyRun: the repair hook is applied to every lifted point and its changes are counted",
+          "[unit][steady]") {
+    const Eigen::Vector2d x_star(3.0, 5.0);
+    test::AffineToyStepper toy = decaying(x_star);
+    SteadyRunSettings s = newton_settings();
+    s.eigenvalues = 0;
+    s.newton.max_iterations = 1;
+    // Clip the second component at 4.5: the fixed point (5) lies outside, so every lift near
+    // it is changed; F is then that of the clipped point and Newton cannot reach x*.
+    long calls = 0;
+    RepairHook clip = [&calls](Eigen::VectorXd& x) {
+        ++calls;
+        RepairReport r;
+        if (x[1] > 4.5) {
+            r.max_adjustment = x[1] - 4.5;
+            x[1] = 4.5;
+        }
+        return r;
+    };
+    toy.lift(Eigen::Vector2d(3.0, 5.0), 0.0);  // the warm-up starts at x*: X0 = x*
+    SteadyRun run(s, toy, clip);
+    const SteadyRunOutcome out = run.run();
+    CHECK(calls == out.evaluations);
+    CHECK(out.repairs >= 1);
+    CHECK(out.largest_repair == Approx(0.5).margin(1e-6));
+}
+
+TEST_CASE("SteadyRun: continuation in a scaled parameter reports the branch in the scene's units",
+          "[unit][steady]") {
+    // x' = lambda - x (one member, no noise): the steady state is x = lambda, stable with
+    // mu = e^{-tau}. Continued from 0.2 to 0.6 in lambda / 0.1.
+    test::SdeEnsembleStepper toy([](const Eigen::VectorXd& x, double lambda) -> Eigen::VectorXd {
+        return Eigen::VectorXd::Constant(x.size(), lambda) - x;
+    }, 0.0, 1, 0.01, 10, Eigen::VectorXd::Zero(1), 1);
+    SteadyRunSettings s = newton_settings();
+    s.continuation = true;
+    s.map.tau = 1.0;
+    s.warmup = 0.1;
+    s.parameter = "lambda";
+    s.parameter_start = 0.2;
+    s.parameter_end = 0.6;
+    s.parameter_scale = 0.1;
+    s.branch.corrector = s.newton;
+    s.branch.parameter_step = 0.1 / 0.1;  // 0.1 in lambda
+    s.branch.step = 1.0;
+    s.branch.min_step = 0.01;
+    s.branch.max_step = 2.0;
+    s.branch.parameter_min = 0.2 / 0.1;
+    s.branch.parameter_max = 0.6 / 0.1;
+    s.branch.display_scale = 0.1;
+    s.branch.spectrum.eigenvalues = 1;
+    double set_to = -1;
+    SteadyRun run(s, toy, {}, [&](double v) {
+        set_to = v;
+        toy.set_parameter(v);
+    });
+    long points_seen = 0;
+    run.set_point_observer([&](const Branch& b) {
+        ++points_seen;
+        CHECK(b.points.back().parameter == Approx(b.points.back().x[0]).margin(1e-7));  // scene units
+    });
+    const SteadyRunOutcome out = run.run();
+    INFO(out.branch.end_reason);
+    REQUIRE(out.converged);
+    REQUIRE(out.branch.points.size() >= 4);
+    CHECK(points_seen == static_cast<long>(out.branch.points.size()));
+    CHECK(out.branch.points.front().parameter == Approx(0.2).margin(1e-12));
+    CHECK(out.branch.end_reason.find("left the parameter range [0.2, 0.6]") != std::string::npos);
+    for (const BranchPoint& p : out.branch.points) {
+        // The corrector stops at |G| <= 1e-10 with a well-conditioned extended Jacobian.
+        CHECK(p.x[0] == Approx(p.parameter).margin(1e-7));
+        REQUIRE(p.has_leading);
+        // mu = R(-dt)^(tau/dt) with R the RK4 polynomial = e^{-1} to O(tau dt^4) ~ 1e-9.
+        CHECK(p.leading.mu.real() == Approx(std::exp(-1.0)).margin(1e-6));
+    }
+    CHECK(set_to > 0.55);  // the hook saw scene units, not lambda / 0.1
+}

@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# mode = steady and mode = continuation on the tiny bed (docs/steady_states.md):
+#  1. the same steady solve (R = 4) on 1, 2 and 4 ranks gives bit-identical run files
+#     (iterates, GMRES history, eigenvalues, samples);
+#  2. a solve that cannot converge (one Newton step, |F| ~ 10x its noise) exits 3 with
+#     "not converged", the residual history and what to try, and /steady/best = the iterate
+#     with the smallest |F|; the run file is self-describing (check_run_file.py);
+#  3. a continuation in gas_drag.superficial_velocity records a branch starting at the
+#     scene's value and plot_steady.py draws it (PNG);
+#  4. bad input is refused (exit 2) naming the key.
+#   steady_modes.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+source "$(dirname "$0")/lib.sh" "$@"
+set -e
+scene=$here/tiny_scene.cfg
+solve=(mode=steady run.duration=0 steady.warmup=1 steady.tau=1 steady.max_iterations=1 steady.max_krylov=3
+       steady.eigenvalues=1 steady.eigenvalue_products=2)
+for np in 1 2 4; do
+  k=$((4 / np))
+  set +e
+  "$mpiexec" -n "$np" "${launcher[@]}" "$efdem" "$scene" "${solve[@]}" ensemble.realizations_per_rank=$k \
+    output.directory="$work" output.prefix=np$np > "$work/np$np.log" 2>&1
+  rc=$?
+  set -e
+  [ "$rc" = 3 ] || { echo "np $np: exit $rc, expected 3 (not converged after one Newton step)"; cat "$work/np$np.log"; exit 1; }
+done
+/usr/bin/python3 "$here/compare_runs.py" "$work/np1.h5" "$work/np2.h5"
+/usr/bin/python3 "$here/compare_runs.py" "$work/np1.h5" "$work/np4.h5"
+grep -q "not converged" "$work/np2.log" || { echo "no 'not converged' message"; cat "$work/np2.log"; exit 1; }
+grep -q "residual history" "$work/np2.log" || { echo "no residual history"; exit 1; }
+grep -q "What to try" "$work/np2.log" || { echo "no advice"; exit 1; }
+/usr/bin/python3 "$here/check_run_file.py" "$work/np2.h5"
+/usr/bin/python3 - "$work/np2.h5" <<'PY'
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1])
+s = f["steady"]
+assert str(f.attrs["end_status"]).startswith("not converged"), f.attrs["end_status"]
+assert s.attrs["converged"] == 0
+it = s["iterate"]
+r = it["residual"][:]
+assert len(r) == 2, r                     # the start and one Newton step
+best = it["x"][int(np.argmin(r))]
+assert np.array_equal(s["best"][:], best), "best is not the iterate with the smallest |F|"
+assert s.attrs["best_residual"] == r.min()
+assert len(s["krylov_products"]) == 1 and 1 <= s["krylov_products"][0] <= 3
+assert len(s["gmres_residual"]) == s["krylov_products"][0] + 1
+# Every evaluation costs tau = 1 of DEM time: warm-up 1 + evaluations x 1.
+assert s.attrs["dem_time"] == s.attrs["evaluations"] * 1.0
+print("steady: not converged as asked, best iterate saved; |F| =", r)
+PY
+
+"$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=continuation continuation.parameter=gas_drag.superficial_velocity \
+  continuation.end=0.5 continuation.step=0.05 continuation.max_points=2 run.duration=0 steady.warmup=1 steady.tau=1 \
+  steady.max_iterations=1 steady.max_krylov=2 steady.eigenvalues=1 steady.eigenvalue_products=2 steady.noise_factor=50 \
+  output.directory="$work" output.prefix=branch > "$work/branch.log" 2>&1 || { cat "$work/branch.log"; exit 1; }
+/usr/bin/python3 "$here/check_run_file.py" "$work/branch.h5"
+/usr/bin/python3 - "$work/branch.h5" <<'PY'
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1])
+b = f["branch"]
+lam = b["parameter"][:]
+assert len(lam) == 2, lam
+assert abs(lam[0] - 0.41) < 1e-12 and lam[1] > lam[0], lam  # from the scene value (lambda/scale x scale) towards the end
+assert b["x"].shape == (2, 19)
+assert np.all(np.isfinite(b["leading_rate"][:]))
+assert np.allclose(b["mean_height"][:], b["x"][:].mean(axis=1))
+print("continuation: branch", lam)
+PY
+/usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/branch.h5" -o "$work/branch.png"
+/usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/np2.h5" -o "$work/steady.png"
+[ -s "$work/branch.png" ] && [ -s "$work/steady.png" ]
+
+refused() {  # WHAT KEY NP OVERRIDES...: exit 2 and the key in the message
+  local what=$1 key=$2 np=$3; shift 3
+  set +e
+  "$mpiexec" -n "$np" "${launcher[@]}" "$efdem" "$scene" output.directory="$work/bad" "$@" > "$work/bad.log" 2>&1
+  local rc=$?
+  set -e
+  [ "$rc" = 2 ] || { echo "$what: exit $rc, expected 2"; cat "$work/bad.log"; exit 1; }
+  grep -q -- "$key" "$work/bad.log" || { echo "$what: the message does not name $key"; cat "$work/bad.log"; exit 1; }
+  echo "refused: $what"
+}
+refused "continuation without its end" "continuation.end" 2 mode=continuation continuation.parameter=gas_drag.superficial_velocity
+refused "a parameter no realization can change" "continuation.parameter" 2 mode=continuation continuation.parameter=dt continuation.end=0.5
+refused "one realization" "mode" 1 mode=steady
+refused "checkpoints" "checkpoint.interval" 2 mode=steady checkpoint.interval=2
+refused "an Anderson key with Newton" "steady.depth" 2 mode=steady steady.depth=2
+refused "a continuation key in mode = steady" "continuation.end" 2 mode=steady continuation.end=0.5
+refused "drop on failure" "ensemble.on_failure" 2 mode=steady ensemble.on_failure=drop
+refused "tau off the sampling grid" "steady.tau" 2 mode=steady steady.tau=0.3
+refused "a restart" "restart" 2 mode=steady restart=$work/none_ckpt.h5
+echo "steady_modes: ok"
