@@ -34,6 +34,7 @@ SCENES = [
     ("examples/paper_fig2a/scene.cfg", []),
     ("examples/paper_fig2b/scene.cfg", []),
     ("examples/paper_fig4/scene.cfg", []),
+    ("examples/steady_demo/scene.cfg", []),
     ("bench/scenes/demo_bed.cfg", []),
     ("bench/scenes/reference_bed.cfg", []),
     ("tests/scripts/single_species_bed.cfg", []),

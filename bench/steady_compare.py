@@ -1,0 +1,86 @@
+#!/usr/bin/python3
+"""Compare the coarse steady state of mode = steady (bench/steady_study.sh) with the time average
+of a direct ensemble after complete demixing, node by node, against the noise of both.
+
+    /usr/bin/python3 bench/steady_compare.py runs/steady_study [--from 150] [--block 20] [-o fig.png]
+
+Reported (RMS over the ICDF nodes, d_p): the difference Newton - direct average; the Newton
+answer's noise (SE of Phi_tau at the answer per node); the direct average's standard error per
+node from block means (blocks of --block time units, so that correlated samples are not counted
+as independent); the band both give together. DEM time is per realization.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
+import run_files  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("folder")
+    ap.add_argument("--from", dest="t_from", type=float, default=150.0)
+    ap.add_argument("--block", type=float, default=20.0)
+    ap.add_argument("-o", "--output")
+    a = ap.parse_args()
+    try:
+        with run_files.open_run(os.path.join(a.folder, "direct.h5"), ["samples/time"]) as d:
+            t, mean = d["samples/time"][:], d["samples/mean"][:]
+            p = d["p"][:]
+            R = int(d.attrs["realizations"])
+            direct_dem = float(d.attrs.get("dem_time", t[-1]))
+        with run_files.open_run(os.path.join(a.folder, "newton.h5"), ["steady/iterate/residual"]) as n:
+            s = n["steady"]
+            x = s["best"][:]
+            it = s["iterate"]
+            noise = it["noise"][int(np.argmin(it["residual"][:]))]
+            status = run_files.text(s.attrs["end_status"])
+            newton_dem = float(n.attrs.get("dem_time", 0.0))
+            eig = [(s["eigenvalue_real"][k], s["eigenvalue_rate"][k], s["eigenvalue_residual"][k])
+                   for k in range(len(s["eigenvalue_real"]))] if "eigenvalue_real" in s else []
+    except run_files.UsageError as e:
+        run_files.fail("steady_compare.py", e)
+    sel = t >= a.t_from
+    avg = mean[sel].mean(axis=0)
+    per_block = max(1, int(round(a.block / (t[1] - t[0]))))
+    nb = sel.sum() // per_block
+    blocks = mean[sel][: nb * per_block].reshape(nb, per_block, -1).mean(axis=1)
+    se_direct = blocks.std(axis=0, ddof=1) / np.sqrt(nb)
+    n_nodes = len(x)
+    se_newton = noise / np.sqrt(n_nodes)  # RMS per node of the SE vector
+    diff = x - avg
+    rms = np.sqrt(np.mean(diff ** 2))
+    band = np.sqrt(se_newton ** 2 + np.mean(se_direct ** 2))
+    print(f"newton: {status}")
+    print(f"direct: R = {R}, time average over t >= {a.t_from:g} ({sel.sum()} samples, {nb} blocks of {a.block:g})")
+    print(f"RMS(Newton - direct average) = {rms:.3f} d_p; Newton noise {se_newton:.3f}, direct s.e. "
+          f"{np.sqrt(np.mean(se_direct ** 2)):.3f}, together {band:.3f} d_p: ratio {rms / band:.2f}")
+    print(f"largest node difference {np.abs(diff).max():.3f} d_p at p = {p[np.argmax(np.abs(diff))]:.2f}")
+    print(f"DEM time per realization: Newton {newton_dem:.0f} (warm-up included), direct {direct_dem:.0f}")
+    for re, rate, res in eig:
+        print(f"eigenvalue mu = {re:.4f}, rate {rate:.4f} per time unit (residual {res:.2g})")
+    if a.output:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        ax.fill_between(p, avg - 2 * se_direct, avg + 2 * se_direct, alpha=0.3, label="direct time average ± 2 s.e.")
+        ax.plot(p, avg, label=f"direct ensemble (R = {R}), t ≥ {a.t_from:g}")
+        ax.errorbar(p, x, yerr=2 * se_newton, fmt="o", ms=3, capsize=2, label="Newton steady state ± 2 noise")
+        ax.set(xlabel="p [-]", ylabel=r"light-particle height $Q_L(p)$ [$d_p$]",
+               title=f"coarse steady state vs direct: RMS {rms:.2f} $d_p$")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(a.output, dpi=110)
+        print(f"wrote {a.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
