@@ -2,7 +2,10 @@
 # Issue 18's DEM check on the demo bed (1,000 spheres, U_s = 0.41, R = 4 on 2 ranks):
 #   direct.h5  a direct ensemble with its own seeds over 300 time units, whose time average
 #              after complete demixing is the reference steady ICDF;
-#   newton.h5  mode = steady (Newton-GMRES, CRN derivatives) from a 60-unit warm-up.
+#   newton.h5  mode = steady (Newton-GMRES, CRN derivatives) from a 60-unit warm-up;
+#   branch.h5  mode = continuation in U_s from 0.2 to 0.6 (steps of 0.1, tau = 10), with the
+#              leading eigenvalue at every point (recorded point by point: a run cut short
+#              keeps the points it reached).
 # Resumable: a run whose run file says it ended is skipped. Compare with
 #   /usr/bin/python3 bench/steady_compare.py runs/steady_study
 #   bash bench/steady_study.sh [OUT_DIR]      (default runs/steady_study; needs build/)
@@ -26,3 +29,7 @@ run() {  # NAME overrides...
 run direct mode=direct seed=101 run.duration=300
 run newton mode=steady seed=1 run.duration=0 steady.warmup=60 steady.tau=20 steady.max_krylov=6 \
   steady.max_iterations=4 steady.eigenvalues=2 steady.eigenvalue_products=6
+run branch mode=continuation seed=7 run.duration=0 gas_drag.superficial_velocity=0.2 \
+  continuation.parameter=gas_drag.superficial_velocity continuation.end=0.6 continuation.step=0.1 \
+  continuation.max_points=6 steady.warmup=40 steady.tau=10 steady.max_krylov=4 steady.max_iterations=3 \
+  steady.eigenvalues=1 steady.eigenvalue_products=3

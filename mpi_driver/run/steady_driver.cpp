@@ -63,6 +63,11 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         if (recorder) recorder->branch_point(b.points.back());
     });
 
+    const auto interrupted_status = [&stepper] {
+        return fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
+                           "continued; its best iterate is saved)",
+                           signal_name(stepper.interrupted()), stepper.time());
+    };
     RunSummary sum;
     coarse::SteadyRunOutcome out;
     try {
@@ -79,17 +84,13 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         out.solve.message = fmt::format("stopped by {}", signal_name(stepper.interrupted()));
         out.branch = trace.branch;
         out.branch.end_reason = out.solve.message;
-        out.end_status = fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
-                                     "continued; its best iterate is saved)",
-                                     signal_name(stepper.interrupted()), stepper.time());
+        out.end_status = interrupted_status();
         sum.stop_signal = stepper.interrupted();
     }
     if (stepper.interrupted() && sum.stop_signal == 0) {
         // The observer stopped the solve at an iterate.
         sum.stop_signal = stepper.interrupted();
-        out.end_status = fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
-                                     "continued; its best iterate is saved)",
-                                     signal_name(stepper.interrupted()), stepper.time());
+        out.end_status = interrupted_status();
     }
     if (recorder) recorder->steady_outcome(out);
     stepper.finish(sum.stop_signal ? kExitInterrupted : 0);
