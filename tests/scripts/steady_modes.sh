@@ -69,6 +69,29 @@ PY
 /usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/np2.h5" -o "$work/steady.png"
 [ -s "$work/branch.png" ] && [ -s "$work/steady.png" ]
 
+# 5. A stop signal to every rank mid-solve: exit 4 within seconds, the run file marked
+#    interrupted with the iterates so far and the best one.
+setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=steady run.duration=0 steady.warmup=1 steady.tau=1 \
+  steady.max_iterations=50 steady.max_krylov=3 steady.eigenvalues=0 output.directory="$work" output.prefix=sig \
+  > "$work/sig.log" 2>&1 &
+job=$!
+for _ in $(seq 100); do grep -q "iterate 1:" "$work/sig.log" 2>/dev/null && break; sleep 0.2; done
+kill -TERM $(ps -o pid=,comm= -s "$job" | awk '$2 == "efdem" {print $1}')
+set +e
+wait "$job"
+rc=$?
+set -e
+[ "$rc" = 4 ] || { echo "signal: exit $rc, expected 4"; cat "$work/sig.log"; exit 1; }
+grep -q "the iterates so far and the best one are in" "$work/sig.log" || { echo "signal: no message"; cat "$work/sig.log"; exit 1; }
+/usr/bin/python3 "$here/check_run_file.py" "$work/sig.h5"
+/usr/bin/python3 - "$work/sig.h5" <<'PY'
+import sys, h5py
+f = h5py.File(sys.argv[1])
+assert str(f.attrs["end_status"]).startswith("interrupted"), f.attrs["end_status"]
+assert len(f["steady/iterate/residual"]) >= 2 and "best" in f["steady"]
+print("signal: interrupted with", len(f["steady/iterate/residual"]), "iterates recorded")
+PY
+
 refused() {  # WHAT KEY NP OVERRIDES...: exit 2 and the key in the message
   local what=$1 key=$2 np=$3; shift 3
   set +e
