@@ -34,10 +34,11 @@ def main():
             direct_dem = float(d.attrs.get("dem_time", t[-1]))
         with run_files.open_run(os.path.join(a.folder, "newton.h5"), ["steady/iterate/residual"]) as n:
             s = n["steady"]
-            x = s["best"][:]
             it = s["iterate"]
+            # A run still going (or cut short) has no /steady/best yet: its best iterate so far.
+            x = s["best"][:] if "best" in s else it["x"][int(np.argmin(it["residual"][:]))]
             noise = it["noise"][int(np.argmin(it["residual"][:]))]
-            status = run_files.text(s.attrs["end_status"])
+            status = run_files.text(s.attrs.get("end_status", "running"))
             newton_dem = float(n.attrs.get("dem_time", 0.0))
             eig = [(s["eigenvalue_real"][k], s["eigenvalue_rate"][k], s["eigenvalue_residual"][k])
                    for k in range(len(s["eigenvalue_real"]))] if "eigenvalue_real" in s else []
@@ -60,6 +61,17 @@ def main():
           f"{np.sqrt(np.mean(se_direct ** 2)):.3f}, together {band:.3f} d_p: ratio {rms / band:.2f}")
     print(f"largest node difference {np.abs(diff).max():.3f} d_p at p = {p[np.argmax(np.abs(diff))]:.2f}")
     print(f"DEM time per realization: Newton {newton_dem:.0f} (warm-up included), direct {direct_dem:.0f}")
+    # The direct ensemble's own slowest decay rate near the steady state: a log-linear fit of
+    # the distance of its mean height from the final average, over the part of the approach
+    # where that distance is well above the noise (between 20x and 3x the block s.e.).
+    h = mean.mean(axis=1)
+    dist = np.abs(h - avg.mean())
+    floor = np.sqrt(np.mean(se_direct ** 2))
+    fit = (dist < 20 * floor * np.sqrt(nb)) & (dist > 3 * floor * np.sqrt(nb)) & (t < a.t_from)
+    if fit.sum() >= 10:
+        slope = np.polyfit(t[fit], np.log(dist[fit]), 1)[0]
+        print(f"direct approach to the steady state: rate {slope:.4f} per time unit over t in "
+              f"[{t[fit].min():.0f}, {t[fit].max():.0f}] (mean height within {dist[fit].min():.2f}..{dist[fit].max():.2f} d_p)")
     for re, rate, res in eig:
         print(f"eigenvalue mu = {re:.4f}, rate {rate:.4f} per time unit (residual {res:.2g})")
     if a.output:

@@ -76,12 +76,14 @@ void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
         out.solve = FixedPointIteration(fs).solve(map, out.x0);
     }
     out.converged = out.solve.converged();
-    // The spectrum where the solve ended (also an unconverged one: the best iterate's
-    // neighbourhood is what the user gets, and the eigenvalues say why it was hard).
-    if (settings_.eigenvalues > 0 && out.converged) {
+    // The spectrum at the answer, and at the best iterate of a solve that ran out of iterations
+    // or line search (what the user gets, and the eigenvalues say why it was hard); not after
+    // a stop the caller asked for (a budget spent, a signal).
+    const bool spectrum = settings_.eigenvalues > 0 && out.solve.reason != SteadyStopReason::stopped;
+    if (spectrum) {
         SpectrumSettings ss = settings_.spectrum;
         ss.eigenvalues = settings_.eigenvalues;
-        out.spectrum = coarse_spectrum(map, out.solve.x, ss);
+        out.spectrum = coarse_spectrum(map, out.converged ? out.solve.x : out.solve.best, ss);
         for (const CoarseEigenvalue& e : out.spectrum.leading)
             log::info("steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual {:.2g})", e.mu.real(),
                       e.mu.imag(), e.rate, e.residual);

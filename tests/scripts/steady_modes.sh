@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # mode = steady and mode = continuation on the tiny bed (docs/steady_states.md):
 #  1. the same steady solve (R = 4) on 1, 2 and 4 ranks gives bit-identical run files
-#     (iterates, GMRES history, eigenvalues, samples);
+#     (iterates, GMRES history, the eigenvalue at the best iterate, samples);
 #  2. a solve that cannot converge (one Newton step, |F| ~ 10x its noise) exits 3 with
 #     "not converged", the residual history and what to try, and /steady/best = the iterate
 #     with the smallest |F|; the run file is self-describing (check_run_file.py);
@@ -45,6 +45,8 @@ assert len(s["krylov_products"]) == 1 and 1 <= s["krylov_products"][0] <= 3
 assert len(s["gmres_residual"]) == s["krylov_products"][0] + 1
 # Every evaluation costs tau = 1 of DEM time: warm-up 1 + evaluations x 1.
 assert s.attrs["dem_time"] == s.attrs["evaluations"] * 1.0
+# Out of iterations: the leading eigenvalue is computed at the best iterate (2 products).
+assert len(s["eigenvalue_real"]) == 1 and s.attrs["eigenvalue_products"] == 2
 print("steady: not converged as asked, best iterate saved; |F| =", r)
 PY
 
