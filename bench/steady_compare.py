@@ -83,7 +83,7 @@ def main():
         fig, ax = plt.subplots(figsize=(6, 4.2))
         ax.fill_between(p, avg - 2 * se_direct, avg + 2 * se_direct, alpha=0.3, label="direct time average ± 2 s.e.")
         ax.plot(p, avg, label=f"direct ensemble (R = {R}), t ≥ {a.t_from:g}")
-        ax.errorbar(p, x, yerr=2 * se_newton, fmt="o", ms=3, capsize=2, label="Newton steady state ± 2 noise")
+        ax.errorbar(p, x, yerr=2 * se_newton, fmt="o", ms=3, capsize=2, label=("Newton best iterate (not converged)" if status.startswith("not converged") else "Newton steady state") + " ± 2 noise")
         ax.set(xlabel="p [-]", ylabel=r"light-particle height $Q_L(p)$ [$d_p$]",
                title=f"coarse steady state vs direct: RMS {rms:.2f} $d_p$")
         ax.grid(alpha=0.3)
