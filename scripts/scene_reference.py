@@ -54,6 +54,7 @@ SCENES = [
     (TINY, ["effects=gravity pair_contact wall_contact gas_drag viscous_damping", "viscous_damping.gamma=0.1"]),
     (TINY, ["bed.settle=true", "gas_drag.A=0.114939"]),
     (TINY, ["mode=steady", "ensemble.realizations_per_rank=2"]),
+    (TINY, ["mode=steady", "steady.coordinates=gaps", "ensemble.realizations_per_rank=2"]),
     (TINY, ["mode=steady", "steady.solver=anderson", "steady.eigenvalues=0", "ensemble.realizations_per_rank=2"]),
     (TINY, ["mode=continuation", "continuation.parameter=gas_drag.superficial_velocity", "continuation.end=0.5",
             "ensemble.realizations_per_rank=2"]),

@@ -19,31 +19,35 @@ CoarseMap::CoarseMap(CoarseStepper& stepper, const CoarseMapSettings& settings,
 MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
     EFDEM_EXPECTS(set_parameter_ || parameter == 0.0);
     if (set_parameter_) set_parameter_(parameter);
+    Eigen::VectorXd lifted = coordinates_ ? coordinates_.to_state(x) : x;
     if (repair_) {
-        Eigen::VectorXd lifted = x;
         const RepairReport report = repair_(lifted);
         EFDEM_ASSERT(report.feasible);
         if (report.changed()) {
             ++repairs_;
             largest_repair_ = std::max(largest_repair_, report.max_adjustment);
         }
-        stepper_.lift(lifted, stepper_.time());
-    } else {
-        stepper_.lift(x, stepper_.time());
     }
+    stepper_.lift(lifted, stepper_.time());
     BurstSamples burst;
     stepper_.run(settings_.tau, burst);
-    EFDEM_ASSERT(burst.size() >= 1 && burst.x.back().size() == x.size());
+    EFDEM_ASSERT(burst.size() >= 1 && burst.x.back().size() == lifted.size());
     micro_time_ += settings_.tau;
     ++evaluations_;
     MapEvaluation e;
     e.x = x;
     e.parameter = parameter;
-    e.phi = burst.x.back();
+    e.phi = coordinates_ ? coordinates_.from_state(burst.x.back()) : burst.x.back();
+    EFDEM_ASSERT(e.phi.size() == x.size());
     e.f = e.phi - x;
     e.standard_error = Eigen::VectorXd::Zero(x.size());
     if (!burst.members.empty()) {
-        const Eigen::MatrixXd& m = burst.members.back();
+        Eigen::MatrixXd m = burst.members.back();
+        if (coordinates_) {
+            Eigen::MatrixXd mu(m.rows(), x.size());
+            for (Eigen::Index r = 0; r < m.rows(); ++r) mu.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
+            m = std::move(mu);
+        }
         if (m.rows() >= 2)
             e.standard_error =
                 (ensemble_variance(m, ensemble_mean(m)) / static_cast<double>(m.rows())).cwiseSqrt();

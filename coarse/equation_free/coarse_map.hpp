@@ -21,6 +21,7 @@
 /// \endcode
 
 #include <functional>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -42,6 +43,19 @@ struct CoarseMapSettings {
     /// CoarseStepper::can_keep_state(), a contract). Off: from whatever micro state the
     /// previous evaluation left, i.e. with fresh noise (kept only for comparisons).
     bool common_random_numbers = true;
+};
+
+/// Coordinates the solver works in, u, and the coarse vector X = to_state(u) the stepper
+/// lifts and restricts (e.g. an ICDF's first node and the logs of its gaps, in which every u is
+/// a monotone ICDF: coarse/demixing/icdf_gap_coordinates.hpp). Φ in u is
+/// from_state(Φ(to_state(u))); each member's restriction is mapped the same way, so the
+/// noise is measured in u. The steady states are the same points, and at a steady state the
+/// eigenvalues of dΦ/du and dΦ/dX are the same (similar matrices).
+struct CoarseCoordinates {
+    std::function<Eigen::VectorXd(const Eigen::VectorXd&)> to_state;
+    std::function<Eigen::VectorXd(const Eigen::VectorXd&)> from_state;
+    std::string name = "heights";  ///< for the record
+    explicit operator bool() const { return static_cast<bool>(to_state); }
 };
 
 /// One evaluation of the map.
@@ -85,6 +99,9 @@ class CoarseMap {
     /// difference it touches: repairs() counts the evaluations it changed, for the record.
     /// A report with feasible == false is a contract violation (a non-finite iterate).
     void set_repair(RepairHook repair) { repair_ = std::move(repair); }
+    /// Solve in other coordinates (see CoarseCoordinates); every x, phi and f of this map is
+    /// then in u. \pre both maps set.
+    void set_coordinates(CoarseCoordinates coordinates) { coordinates_ = std::move(coordinates); }
     long repairs() const { return repairs_; }
     /// The largest change a repair made to a lifted point so far [unit of x].
     double largest_repair() const { return largest_repair_; }
@@ -107,6 +124,7 @@ class CoarseMap {
     CoarseMapSettings settings_;
     std::function<void(double)> set_parameter_;
     RepairHook repair_;
+    CoarseCoordinates coordinates_;
     long repairs_ = 0;
     double largest_repair_ = 0;
     MapEvaluation base_;

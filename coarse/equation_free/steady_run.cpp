@@ -20,10 +20,32 @@ double mean_height_error_bound(double noise_norm, Eigen::Index n) {
 }
 
 SteadyRun::SteadyRun(const SteadyRunSettings& settings, CoarseStepper& stepper, RepairHook repair,
-                     std::function<void(double)> set_parameter)
-    : settings_(settings), stepper_(stepper), repair_(std::move(repair)), set_parameter_(std::move(set_parameter)) {
+                     std::function<void(double)> set_parameter, CoarseCoordinates coordinates)
+    : coordinates_(std::move(coordinates)), settings_(settings), stepper_(stepper), repair_(std::move(repair)),
+      set_parameter_(std::move(set_parameter)) {
     EFDEM_EXPECTS(settings_.warmup > 0.0);
     EFDEM_EXPECTS(!settings_.continuation || set_parameter_);
+}
+
+Eigen::VectorXd SteadyRun::state(const Eigen::VectorXd& y, Eigen::Index n) const {
+    if (!coordinates_) return y;
+    Eigen::VectorXd out = y;
+    out.head(n) = coordinates_.to_state(y.head(n));
+    return out;
+}
+
+Eigen::VectorXd SteadyRun::solver_point(const Eigen::VectorXd& x) const {
+    return coordinates_ ? coordinates_.from_state(x) : x;
+}
+
+IterateObserver SteadyRun::observer_in_states(Eigen::Index n) const {
+    if (!iterate_observer_ || !coordinates_) return iterate_observer_;
+    return [this, n](const SteadySolveRecord& rec) {
+        SteadySolveRecord view = rec;
+        view.x = state(rec.x, n);
+        if (rec.best.size() > 0) view.best = state(rec.best, n);
+        return iterate_observer_(view);
+    };
 }
 
 SteadyRunOutcome SteadyRun::run() {
@@ -31,6 +53,7 @@ SteadyRunOutcome SteadyRun::run() {
     out.continuation = settings_.continuation;
     out.solver = settings_.solver == SteadyRunSettings::Solver::newton ? "newton" : "anderson";
     out.tau = settings_.map.tau;
+    out.coordinates = coordinates_ ? coordinates_.name : "heights";
     out.parameter = settings_.parameter;
     out.parameter_scale = settings_.parameter_scale;
     if (settings_.continuation) set_parameter_(settings_.parameter_start);
@@ -49,6 +72,7 @@ SteadyRunOutcome SteadyRun::run() {
     }
     CoarseMap map(stepper_, settings_.map, hook);
     if (repair_) map.set_repair(repair_);
+    if (coordinates_) map.set_coordinates(coordinates_);
     if (settings_.continuation)
         continue_branch(map, out);
     else
@@ -67,13 +91,13 @@ SteadyRunOutcome SteadyRun::run() {
 void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
     if (settings_.solver == SteadyRunSettings::Solver::newton) {
         NewtonKrylovSettings ns = settings_.newton;
-        ns.observer = iterate_observer_;
+        ns.observer = observer_in_states(out.x0.size());
         FixedPointSystem system(map, out.x0.size());
-        out.solve = NewtonKrylov(ns).solve(system, out.x0);
+        out.solve = NewtonKrylov(ns).solve(system, solver_point(out.x0));
     } else {
         FixedPointSettings fs = settings_.fixed_point;
-        fs.observer = iterate_observer_;
-        out.solve = FixedPointIteration(fs).solve(map, out.x0);
+        fs.observer = observer_in_states(out.x0.size());
+        out.solve = FixedPointIteration(fs).solve(map, solver_point(out.x0));
     }
     out.converged = out.solve.converged();
     // The spectrum at the answer, and at the best iterate of a solve that ran out of iterations
@@ -83,11 +107,15 @@ void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
     if (spectrum) {
         SpectrumSettings ss = settings_.spectrum;
         ss.eigenvalues = settings_.eigenvalues;
-        out.spectrum = coarse_spectrum(map, out.converged ? out.solve.x : out.solve.best, ss);
+        out.spectrum = coarse_spectrum(map, out.converged ? out.solve.x : out.solve.best, ss);  // in u: same eigenvalues
         for (const CoarseEigenvalue& e : out.spectrum.leading)
             log::info("steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual {:.2g})", e.mu.real(),
                       e.mu.imag(), e.rate, e.residual);
     }
+    // Report in the coarse vector.
+    const Eigen::Index n = out.x0.size();
+    out.solve.x = state(out.solve.x, n);
+    if (out.solve.best.size() > 0) out.solve.best = state(out.solve.best, n);
     out.end_status = out.converged
                          ? fmt::format("completed: {}", out.solve.message)
                          : fmt::format("not converged: {}; best |F| = {:.4e} (noise {:.3e} at the start)",
@@ -97,17 +125,20 @@ void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
 
 Branch SteadyRun::unscaled(const Branch& branch) const {
     Branch b = branch;
-    for (BranchPoint& p : b.points) p.parameter *= settings_.parameter_scale;
+    for (BranchPoint& p : b.points) {
+        p.parameter *= settings_.parameter_scale;
+        p.x = state(p.x, p.x.size());
+    }
     return b;
 }
 
 void SteadyRun::continue_branch(CoarseMap& map, SteadyRunOutcome& out) {
     ContinuationSettings cs = settings_.branch;
-    cs.corrector.observer = iterate_observer_;
+    cs.corrector.observer = observer_in_states(out.x0.size());
     if (point_observer_) cs.on_point = [this](const Branch& b) { point_observer_(unscaled(b)); };
     PseudoArclengthContinuation continuation(map, cs);
     const double direction = settings_.parameter_end >= settings_.parameter_start ? 1.0 : -1.0;
-    out.branch = unscaled(continuation.run(out.x0, settings_.parameter_start / settings_.parameter_scale, direction));
+    out.branch = unscaled(continuation.run(solver_point(out.x0), settings_.parameter_start / settings_.parameter_scale, direction));
     out.converged = !out.branch.points.empty();
     const std::size_t n = out.branch.points.size();
     out.end_status = out.converged ? fmt::format("completed: {} branch point(s) from {} = {:.4g} to {:.4g}; {}", n,

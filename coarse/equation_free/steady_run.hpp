@@ -32,6 +32,7 @@ namespace efdem::coarse {
 struct SteadyRunOutcome {
     bool continuation = false;
     std::string solver;     ///< "newton" or "anderson"
+    std::string coordinates = "heights";  ///< what the solver worked in (CoarseCoordinates::name)
     double tau = 0;         ///< micro time of one evaluation
     double warmup_end = 0;  ///< micro clock at the end of the warm-up
     Eigen::VectorXd x0;     ///< the initial guess (last warm-up sample)
@@ -54,8 +55,10 @@ class SteadyRun {
   public:
     /// `repair` (may be empty): makes a lifted point liftable; `set_parameter` (continuation:
     /// required): sets the parameter (scene units) on the micro model.
+    /// `coordinates` (may be empty: the coarse vector itself): what the solver works in; every
+    /// vector this run reports (outcome, observers) is the coarse vector X again.
     SteadyRun(const SteadyRunSettings& settings, CoarseStepper& stepper, RepairHook repair,
-              std::function<void(double)> set_parameter = {});
+              std::function<void(double)> set_parameter = {}, CoarseCoordinates coordinates = {});
     /// Called at every iterate of every solve (steady: one solve; continuation: the first point
     /// and each corrector); a non-empty answer stops the run there.
     void set_iterate_observer(IterateObserver observer) { iterate_observer_ = std::move(observer); }
@@ -69,6 +72,11 @@ class SteadyRun {
     void solve_steady(CoarseMap& map, SteadyRunOutcome& out);
     void continue_branch(CoarseMap& map, SteadyRunOutcome& out);
     Branch unscaled(const Branch& branch) const;
+    /// u -> X of the first `n` components (the rest, e.g. a continuation parameter, kept).
+    Eigen::VectorXd state(const Eigen::VectorXd& y, Eigen::Index n) const;
+    Eigen::VectorXd solver_point(const Eigen::VectorXd& x) const;
+    IterateObserver observer_in_states(Eigen::Index n) const;
+    CoarseCoordinates coordinates_;
 
     SteadyRunSettings settings_;
     CoarseStepper& stepper_;

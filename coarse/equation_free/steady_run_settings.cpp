@@ -39,7 +39,10 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     whole_multiple(steady, "warmup", s.warmup, sample_interval, interval);
     s.map.tau = steady.get_or<double>("tau", 20.0, Bounds::open_closed(0.0, 1e7));
     whole_multiple(steady, "tau", s.map.tau, sample_interval, interval);
-    s.map.difference_step = steady.get_or<double>("difference_step", 0.5, Bounds::open_closed(0.0, 1e3));
+    s.gap_coordinates = steady.get_or_choice("coordinates", "heights", {"heights", "gaps"}) == "gaps";
+    // In log gaps 0.2 changes the gaps by about 20 % at most; in heights 0.5 d_p over the nodes.
+    s.map.difference_step =
+        steady.get_or<double>("difference_step", s.gap_coordinates ? 0.2 : 0.5, Bounds::open_closed(0.0, 1e3));
     s.map.common_random_numbers = newton;  // Anderson needs no kept state
 
     SteadyStopRule stop;

@@ -11,7 +11,8 @@
 /// | steady.warmup             | direct simulation before the first evaluation; its last     | 20       |
 /// |                           | sample is the initial guess                                 |          |
 /// | steady.tau                | micro time of one evaluation of Phi_tau                     | 20       |
-/// | steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 0.5      |
+/// | steady.coordinates        | `heights` (the ICDF nodes) or `gaps` (first node, log gaps) | heights  |
+/// | steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 0.5/0.2  |
 /// | steady.tolerance          | absolute floor of the stopping rule on \|F\|                | 1e-10    |
 /// | steady.noise_factor       | stop at \|F\| <= this x the noise of F                      | 2        |
 /// | steady.max_iterations     | Newton steps (newton) / iterations (anderson)               | 8 / 40   |
@@ -48,6 +49,9 @@ namespace efdem::coarse {
 struct SteadyRunSettings {
     enum class Solver { newton, anderson } solver = Solver::newton;
     bool continuation = false;  ///< mode = continuation (else mode = steady)
+    /// steady.coordinates: solve in the node heights or in the ICDF's gap coordinates
+    /// (coarse/demixing/icdf_gap_coordinates.hpp; the caller supplies them).
+    bool gap_coordinates = false;
     double warmup = 20.0;
     CoarseMapSettings map;
     NewtonKrylovSettings newton;

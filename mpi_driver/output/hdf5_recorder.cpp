@@ -316,6 +316,7 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         document(name);
     };
     file_.attribute("/steady", "solver", o.solver);
+    file_.attribute("/steady", "coordinates", o.coordinates);
     file_.attribute("/steady", "tau", o.tau);
     file_.attribute("/steady", "warmup_end", o.warmup_end);
     file_.attribute("/steady", "evaluations", std::int64_t{o.evaluations});

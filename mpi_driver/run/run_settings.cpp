@@ -168,6 +168,9 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
                                   "of >= 2 realizations; this run has {} (ranks x ensemble.realizations_per_rank)",
                                   mode_name(), realizations),
                       "steady or continuation with >= 2 realizations (more ranks or ensemble.realizations_per_rank)");
+        if (steady.gap_coordinates && observable != "icdf")
+            root.scope("steady").fail("coordinates", "= gaps are coordinates of an ICDF, and cpi.observable is " + observable,
+                                      "heights, or gaps with cpi.observable = icdf");
         const auto* row = coarse::observable_table().find(observable);
         if (row && !row->make(coarse::ProbabilityGrid(observe.quantiles))->restricts_members())
             root.scope("cpi").fail("observable",

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/demixing/icdf_gap_coordinates.hpp"
 #include "coarse/equation_free/steady_run.hpp"
 #include "core/log.hpp"
 #include "mpi_driver/ensemble/stop_signal.hpp"
@@ -24,7 +25,8 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
     const coarse::SteadyRunSettings& ss = s.steady;
     coarse::EnsembleObservable& observable = stepper.observable();
     coarse::SteadyRun run(ss, stepper, observable.repair_hook([&stepper] { return stepper.height_range(); }),
-                          [&stepper](double value) { stepper.set_parameter(value); });
+                          [&stepper](double value) { stepper.set_parameter(value); },
+                          ss.gap_coordinates ? coarse::icdf_gap_coordinates() : coarse::CoarseCoordinates{});
     const double micro_start = stepper.micro_time();
     const double budget = s.duration;  // 0: none
     double parameter = ss.continuation ? ss.parameter_start : 0.0;

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "coarse/demixing/icdf_gap_coordinates.hpp"
 #include "coarse/equation_free/steady_run.hpp"
 #include "tests/coarse/steady_toy_steppers.hpp"
 
@@ -162,4 +163,46 @@ TEST_CASE("SteadyRun: continuation in a scaled parameter reports the branch in t
         CHECK(p.leading.mu.real() == Approx(std::exp(-1.0)).margin(1e-6));
     }
     CHECK(set_to > 0.55);  // the hook saw scene units, not lambda / 0.1
+}
+
+TEST_CASE("gap coordinates: every lifted point is an increasing ICDF, the answer is reported in heights",
+          "[unit][steady]") {
+    const CoarseCoordinates gaps = icdf_gap_coordinates();
+    const Eigen::Vector3d x(1.0, 1.5, 4.0);
+    // u = (1, log 0.5, log 2.5); back to x to round-off.
+    const Eigen::VectorXd u = gaps.from_state(x);
+    CHECK(u[1] == Approx(std::log(0.5)).epsilon(1e-14));
+    CHECK((gaps.to_state(u) - x).norm() < 1e-14);
+    // Any u is increasing (while exp(u_i) is above the round-off of the heights).
+    const Eigen::VectorXd wild = gaps.to_state(Eigen::Vector3d(-3.0, 5.0, -10.0));
+    CHECK((wild[1] > wild[0] && wild[2] > wild[1]));
+
+    // x' = -0.1 (x - x*) with x* increasing; Newton in u (F is not affine in u: two or three
+    // steps) from an increasing start.
+    const Eigen::Vector3d x_star(1.0, 2.0, 4.0);
+    test::AffineToyStepper toy({std::exp(-0.1 * 0.5) * Eigen::Matrix3d::Identity(), x_star, 0.5});
+    toy.lift(Eigen::Vector3d(0.0, 0.2, 0.5), 0.0);
+    SteadyRunSettings s = newton_settings();
+    s.eigenvalues = 1;
+    s.spectrum.eigenvalues = 1;
+    long non_monotone = 0, lifts = 0;
+    RepairHook check = [&](Eigen::VectorXd& v) {
+        ++lifts;
+        for (Eigen::Index i = 1; i < v.size(); ++i)
+            if (!(v[i] > v[i - 1])) ++non_monotone;
+        return RepairReport{};
+    };
+    SteadyRun run(s, toy, check, {}, gaps);
+    const SteadyRunOutcome out = run.run();
+    INFO(out.end_status);
+    REQUIRE(out.converged);
+    CHECK(out.coordinates == "gaps");
+    CHECK(lifts == out.evaluations);
+    CHECK(non_monotone == 0);
+    // |F| <= 1e-10 in u; u -> X is Lipschitz with constant max(1, gaps) ~ 2 here.
+    CHECK((out.solve.x - x_star).norm() < 1e-8);
+    CHECK((out.solve.best - x_star).norm() < 1e-8);
+    // The eigenvalue is coordinate-free at the fixed point: e^{-0.1 tau}.
+    REQUIRE(out.spectrum.leading.size() == 1);
+    CHECK(out.spectrum.leading.front().rate == Approx(-0.1).margin(1e-5));
 }
