@@ -2,7 +2,7 @@
 """Compare the coarse steady state of mode = steady (bench/steady_study.sh) with the time average
 of a direct ensemble after complete demixing, node by node, against the noise of both.
 
-    /usr/bin/python3 bench/steady_compare.py runs/steady_study [--from 150] [--block 20] [-o fig.png]
+    /usr/bin/python3 bench/steady_compare.py runs/steady_study [--run newton_gaps] [--from 150] [--block 20] [-o fig.png]
 
 Reported (RMS over the ICDF nodes, d_p): the difference Newton - direct average; the Newton
 answer's noise (SE of Phi_tau at the answer per node); the direct average's standard error per
@@ -25,6 +25,7 @@ def main():
     ap.add_argument("--from", dest="t_from", type=float, default=150.0)
     ap.add_argument("--block", type=float, default=20.0)
     ap.add_argument("-o", "--output")
+    ap.add_argument("--run", default="newton", help="the steady run's prefix in the folder (newton, newton_gaps)")
     a = ap.parse_args()
     try:
         with run_files.open_run(os.path.join(a.folder, "direct.h5"), ["samples/time"]) as d:
@@ -32,7 +33,7 @@ def main():
             p = d["p"][:]
             R = int(d.attrs["realizations"])
             direct_dem = float(d.attrs.get("dem_time", t[-1]))
-        with run_files.open_run(os.path.join(a.folder, "newton.h5"), ["steady/iterate/residual"]) as n:
+        with run_files.open_run(os.path.join(a.folder, a.run + ".h5"), ["steady/iterate/residual"]) as n:
             s = n["steady"]
             it = s["iterate"]
             # A run still going (or cut short) has no /steady/best yet: its best iterate so far.

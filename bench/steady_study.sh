@@ -3,6 +3,7 @@
 #   direct.h5  a direct ensemble with its own seeds over 300 time units, whose time average
 #              after complete demixing is the reference steady ICDF;
 #   newton.h5  mode = steady (Newton-GMRES, CRN derivatives) from a 60-unit warm-up;
+#   newton_gaps.h5  the same in gap coordinates (steady.coordinates = gaps), at most 500 of DEM time;
 #   branch.h5  mode = continuation in U_s from 0.2 to 0.6 (steps of 0.1, tau = 10), with the
 #              leading eigenvalue at every point (recorded point by point: a run cut short
 #              keeps the points it reached).
@@ -29,6 +30,8 @@ run() {  # NAME overrides...
 run direct mode=direct seed=101 run.duration=300
 run newton mode=steady seed=1 run.duration=0 steady.warmup=60 steady.tau=20 steady.max_krylov=6 \
   steady.max_iterations=4 steady.eigenvalues=2 steady.eigenvalue_products=6
+run newton_gaps mode=steady seed=1 run.duration=500 steady.coordinates=gaps steady.warmup=60 steady.tau=20 \
+  steady.max_krylov=6 steady.max_iterations=3 steady.eigenvalues=2 steady.eigenvalue_products=4
 run branch mode=continuation seed=7 run.duration=0 gas_drag.superficial_velocity=0.2 \
   continuation.parameter=gas_drag.superficial_velocity continuation.end=0.6 continuation.step=0.1 \
   continuation.max_points=6 steady.warmup=40 steady.tau=10 steady.max_krylov=4 steady.max_iterations=3 \
