@@ -48,7 +48,7 @@ IterateObserver SteadyRun::observer_in_states(Eigen::Index n) const {
     };
 }
 
-SteadyRunOutcome SteadyRun::run() {
+SteadyRunOutcome SteadyRun::header() const {
     SteadyRunOutcome out;
     out.continuation = settings_.continuation;
     out.solver = settings_.solver == SteadyRunSettings::Solver::newton ? "newton" : "anderson";
@@ -56,6 +56,11 @@ SteadyRunOutcome SteadyRun::run() {
     out.coordinates = coordinates_ ? coordinates_.name : "heights";
     out.parameter = settings_.parameter;
     out.parameter_scale = settings_.parameter_scale;
+    return out;
+}
+
+SteadyRunOutcome SteadyRun::run() {
+    SteadyRunOutcome out = header();
     if (settings_.continuation) set_parameter_(settings_.parameter_start);
     BurstSamples warm;
     stepper_.run(settings_.warmup, warm);

@@ -67,6 +67,9 @@ class SteadyRun {
 
     /// Warm-up, then the solve or the continuation.
     SteadyRunOutcome run();
+    /// What the settings alone say of the outcome (mode, solver, coordinates, tau, parameter):
+    /// where run() starts, and what a caller reports of a run cut short.
+    SteadyRunOutcome header() const;
 
   private:
     void solve_steady(CoarseMap& map, SteadyRunOutcome& out);

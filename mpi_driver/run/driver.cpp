@@ -30,12 +30,6 @@ coarse::CoarseVariable coarse_variable(coarse::EnsembleObservable& observable, E
     return v;
 }
 
-void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress& progress) {
-    sum.dem_time = stepper.micro_time();
-    sum.wall_seconds = progress.elapsed_seconds();
-    sum.particle_steps = stepper.particle_steps();
-    sum.restrict_seconds = stepper.overhead().restrict_seconds;
-}
 
 /// The end of a run stopped by a signal: the checkpoint written where it can be continued.
 void stopped(RunSummary& sum, const EnsembleStepper& stepper, const std::filesystem::path& checkpoint,
@@ -50,6 +44,13 @@ void stopped(RunSummary& sum, const EnsembleStepper& stepper, const std::filesys
                                        signal_name(sum.stop_signal), stepper.time(), sum.checkpoint, checkpoint_time);
 }
 }  // namespace
+
+void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress& progress) {
+    sum.dem_time = stepper.micro_time();
+    sum.wall_seconds = progress.elapsed_seconds();
+    sum.particle_steps = stepper.particle_steps();
+    sum.restrict_seconds = stepper.overhead().restrict_seconds;
+}
 
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress, const RunControl& control) {
     DriverState state;

@@ -32,6 +32,9 @@ struct RunControl {
     std::optional<DriverState> resume;
 };
 
+/// The totals every run mode reports: DEM time, run-loop wall time, particle-steps, restriction time.
+void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress& progress);
+
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Progress& progress,
                       const RunControl& control = {});
 

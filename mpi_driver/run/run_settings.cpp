@@ -11,6 +11,15 @@
 
 namespace efdem::mpi_driver {
 
+namespace {
+/// Whether the observable named `name` can restrict one realization on its own (what a spread
+/// over the realizations needs); an unknown name is refused where it is read.
+bool restricts_members(const std::string& name, int quantiles) {
+    const auto* row = coarse::observable_table().find(name);
+    return !row || row->make(coarse::ProbabilityGrid(quantiles))->restricts_members();
+}
+}  // namespace
+
 RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& scene) {
     RunSettings s;
     const std::string mode = root.get_or_choice("mode", "direct", {"direct", "cpi", "steady", "continuation"});
@@ -67,6 +76,9 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                 // Read with the bounds its effect reads it with (dem/gas/gas_drag.cpp).
                 return root.scope(effect).get<double>(key.substr(dot + 1), Bounds::closed(0.0, 1e3));
             });
+        if (s.steady.gap_coordinates && s.observable != "icdf")
+            root.scope("steady").fail("coordinates", "= gaps are coordinates of an ICDF, and cpi.observable is " + s.observable,
+                                      "heights, or gaps with cpi.observable = icdf");
     }
     if (s.lifts()) {
         // After cpi.warmup and one burst something must be left to jump over: a run of exactly
@@ -168,11 +180,7 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
                                   "of >= 2 realizations; this run has {} (ranks x ensemble.realizations_per_rank)",
                                   mode_name(), realizations),
                       "steady or continuation with >= 2 realizations (more ranks or ensemble.realizations_per_rank)");
-        if (steady.gap_coordinates && observable != "icdf")
-            root.scope("steady").fail("coordinates", "= gaps are coordinates of an ICDF, and cpi.observable is " + observable,
-                                      "heights, or gaps with cpi.observable = icdf");
-        const auto* row = coarse::observable_table().find(observable);
-        if (row && !row->make(coarse::ProbabilityGrid(observe.quantiles))->restricts_members())
+        if (!restricts_members(observable, observe.quantiles))
             root.scope("cpi").fail("observable",
                                    fmt::format("cannot restrict a realization on its own, and mode = {} measures the "
                                                "noise of F from the realizations' spread", mode_name()),
@@ -186,9 +194,7 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
                            "spread; this run has {} (ranks x ensemble.realizations_per_rank)", realizations),
                "fixed or periods with one realization; adaptive with >= 2 (more ranks or "
                "ensemble.realizations_per_rank)");
-    const coarse::ProbabilityGrid grid(observe.quantiles);
-    const auto* row = coarse::observable_table().find(observable);
-    if (row && !row->make(grid)->restricts_members())
+    if (!restricts_members(observable, observe.quantiles))
         c.fail("observable", "cannot restrict a realization on its own, and cpi.projection = adaptive needs every "
                              "realization's own slope",
                "icdf with cpi.projection = adaptive");

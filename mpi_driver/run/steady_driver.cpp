@@ -8,6 +8,7 @@
 #include "coarse/equation_free/steady_run.hpp"
 #include "core/log.hpp"
 #include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/run/driver.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -47,13 +48,14 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         it.parameter = ss.continuation && rec.x.size() > n ? rec.x[n] * ss.parameter_scale : parameter;
         it.dem_time = stepper.micro_time() - micro_start - ss.warmup;
         if (recorder) recorder->steady_iterate(it);
-        const double rate = stepper.micro_time() > 0 ? stepper.particle_steps() / progress.elapsed_seconds() : 0.0;
+        const double wall = progress.elapsed_seconds();
+        const double rate = wall > 0 ? stepper.particle_steps() / wall : 0.0;
         log::info("steady: solve {} iterate {}: |F| = {:.4e} (noise {:.3e}, {:.2f} x noise){}; DEM time {:.4g}{} in "
                   "{} wall ({:.3g} particle-steps/s)",
                   it.solve, it.iteration, it.residual, it.noise, it.noise > 0 ? it.residual / it.noise : 0.0,
                   ss.continuation ? fmt::format(" at {} = {:.5g}", ss.parameter, it.parameter) : std::string{},
                   it.dem_time, budget > 0 ? fmt::format(" of {:.4g}", budget) : std::string{},
-                  format_duration(progress.elapsed_seconds()), rate);
+                  format_duration(wall), rate);
         if (stepper.interrupted()) return fmt::format("stopped by {}", signal_name(stepper.interrupted()));
         if (budget > 0 && it.dem_time >= budget)
             return fmt::format("the DEM-time budget run.duration = {:g} is spent ({:.4g} used)", budget, it.dem_time);
@@ -76,11 +78,7 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         out = run.run();
     } catch (const RunInterrupted&) {
         // Between two samples of an evaluation: what was found so far is what is saved.
-        out.continuation = ss.continuation;
-        out.solver = ss.solver == coarse::SteadyRunSettings::Solver::newton ? "newton" : "anderson";
-        out.tau = ss.map.tau;
-        out.parameter = ss.parameter;
-        out.parameter_scale = ss.parameter_scale;
+        out = run.header();
         out.solve = trace.latest;
         out.solve.reason = coarse::SteadyStopReason::stopped;
         out.solve.message = fmt::format("stopped by {}", signal_name(stepper.interrupted()));
@@ -99,10 +97,7 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
     sum.end_status = out.end_status;
     sum.unconverged = sum.stop_signal == 0 && !out.converged;
     sum.simulated_time = stepper.micro_time() - micro_start;
-    sum.dem_time = stepper.micro_time();
-    sum.wall_seconds = progress.elapsed_seconds();
-    sum.particle_steps = stepper.particle_steps();
-    sum.restrict_seconds = stepper.overhead().restrict_seconds;
+    fill_totals(sum, stepper, progress);
     sum.lift_seconds = stepper.overhead().lift_seconds;
     if (sum.unconverged) {
         const coarse::SteadySolveRecord& r = out.solve;
