@@ -3,10 +3,13 @@
 the 1,000-sphere demo bed, 200 time units, bursts of healing 10 + window 10, warm-up 10, at
 U_s = 0.19 and 0.41:
 
-    /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --out runs/adaptive_study
+    /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --realizations 8
 
-Runs, one folder each under --out/u<U_s>/ (a run whose .h5 says "completed" is not repeated: rerun the
-command in a later session and it continues), most informative first:
+Runs are made in a working folder each under --out/u<U_s>/ (default runs/adaptive_study_r<R>); what
+the analysis reads of each completed run (its samples, its /cpi records, its attributes and the
+command) is kept in one file per run under --results (default bench/results/adaptive_study_r<R>/
+u<U_s>/<run>.h5, committed). A run whose result file is there is not repeated: rerun the command in
+a later session, or in a fresh clone, and it continues. Most informative first:
 
   direct_a, direct_b   mode=direct, seeds 101, 202: the empirical noise floor is their difference
   adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values); at
@@ -21,9 +24,10 @@ ensemble, E[e^2] = floor^2 (each difference of two independent ensembles of R ca
 the wall time of the mean direct run over the CPI run's (same ranks and R; the runs are made one
 after the other on a shared machine, so wall ratios carry its load).
 
---realizations R (default 4: ranks x 2; 8 fits a larger machine) and --np (default 2).
+--realizations R (default 4: ranks x 2) and --np (default 2).
 --deadline HH:MM (UTC): start no run that, at the direct runs' pace, would end after it.
---analyse-only: no runs. Writes analysis.md, analysis.json and error_vs_speedup.png into --out.
+--only NAME...: make only these runs (e.g. direct_a direct_b, which do not depend on the controller).
+--analyse-only: no runs. Writes analysis.md, analysis.json and error_vs_speedup.png into --results.
 """
 import argparse
 import datetime as dt_
@@ -75,38 +79,44 @@ def base(u, realizations, np_):
             "cpi.window": 10, "ensemble.realizations_per_rank": realizations // np_}
 
 
-h5 = sr.run_file
-completed = sr.completed
 attr_text = sr.text
 
 
-def direct_pace(folder):
+def result(args, u, name):
+    """The committed result file of run NAME at U_s = u."""
+    return os.path.join(args.results, f"u{u:g}", name + ".h5")
+
+
+def direct_pace(args, u):
     """Wall seconds per time unit of the direct runs made so far (None before the first)."""
     made = []
     for name in ("direct_a", "direct_b"):
-        if completed(folder, name):
-            with h5py.File(h5(folder, name), "r") as f:
+        if sr.archived(result(args, u, name)):
+            with h5py.File(result(args, u, name), "r") as f:
                 made.append(float(f.attrs["wall_seconds"]) / float(f.attrs["dem_time"]))
     return float(np.mean(made)) if made else None
 
 
 def run_one(args, folder, u, name, mode, seed, extra):
-    if completed(folder, name):
+    if sr.archived(result(args, u, name)):
         print(f"  u{u:g}/{name}: done before, skipped", flush=True)
         return True
     if args.deadline:
-        pace = direct_pace(folder) or 4.0
+        pace = direct_pace(args, u) or 4.0 * args.realizations / 4
         est = pace * DURATION * (1.0 if mode == "direct" else 0.7)
         if dt_.datetime.now(dt_.timezone.utc) + dt_.timedelta(seconds=est) > args.deadline:
             print(f"  u{u:g}/{name}: not started: about {est / 60:.0f} min would end after {args.deadline:%H:%M} UTC",
                   flush=True)
             return False
     over = {**base(u, args.realizations, args.np), "seed": seed, **extra}
-    return sr.run_case(args.efdem, args.np, SCENE, folder, name, mode, over, label=f"u{u:g}/{name}")
+    ok = sr.run_case(args.efdem, args.np, SCENE, folder, name, mode, over, label=f"u{u:g}/{name}")
+    if ok:
+        sr.archive(folder, name, result(args, u, name))
+    return ok
 
 
-def load(folder, name):
-    with h5py.File(h5(folder, name), "r") as f:
+def load(path):
+    with h5py.File(path, "r") as f:
         d = {k: attr_text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
         d["t"] = f["samples/time"][:]
         d["mean"] = f["samples/mean"][:]
@@ -139,29 +149,25 @@ def analyse(args):
                         f"Demo bed (1,000 spheres), R = {args.realizations}, {DURATION:g} time units, "
                         "burst 10 + 10, warm-up 10. Error e and noise floor as in the script's docstring.", ""]
     for u in SPEEDS:
-        folder = os.path.join(args.out, f"u{u:g}")
-        if not (completed(folder, "direct_a") and completed(folder, "direct_b")):
+        done = lambda name: sr.archived(result(args, u, name))  # noqa: E731
+        if not (done("direct_a") and done("direct_b")):
             report.append(f"U_s = {u:g}: the two direct ensembles are not complete yet; nothing to compare.\n")
             continue
-        da, db = load(folder, "direct_a"), load(folder, "direct_b")
-        # Wall times compare only runs made in this study, one after the other (a run copied from
-        # an earlier study, marked by provenance.txt, carried that session's load).
-        copied = lambda name: os.path.exists(os.path.join(folder, name, "provenance.txt"))  # noqa: E731
-        walls = [float(d["wall_seconds"]) for n, d in (("direct_a", da), ("direct_b", db)) if not copied(n)]
-        wall_direct = float(np.mean(walls)) if walls else math.nan
+        da, db = load(result(args, u, "direct_a")), load(result(args, u, "direct_b"))
+        wall_direct = 0.5 * (float(da["wall_seconds"]) + float(db["wall_seconds"]))
         floor_all = am.rms_error(da["mean"], am.align(db["t"], db["mean"], da["t"])[1])
         report += [f"## U_s = {u:g}", "", f"Noise floor RMS(D_a - D_b) over all samples: **{floor_all:.3f} d_p**; "
-                   f"direct wall time {wall_direct:.0f} s (the directs made in this study; runs copied from an "
-                   "earlier study, which carried its load, have no wall ratio).", "",
+                   f"direct wall time {wall_direct:.0f} s (mean of the two; every run of the study is made one after "
+                   "the other with one binary, on a machine shared with other work: wall ratios carry its load).", "",
                    "| run | error e [d_p] | floor on its samples | e / floor | DEM-time speed-up | wall speed-up | "
                    "jumps kept / rejected / direct bursts | mean DT |", "|---|---|---|---|---|---|---|---|"]
         for name, mode, _, _ in runs(u):
-            if mode != "cpi" or not completed(folder, name):
+            if mode != "cpi" or not done(name):
                 continue
-            r = load(folder, name)
+            r = load(result(args, u, name))
             e, floor, n = score(r, da, db)
             s_dem = float(r["simulated_time"]) / float(r["dem_time"])
-            s_wall = math.nan if copied(name) else wall_direct / float(r["wall_seconds"])
+            s_wall = wall_direct / float(r["wall_seconds"])
             st = r.get("status", [])
             kept = sum(1 for s in st if s == "projected")
             rej = sum(1 for s in st if s == "rejected")
@@ -171,16 +177,17 @@ def analyse(args):
                          "speedup_wall": s_wall, "kept": kept, "rejected": rej, "direct_bursts": direct,
                          "mean_dt": float(np.mean(dts)) if dts else 0.0, "samples": n,
                          "summary": r.get("summary", "")})
-            report.append(f"| {name}{' (copied)' if copied(name) else ''} | {e:.3f} | {floor:.3f} | {e / floor:.2f} | "
+            report.append(f"| {name} | {e:.3f} | {floor:.3f} | {e / floor:.2f} | "
                           f"{s_dem:.2f} | {s_wall:.2f} | "
                           f"{kept} / {rej} / {direct} | {rows[-1]['mean_dt']:.1f} |")
         report.append("")
         for row in rows:
             if row["u"] == u and row["summary"]:
                 report += [f"`{row['run']}`:", "```", row["summary"], "```", ""]
-    with open(os.path.join(args.out, "analysis.md"), "w") as f:
+    os.makedirs(args.results, exist_ok=True)
+    with open(os.path.join(args.results, "analysis.md"), "w") as f:
         f.write("\n".join(report) + "\n")
-    with open(os.path.join(args.out, "analysis.json"), "w") as f:
+    with open(os.path.join(args.results, "analysis.json"), "w") as f:
         json.dump(rows, f, indent=1)
     if rows:
         fig, axes = plt.subplots(1, len(SPEEDS), figsize=(11, 4.2), sharey=True)
@@ -196,23 +203,29 @@ def analyse(args):
             ax.set_xlabel("speed-up over a direct ensemble [-] (filled: DEM time, open: wall time)")
         np.atleast_1d(axes)[0].set_ylabel("error / empirical noise floor [-]")
         fig.tight_layout()
-        fig.savefig(os.path.join(args.out, "error_vs_speedup.png"), dpi=120)
+        fig.savefig(os.path.join(args.results, "error_vs_speedup.png"), dpi=120)
     print("\n".join(report))
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--efdem", default=os.path.join(HERE, "..", "build", "mpi_driver", "efdem"))
-    ap.add_argument("--out", default=os.path.join(HERE, "..", "runs", "adaptive_study"))
+    ap.add_argument("--out", help="working folders (default runs/adaptive_study_r<R>)")
+    ap.add_argument("--results", help="one result file per run (default bench/results/adaptive_study_r<R>)")
     ap.add_argument("--realizations", type=int, default=4)
+    ap.add_argument("--only", nargs="*", help="make only these runs (the analysis uses every completed one)")
     ap.add_argument("--np", type=int, default=2)
     ap.add_argument("--deadline", type=lambda s: dt_.datetime.combine(
         dt_.datetime.now(dt_.timezone.utc).date(), dt_.time.fromisoformat(s), dt_.timezone.utc))
     ap.add_argument("--analyse-only", action="store_true")
     args = ap.parse_args()
+    args.out = args.out or os.path.join(HERE, "..", "runs", f"adaptive_study_r{args.realizations}")
+    args.results = args.results or os.path.join(HERE, "results", f"adaptive_study_r{args.realizations}")
     if not args.analyse_only:
         for u in SPEEDS:  # U_s = 0.19 (the >= 5x target) first, then 0.41
             for name, mode, seed, extra in runs(u):
+                if args.only and name not in args.only:
+                    continue
                 folder = os.path.join(args.out, f"u{u:g}")
                 os.makedirs(folder, exist_ok=True)
                 run_one(args, folder, u, name, mode, seed, extra)

@@ -46,3 +46,33 @@ def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None):
     ok = code == 0 and completed(folder, name)
     print(f"  {label}: {'ok' if ok else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
     return ok
+
+
+# What a study keeps of a run, in the run file's own layout: the groups its analysis reads and the
+# root attributes. The working folders (runs/) are not part of a checkout; these files are
+# committed under bench/results/, one per run, so that a study continues in a fresh clone.
+ARCHIVED_GROUPS = ("samples", "cpi", "realization", "p")
+
+
+def archive(folder, name, dest):
+    """Copy the kept part of FOLDER/NAME/NAME.h5 to DEST (an .h5 path), with its log's last lines."""
+    os.makedirs(os.path.dirname(dest), exist_ok=True)
+    tmp = dest + ".part"
+    with h5py.File(run_file(folder, name), "r") as src, h5py.File(tmp, "w") as out:
+        for key, value in src.attrs.items():
+            out.attrs[key] = value
+        for group in ARCHIVED_GROUPS:
+            if group in src:
+                src.copy(src[group], out, name=group)
+        with open(os.path.join(folder, name, "command.txt")) as f:
+            out.attrs["study_command"] = f.read().strip()
+    os.replace(tmp, dest)  # a half-written archive is never mistaken for a result
+
+
+def archived(dest):
+    """Whether DEST holds the archive of a completed run."""
+    try:
+        with h5py.File(dest, "r") as f:
+            return text(f.attrs.get("end_status", "")).startswith("completed")
+    except (OSError, KeyError):
+        return False

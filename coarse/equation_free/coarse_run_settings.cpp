@@ -85,7 +85,7 @@ CoarseRunSettings CoarseRunSettings::from_params(const Params& cpi, double sampl
             if (s.fixed.dt < c.dt_min || s.fixed.dt > c.dt_max)
                 cpi.fail("dt", fmt::format("caps the first jump with cpi.projection = adaptive and must lie in "
                                            "cpi.dt_min..cpi.dt_max = {:g}..{:g}", c.dt_min, c.dt_max),
-                         fmt::format("{:g} <= cpi.dt <= {:g}, or leave it out (first jump <= one burst)", c.dt_min,
+                         fmt::format("{:g} <= cpi.dt <= {:g}, or leave it out (first jump from the tolerance)", c.dt_min,
                                      c.dt_max));
             m.first_dt = s.fixed.dt;
         }

@@ -25,7 +25,8 @@
 /// | cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     |
 /// | cpi.growth        | adaptive: DT_next <= growth x DT_last                         | 2       |
 ///
-/// With `adaptive`, cpi.dt (if given) caps the first jump (default: one burst) and the keys of
+/// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance
+/// when healing >= window gives the first burst a curvature, else one burst) and the keys of
 /// `periods` are refused; the adaptive keys are refused with the other projections.
 /// warmup, healing, window and max_extension must be whole multiples of the sampling interval.
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <utility>
 
 #include <fmt/format.h>
@@ -13,6 +14,26 @@
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {
+
+namespace {
+
+/// The slope node of a burst's samples in [t_a, t_b): the ensemble's least-squares slope and its
+/// members' standard error. False when the window holds too few samples or no members.
+bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
+    const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
+    const auto n = static_cast<std::size_t>(
+        std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) - b.t.begin());  // samples before t_b
+    if (b.members.size() != b.t.size()) return false;
+    const std::span<const double> t(b.t.data(), n);
+    const SlopeEstimate slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
+    if (!slope.ok) return false;
+    Eigen::VectorXd se = member_slope_standard_error(t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
+    if (se.size() != slope.slope.size()) return false;
+    out = SlopeNode{slope.t_mean, slope.slope, std::move(se)};
+    return true;
+}
+
+}  // namespace
 
 MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSettings& settings, RepairHook repair)
     : settings_(settings), repair_(std::move(repair)) {
@@ -94,7 +115,10 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
 
 void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
     history_.push_back(m.node);
-    while (history_.size() > static_cast<std::size_t>(settings_.steps) + 1) history_.pop_front();
+    while (history_.size() > static_cast<std::size_t>(settings_.steps) + 1) {
+        history_.pop_front();
+        curvature_only_front_ = false;
+    }
     t_end_ = m.t_end;
     x_end_ = m.x_end;
     decay_ = m.decay;
@@ -103,7 +127,8 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
-    const std::size_t q = std::min<std::size_t>(static_cast<std::size_t>(settings_.steps), history_.size());
+    const std::size_t usable = history_.size() - (curvature_only_front_ ? 1 : 0);
+    const std::size_t q = std::min<std::size_t>(static_cast<std::size_t>(settings_.steps), usable);
     return {history_.end() - static_cast<std::ptrdiff_t>(q), history_.end()};
 }
 
@@ -147,9 +172,10 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
             c.limited_by = why;
         }
     };
-    if (!std::isfinite(model.curvature))
-        limit(std::isfinite(settings_.first_dt) ? settings_.first_dt : std::max(s.dt_min, burst),
-              "first jump (no curvature measured yet)");
+    if (std::isfinite(settings_.first_dt) && totals_.accepted == 0)
+        limit(settings_.first_dt, "first jump (cpi.dt)");
+    else if (!std::isfinite(model.curvature))
+        limit(std::max(s.dt_min, burst), "first jump (no curvature measured yet)");
     if (std::isfinite(dt_last_)) limit(s.growth * dt_last_, "growth");
     limit(dt_cap_, "rejection");
     if (settings_.dt_quantum > 0.0 && std::isfinite(dt))
@@ -207,6 +233,15 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     Measured m;
     if (history_.empty()) {  // the first slope: one burst, no jump
         if (!measure_burst(stepper, rec, m)) return rec;
+        // No lift before it: with healing >= window its start is a second window, whose slope
+        // gives the first jump a curvature (for the error model only).
+        const double w = settings_.window;
+        SlopeNode early;
+        if (settings_.adaptive && settings_.healing >= w * (1.0 - 1e-12) &&
+            window_node(rec.burst, m.t_end - 2.0 * w, m.t_end - w, early)) {
+            history_.push_back(std::move(early));
+            curvature_only_front_ = true;
+        }
         accept_burst(m);
         rec.status = StepStatus::burst_only;
         rec.t_end = t_end_;
@@ -358,7 +393,7 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
 void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::string& text) const {
     r.clear();
     const Eigen::Index m = x_end_.size();
-    r.insert(r.end(), {2.0 /* layout version */, static_cast<double>(history_.size()), static_cast<double>(m), t_end_,
+    r.insert(r.end(), {3.0 /* layout version */, static_cast<double>(history_.size()), static_cast<double>(m), t_end_,
                        dt_last_, dt_cap_, static_cast<double>(consecutive_rejections_), decay_.ok ? 1.0 : 0.0,
                        decay_.rate, decay_.ratio, decay_.delay});
     r.insert(r.end(), x_end_.data(), x_end_.data() + m);
@@ -371,16 +406,20 @@ void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::stri
     r.insert(r.end(), {static_cast<double>(t.attempts), static_cast<double>(t.accepted), static_cast<double>(t.rejected),
                        static_cast<double>(t.direct), t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r,
                        t.dt_tolerance_4r, t.statistical, t.truncation});
+    r.push_back(curvature_only_front_ ? 1.0 : 0.0);  // layout 3
     text = decay_.message + '\n' + hold_kind_ + '\n' + hold_;
 }
 
 void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, const std::string& text) {
     history_.clear();
+    curvature_only_front_ = false;
     if (r.empty()) return;  // saved before the first burst
-    EFDEM_EXPECTS(r.size() >= 11 && r[0] == 2.0);
+    // Layout 2 (checkpoint format 2 of earlier versions) lacks the last value: no curvature-only node.
+    EFDEM_EXPECTS(r.size() >= 11 && (r[0] == 2.0 || r[0] == 3.0));
     const auto n = static_cast<std::size_t>(r[1]);
     const auto m = static_cast<Eigen::Index>(r[2]);
-    EFDEM_EXPECTS(r.size() == 11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10);
+    const std::size_t layout_extra = r[0] == 3.0 ? 1 : 0;
+    EFDEM_EXPECTS(r.size() == 11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10 + layout_extra);
     t_end_ = r[3];
     dt_last_ = r[4];
     dt_cap_ = r[5];
@@ -420,6 +459,7 @@ void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, 
     t.dt_tolerance_4r = r[k + 7];
     t.statistical = r[k + 8];
     t.truncation = r[k + 9];
+    if (layout_extra) curvature_only_front_ = r[k + 10] != 0.0;
 }
 
 }  // namespace efdem::coarse

@@ -7,15 +7,19 @@
 /// One step, adaptive (the stepper is at the end of the last accepted burst, X_n):
 ///   1. plan DT: the largest DT whose predicted error (statistical + truncation, from the
 ///      slopes measured so far) is at most safety x tolerance, then the limits: growth over the
-///      last DT, dt_max, the first jump (no curvature known yet) at most one burst, the end
-///      of the run, the stability monitor; below dt_min no jump is worth its error: run one
+///      last DT, dt_max, the first jump at most one burst if no curvature is known yet (see
+///      below), the end of the run, the stability monitor; below dt_min no jump is worth its error: run one
 ///      burst directly instead (status burst_only, the record says why);
 ///   2. keep the micro state, project X_n + sum_k W_k s_k, repair, lift;
 ///   3. run the next burst (provisional samples) and measure its slope;
 ///   4. judge the jump a posteriori with the curvature that slope shows: accept (samples
 ///      final, the slope joins the history) or reject (back to the kept state, the next step
 ///      tries a smaller DT; status rejected).
-/// The very first step of a run runs one burst only (its slope is the first jump's).
+/// The very first step of a run runs one burst only (its slope is the first jump's). No lift
+/// precedes it, so its healing is direct simulation like the window: when healing >= window,
+/// adaptive runs also fit the window just before the last one, [t - 2 window, t - window), and
+/// the first jump is planned from the curvature of those two slopes (a node used for the
+/// curvature only, never projected from) instead of being capped at one burst.
 /// With a fixed DT (adaptive = false) steps 1-4 run without keeping, judging or rejecting;
 /// the error estimates are still recorded.
 ///
@@ -62,8 +66,8 @@ struct MultistepSettings {
     int steps = 1;          ///< q: 1 forward Euler, 2 Adams-Bashforth 2
     bool adaptive = true;   ///< DT by the controller; false: `dt` for every jump
     double dt = 80.0;       ///< adaptive = false: the projective step (>= 0)
-    /// adaptive: the first jump (no curvature measured yet) is at most this; NaN: one burst,
-    /// but at least dt_min.
+    /// adaptive: the first jump is at most this; NaN: planned from the tolerance when the first
+    /// burst measured a curvature (healing >= window), else one burst, but at least dt_min.
     double first_dt = std::numeric_limits<double>::quiet_NaN();
     StepSizeSettings control;
     /// adaptive: DT is rounded down to a whole multiple of this (the sampling interval, so
@@ -129,6 +133,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     MultistepSettings settings_;
     RepairHook repair_;
     std::deque<SlopeNode> history_;  ///< accepted slopes, oldest first (at most steps + 1)
+    /// history_.front() is the first burst's earlier window: for the curvature, not projected from.
+    bool curvature_only_front_ = false;
     double t_end_ = 0.0;             ///< end of the last accepted burst
     Eigen::VectorXd x_end_;          ///< X there
     DecayRateEstimate decay_;        ///< from the last accepted burst
