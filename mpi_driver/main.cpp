@@ -325,7 +325,8 @@ int main(int argc, char** argv) {
         Params root = table->root();
         const dem::DemScene scene = dem::DemScene::from_params(root);
         settings = RunSettings::from_params(root, scene);
-        settings->check_ensemble(root, mpi.size() * settings->realizations_per_rank);
+        const int ranks = options.ranks > 0 ? options.ranks : mpi.size();  // --ranks=N with --check
+        settings->check_ensemble(root, ranks * settings->realizations_per_rank);
         const int k = check ? 1 : settings->realizations_per_rank;
         // Settling a paper-size bed takes minutes: the root says how its own realizations go
         // (the other ranks settle theirs at the same time).
@@ -414,7 +415,8 @@ int main(int argc, char** argv) {
             for (const auto& d : table->declarations())
                 std::printf("%s\t%s\t%s\n", d.key.c_str(), d.expected.c_str(), d.required ? "required" : d.fallback.c_str());
         } else if (mpi.is_root()) {
-            std::printf("%s", check_report(*table, *settings, systems.front(), mpi.size()).c_str());
+            std::printf("%s", check_report(*table, *settings, systems.front(),
+                                           options.ranks > 0 ? options.ranks : mpi.size()).c_str());
         }
         return kExitOk;
     }

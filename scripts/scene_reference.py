@@ -35,6 +35,8 @@ SCENES = [
     ("examples/paper_fig2b/scene.cfg", []),
     ("examples/paper_fig4/scene.cfg", []),
     ("examples/steady_demo/scene.cfg", []),
+    ("examples/tall_bed/scene_u019.cfg", ["ensemble.realizations_per_rank=2"]),
+    ("examples/tall_bed/scene_u041.cfg", ["ensemble.realizations_per_rank=2"]),
     ("bench/scenes/demo_bed.cfg", []),
     ("bench/scenes/reference_bed.cfg", []),
     ("tests/scripts/single_species_bed.cfg", []),

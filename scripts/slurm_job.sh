@@ -25,7 +25,7 @@ scene=$1; shift
 # Where the run writes, as efdem resolves it (--check fails fast on a bad scene, before any
 # compute time is spent).
 # (output.overwrite=true only here, so that --check reports the paths of an existing run too.)
-report=$("$EFDEM" --check "$scene" "$@" output.overwrite=true 2>&1) || { echo "$report" >&2; exit 2; }
+report=$("$EFDEM" --check --ranks="${SLURM_NTASKS:-1}" "$scene" "$@" output.overwrite=true 2>&1) || { echo "$report" >&2; exit 2; }
 run_file=$(sed -n 's/^run file: //p' <<< "$report")
 checkpoints=$(sed -n 's/^checkpoints: //p' <<< "$report")
 outdir=$(dirname "$run_file"); prefix=$(basename "$run_file" .h5); ckdir=$(dirname "$checkpoints")
@@ -41,7 +41,7 @@ if [ -n "$run_file" ]; then
 fi
 if [ ${#restart[@]} -eq 0 ]; then
   # A new run: refused (with the message) where an earlier run left files under this prefix.
-  "$EFDEM" --check "$scene" "$@" > /dev/null || exit $?
+  "$EFDEM" --check --ranks="${SLURM_NTASKS:-1}" "$scene" "$@" > /dev/null || exit $?
 fi
 
 step=

@@ -36,9 +36,11 @@ MpiSession::~MpiSession() {
 
 std::string MpiSession::launcher_mismatch() const {
     if (size() != 1) return {};
-    // Variables that launchers of several MPI implementations and Slurm set per process.
+    // Variables that launchers of several MPI implementations and srun set per process. Not
+    // SLURM_NTASKS: a batch script's own shell has it (the job's size), and a serial
+    // `efdem --check` there (scripts/slurm_job.sh) is not a launcher mismatch.
     for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS",
-                            "SLURM_NTASKS"}) {
+                            "SLURM_STEP_NUM_TASKS"}) {
         const char* value = std::getenv(var);
         if (value && std::atoi(value) > 1)
             return fmt::format(

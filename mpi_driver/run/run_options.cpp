@@ -1,5 +1,8 @@
 #include "mpi_driver/run/run_options.hpp"
 
+#include <exception>
+#include <string>
+
 #include "core/error.hpp"
 
 namespace efdem::mpi_driver {
@@ -14,6 +17,20 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
         else if (arg == "--list-effects") o.action = Action::list_effects;
         else if (arg == "--check") o.action = Action::check;
         else if (arg == "--list-keys") o.action = Action::list_keys;
+        else if (arg.rfind("--ranks=", 0) == 0) {
+            const std::string v = arg.substr(8);
+            std::size_t used = 0;
+            long n = 0;
+            try {
+                n = std::stol(v, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (v.empty() || used != v.size() || n < 1 || n > 10000000)
+                throw InputError(where, "--ranks='" + v + "': expected a whole number of ranks >= 1 (the ranks the "
+                                            "checked run will have), e.g. --ranks=8");
+            o.ranks = static_cast<int>(n);
+        }
         else if (arg.rfind("--", 0) == 0)
             throw InputError(where, "unknown option '" + arg + "'; see efdem --help");
         else if (arg.rfind("restart=", 0) == 0) {
@@ -27,6 +44,8 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
     }
     if ((o.action == Action::run || o.action == Action::check || o.action == Action::list_keys) && o.scene.empty())
         throw InputError(where, "no scene file given; usage: efdem [--check] SCENE [key=value ...]");
+    if (o.ranks > 0 && o.action != Action::check && o.action != Action::list_keys)
+        throw InputError(where, "--ranks=N only goes with --check or --list-keys (a run has the ranks mpirun gives it)");
     return o;
 }
 
@@ -39,6 +58,8 @@ usage:
   efdem --check SCENE [key=value ...]         read the scene, build one realization, report the
                                               active effects and everything derived from the
                                               inputs, run zero steps
+  efdem --check --ranks=N SCENE [...]         as --check, for a run on N ranks (what a batch
+                                              script checks before it launches N)
   efdem --list-keys SCENE [key=value ...]     as --check, then every key the scene's set-up read
                                               (tab-separated: key, what it accepts, default or
                                               'required'); all keys: docs/scene_reference.md

@@ -17,6 +17,9 @@ struct RunOptions {
     std::string scene;                   ///< path of the scene file
     std::vector<std::string> overrides;  ///< "key=value"
     std::string restart;                 ///< `restart=FILE`: the checkpoint to continue from
+    /// `--ranks=N` (with --check or --list-keys): check the scene as for a run on N ranks (a
+    /// batch script checks serially before it launches N); 0: the ranks this process runs on.
+    int ranks = 0;
 
     /// Parses argv; InputError (location "<command line>") for anything it does not understand.
     static RunOptions parse(int argc, const char* const* argv);

@@ -6,6 +6,8 @@
 # 2. The requeued job continues from the newest checkpoint and completes; its output equals an
 #    uninterrupted run's bit for bit.
 # 3. A third start finds the run complete and does nothing.
+# 4. The job checks a scene for the ranks it will launch (SLURM_NTASKS), e.g. adaptive CPI.
+# 5. The launcher check and --ranks.
 #   slurm_requeue.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 source "$(dirname "$0")/lib.sh" "$@"
 mkdir "$work/bin"
@@ -42,3 +44,31 @@ bash "$job" "$here/tiny_scene.cfg" "${args[@]}" output.directory="$work/job" > "
   && grep -q "is complete; nothing to do" "$work/job3.log" \
   || { cat "$work/job3.log"; echo "FAIL: a complete run was started again"; exit 1; }
 echo "PASS: a complete run is not started again"
+
+# 4. A scene that needs the job's ranks (adaptive CPI, one realization per rank): the job checks it
+#    serially, before srun, as for SLURM_NTASKS ranks; refused (exit 2, the key named) for one rank.
+adaptive=(mode=cpi cpi.projection=adaptive cpi.tolerance=0.1 cpi.dt_min=1 cpi.dt_max=4 run.duration=12
+          ensemble.realizations_per_rank=1 output.directory="$work/adaptive")
+SLURM_NTASKS=2 bash "$job" "$here/tiny_scene.cfg" "${adaptive[@]}" > "$work/job4.log" 2>&1 \
+  || { cat "$work/job4.log"; echo "FAIL: an adaptive scene on 2 ranks did not pass the job's check and run"; exit 1; }
+grep -q "^completed" "$work/job4.log" || { cat "$work/job4.log"; echo "FAIL: the adaptive job did not complete"; exit 1; }
+SLURM_NTASKS=1 bash "$job" "$here/tiny_scene.cfg" "${adaptive[@]}" output.prefix=one > "$work/job5.log" 2>&1
+code=$?
+[ $code -eq 2 ] && grep -q "cpi.projection" "$work/job5.log" && grep -q "this run has 1" "$work/job5.log" \
+  || { cat "$work/job5.log"; echo "FAIL: an adaptive scene on 1 rank: exit $code, expected 2 naming cpi.projection"; exit 1; }
+echo "PASS: the job checks the scene for the ranks it will launch (2: runs; 1: refused, exit 2)"
+
+# 5. The launcher check: a batch shell has SLURM_NTASKS (the job's size), a serial --check there is
+#    fine; a process that srun started as one of 2 (SLURM_STEP_NUM_TASKS=2) but whose MPI sees one
+#    is a launcher from another MPI: refused with a message that says so.
+SLURM_NTASKS=8 "$efdem" --check --ranks=8 "$here/tiny_scene.cfg" > "$work/check8.log" 2>&1 \
+  || { cat "$work/check8.log"; echo "FAIL: a serial --check in a batch shell (SLURM_NTASKS=8) was refused"; exit 1; }
+SLURM_STEP_NUM_TASKS=2 "$efdem" --check "$here/tiny_scene.cfg" > "$work/mismatch.log" 2>&1
+code=$?
+[ $code -ne 0 ] && grep -q "different MPI" "$work/mismatch.log" \
+  || { cat "$work/mismatch.log"; echo "FAIL: a launcher mismatch (SLURM_STEP_NUM_TASKS=2, one MPI rank): exit $code"; exit 1; }
+"$efdem" --ranks=2 "$here/tiny_scene.cfg" > "$work/ranks.log" 2>&1
+code=$?
+[ $code -eq 2 ] && grep -q -- "--ranks=N only goes with --check" "$work/ranks.log" \
+  || { cat "$work/ranks.log"; echo "FAIL: --ranks without --check: exit $code, expected 2"; exit 1; }
+echo "PASS: launcher check (SLURM_NTASKS in the batch shell is not a mismatch; an srun task's is); --ranks only with --check"
