@@ -20,6 +20,8 @@ SystemEvaluation ArclengthSystem::assemble(const MapEvaluation& e, const Eigen::
     out.g.head(n) = e.f;
     out.g[n] = tangent_.dot(y - predicted_);
     out.noise_norm = e.noise_norm;
+    out.state_residual = e.state_residual_norm;  // |F| of the point, without the arclength row
+    out.state_noise = e.state_noise_norm;
     return out;
 }
 

@@ -41,18 +41,25 @@ MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
     EFDEM_ASSERT(e.phi.size() == x.size());
     e.f = e.phi - x;
     e.standard_error = Eigen::VectorXd::Zero(x.size());
-    if (!burst.members.empty()) {
-        Eigen::MatrixXd m = burst.members.back();
+    auto standard_error = [](const Eigen::MatrixXd& m) -> Eigen::VectorXd {
+        return (ensemble_variance(m, ensemble_mean(m)) / static_cast<double>(m.rows())).cwiseSqrt();
+    };
+    double state_noise = 0.0;
+    if (!burst.members.empty() && burst.members.back().rows() >= 2) {
+        const Eigen::MatrixXd& m = burst.members.back();
+        state_noise = standard_error(m).norm();
         if (coordinates_) {
             Eigen::MatrixXd mu(m.rows(), x.size());
             for (Eigen::Index r = 0; r < m.rows(); ++r) mu.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
-            m = std::move(mu);
+            e.standard_error = standard_error(mu);
+        } else {
+            e.standard_error = standard_error(m);
         }
-        if (m.rows() >= 2)
-            e.standard_error =
-                (ensemble_variance(m, ensemble_mean(m)) / static_cast<double>(m.rows())).cwiseSqrt();
     }
     e.noise_norm = e.standard_error.norm();
+    // In X: Phi's restriction against the point the solver asked for (before any repair).
+    e.state_residual_norm = coordinates_ ? (burst.x.back() - coordinates_.to_state(x)).norm() : e.f.norm();
+    e.state_noise_norm = coordinates_ ? state_noise : e.noise_norm;
     return e;
 }
 

@@ -70,6 +70,10 @@ struct MapEvaluation {
     /// |standard_error|_2: the expected norm of the noise in phi (and F), what the stopping
     /// rule compares |F| with.
     double noise_norm = 0;
+    /// |F| and the noise norm in the stepper's coordinates X (the ICDF's heights [d_p]), for the
+    /// record: equal to |f| and noise_norm unless the map works in other coordinates.
+    double state_residual_norm = 0;
+    double state_noise_norm = 0;
 };
 
 class CoarseMap {

@@ -47,8 +47,8 @@ BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec
     BranchPoint p;
     p.x = rec.x.head(n);
     p.parameter = rec.x.size() > n ? rec.x[n] : 0.0;
-    p.residual = rec.residuals.back();
-    p.noise = rec.noise.back();
+    p.residual = rec.state_residuals.back();
+    p.noise = rec.state_noise.back();
     p.newton_iterations = rec.iterations;
     p.step = step;
     if (settings_.stability) {

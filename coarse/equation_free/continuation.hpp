@@ -54,8 +54,8 @@ struct ContinuationSettings {
 struct BranchPoint {
     double parameter = 0;
     Eigen::VectorXd x;
-    double residual = 0;  ///< |F| at the point
-    double noise = 0;     ///< the noise norm measured with it
+    double residual = 0;  ///< |F| at the point in the stepper's coordinates X (d_p for the ICDF)
+    double noise = 0;     ///< the noise norm measured with it, in X
     int newton_iterations = 0;
     double step = 0;  ///< the arclength step that reached it (0 for the first point)
     bool has_leading = false;

@@ -28,7 +28,7 @@ SteadySolveRecord FixedPointIteration::solve(CoarseMap& map, const Eigen::Vector
         const MapEvaluation e = map.evaluate(x, parameter);
         const double r = e.f.norm();
         const bool growing = r > rec.best_residual;
-        rec.add_iterate(x, r, e.noise_norm);
+        rec.add_iterate(x, r, e.noise_norm, e.state_residual_norm, e.state_noise_norm);
         log::info("fixed point {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
         // The observer sees every iterate (the last one too); a stop it asks for comes after
         // the stopping rule, so a converged solve is never reported as stopped.

@@ -32,7 +32,7 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorX
     while (true) {
         const SystemEvaluation e = system.begin(y);
         const double r = e.g.norm();
-        rec.add_iterate(y, r, e.noise_norm);
+        rec.add_iterate(y, r, e.noise_norm, e.state_residual, e.state_noise);
         log::info("newton {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
         // The observer sees every iterate (the last one too); a stop it asks for comes after
         // the stopping rule, so a converged solve is never reported as stopped.

@@ -5,6 +5,8 @@
 /// FixedPointSystem is G = F = Phi_tau - X; ArclengthSystem (continuation) appends the
 /// pseudo-arclength row.
 
+#include <limits>
+
 #include <Eigen/Core>
 
 namespace efdem::coarse {
@@ -12,6 +14,10 @@ namespace efdem::coarse {
 struct SystemEvaluation {
     Eigen::VectorXd g;       ///< G(y)
     double noise_norm = 0;   ///< norm of G's standard error from the ensemble (0: none)
+    /// |F| and its noise norm in the stepper's coordinates (MapEvaluation::state_residual_norm,
+    /// state_noise_norm), for the record; NaN: the same as |g| and noise_norm.
+    double state_residual = std::numeric_limits<double>::quiet_NaN();
+    double state_noise = std::numeric_limits<double>::quiet_NaN();
 };
 
 class NewtonSystem {

@@ -124,8 +124,8 @@ void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
     out.end_status = out.converged
                          ? fmt::format("completed: {}", out.solve.message)
                          : fmt::format("not converged: {}; best |F| = {:.4e} (noise {:.3e} at the start)",
-                                       out.solve.message, out.solve.best_residual,
-                                       out.solve.noise.empty() ? 0.0 : out.solve.noise.front());
+                                       out.solve.message, out.solve.best_state_residual(),
+                                       out.solve.state_noise.empty() ? 0.0 : out.solve.state_noise.front());
 }
 
 Branch SteadyRun::unscaled(const Branch& branch) const {

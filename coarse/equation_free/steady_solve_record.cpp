@@ -1,6 +1,7 @@
 #include "coarse/equation_free/steady_solve_record.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace efdem::coarse {
 
@@ -23,10 +24,19 @@ bool SteadyStopRule::reached(double r, double noise, SteadyStopReason& reason) c
     return true;
 }
 
-void SteadySolveRecord::add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm) {
+double SteadySolveRecord::best_state_residual() const {
+    if (residuals.empty() || state_residuals.size() != residuals.size()) return best_residual;
+    const auto k = std::min_element(residuals.begin(), residuals.end()) - residuals.begin();
+    return state_residuals[static_cast<std::size_t>(k)];
+}
+
+void SteadySolveRecord::add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm,
+                                    double residual_in_state, double noise_in_state) {
     x = y;
     residuals.push_back(residual);
     noise.push_back(noise_norm);
+    state_residuals.push_back(std::isnan(residual_in_state) ? residual : residual_in_state);
+    state_noise.push_back(std::isnan(noise_in_state) ? noise_norm : noise_in_state);
     if (residual < best_residual) {
         best_residual = residual;
         best = y;

@@ -52,6 +52,10 @@ struct SteadySolveRecord {
     double best_residual = std::numeric_limits<double>::infinity();
     std::vector<double> residuals;  ///< |F| at each iterate, the first included
     std::vector<double> noise;      ///< the noise norm measured with each residual
+    /// The same two in the stepper's coordinates X ([d_p] for the ICDF), whatever coordinates
+    /// the solver works in (equal to residuals and noise when it works in X): what is recorded.
+    std::vector<double> state_residuals;
+    std::vector<double> state_noise;
     std::vector<int> krylov_iterations;  ///< GMRES products per Newton step (empty: fixed point)
     /// Per Newton step, the GMRES residual |G + G' d_j| before the first product and after each
     /// product j (krylov_iterations[k] + 1 values; empty: fixed point).
@@ -61,11 +65,17 @@ struct SteadySolveRecord {
     long evaluations = 0;     ///< evaluations of the coarse map (each one burst of tau)
     double micro_time = 0;    ///< micro time of those evaluations [sqrt(d_p/g)]
 
+    /// state_residuals at the best iterate (the one with the smallest solver |F|): what the
+    /// record reports as the best |F|, in X; best_residual when nothing was recorded.
+    double best_state_residual() const;
+
     bool converged() const {
         return reason == SteadyStopReason::converged || reason == SteadyStopReason::noise_level;
     }
-    /// Adds an iterate and its residual, updating the best.
-    void add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm);
+    /// Adds an iterate and its residual, updating the best; `state` is the evaluation's |F| and
+    /// noise in X (NaN in it: the same as residual and noise_norm).
+    void add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm, double residual_in_state,
+                     double noise_in_state);
 };
 
 }  // namespace efdem::coarse

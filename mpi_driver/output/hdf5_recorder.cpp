@@ -343,7 +343,7 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
     file_.attribute("/steady", "reason", coarse::to_string(r.reason));
     file_.attribute("/steady", "message", r.message);
     file_.attribute("/steady", "iterations", std::int64_t{r.iterations});
-    file_.attribute("/steady", "best_residual", r.best_residual);
+    file_.attribute("/steady", "best_residual", r.best_state_residual());  // in heights, as /steady/iterate/residual
     vector("/steady/x", r.x);
     vector("/steady/best", r.best);
     if (r.best.size() == dim_) file_.attribute("/steady", "mean_height", coarse::mean_height(r.best));

@@ -41,8 +41,8 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         SteadyIterateRecord it;
         it.solve = trace.solve;
         it.iteration = iteration;
-        it.residual = rec.residuals.back();
-        it.noise = rec.noise.back();
+        it.residual = rec.state_residuals.back();  // in heights, whatever the solver's coordinates
+        it.noise = rec.state_noise.back();
         const Eigen::Index n = stepper.observable().dimension();
         it.x = rec.x.head(std::min<Eigen::Index>(n, rec.x.size()));
         it.parameter = ss.continuation && rec.x.size() > n ? rec.x[n] * ss.parameter_scale : parameter;
@@ -101,19 +101,21 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
     sum.lift_seconds = stepper.overhead().lift_seconds;
     if (sum.unconverged) {
         const coarse::SteadySolveRecord& r = out.solve;
+        // In heights [d_p] like the run file's /steady/iterate/residual (the solver's own |F| is
+        // in its coordinates, log gaps with steady.coordinates = gaps).
         std::string history;
-        for (std::size_t k = 0; k < r.residuals.size(); ++k)
-            history += fmt::format("{}{:.3e}", k ? ", " : "", r.residuals[k]);
+        for (std::size_t k = 0; k < r.state_residuals.size(); ++k)
+            history += fmt::format("{}{:.3e}", k ? ", " : "", r.state_residuals[k]);
         log::error("{}", out.end_status);
         if (!out.continuation)
-            log::error("residual history |F|: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is /steady/best in "
+            log::error("residual history |F| [d_p]: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is /steady/best in "
                        "the run file. What to try: a longer steady.tau (slow modes then contract more per "
                        "evaluation), more realizations (the noise falls as 1/sqrt(R)), a larger "
                        "steady.difference_step when GMRES did not converge, steady.solver = anderson for a stable "
                        "state",
-                       history, r.noise.empty() ? 0.0 : r.noise.back(), r.best_residual);
+                       history, r.state_noise.empty() ? 0.0 : r.state_noise.back(), r.best_state_residual());
         else
-            log::error("no branch point converged; the first point's residual history |F|: {}. What to try: a "
+            log::error("no branch point converged; the first point's residual history |F| [d_p]: {}. What to try: a "
                        "longer steady.tau, more realizations, a larger steady.difference_step",
                        history);
     }
