@@ -123,6 +123,7 @@ def load(path):
         d["t"] = f["samples/time"][:]
         d["mean"] = f["samples/mean"][:]
         d["var"] = f["samples/variance"][:]
+        d["icdf"] = f["samples/icdf"][:]  # samples x R x nodes
         if "cpi/status" in f:
             d["status"] = [attr_text(s) for s in f["cpi/status"][:]]
             d["dt"] = f["cpi/dt"][:]
@@ -147,6 +148,7 @@ def score(run, da, db):
 
 
 def analyse(args):
+    floors = {}
     rows, report = [], ["# Adaptive vs fixed-DT CPI, independent seeds (bench/adaptive_study.py)", "",
                         f"Demo bed (1,000 spheres), R = {args.realizations}, {DURATION:g} time units, "
                         "burst 10 + 10, warm-up 10. Error e and noise floor as in the script's docstring.", ""]
@@ -158,7 +160,20 @@ def analyse(args):
         da, db = load(result(args, u, "direct_a")), load(result(args, u, "direct_b"))
         wall_direct = 0.5 * (float(da["wall_seconds"]) + float(db["wall_seconds"]))
         floor_all = am.rms_error(da["mean"], am.align(db["t"], db["mean"], da["t"])[1])
+        # What the floor should be from the spread (E (D_a - D_b)^2 = var_a/R + var_b/R), and how
+        # much one pair's floor scatters: every split of each direct ensemble into two halves is
+        # a floor of two ensembles of R/2; / sqrt(2) it estimates one of R (frozen offsets of
+        # realizations make these differ far more than per-sample noise would).
+        r_direct = int(da["realizations"])
+        var_b = am.align(db["t"], db["var"], da["t"])[1]
+        floor_spread = math.sqrt(float(np.mean((da["var"] + var_b) / r_direct)))
+        splits = np.concatenate([am.split_floors(d["icdf"]) for d in (da, db)]) / math.sqrt(2.0)
+        floors[f"{u:g}"] = {"floor": floor_all, "floor_spread": floor_spread, "split_min": float(splits.min()),
+                            "split_median": float(np.median(splits)), "split_max": float(splits.max())}
         report += [f"## U_s = {u:g}", "", f"Noise floor RMS(D_a - D_b) over all samples: **{floor_all:.3f} d_p**; "
+                   f"from the realizations' spread sqrt((var_a + var_b)/R): {floor_spread:.3f} d_p; one pair's floor "
+                   f"scatters over {splits.min():.3f}-{splits.max():.3f} d_p (median {np.median(splits):.3f}; the "
+                   f"{len(splits)} half-splits of the two direct ensembles, / sqrt(2)). "
                    f"direct wall time {wall_direct:.0f} s (mean of the two; every run of the study is made one after "
                    "the other with one binary, on a machine shared with other work: wall ratios carry its load).", "",
                    "| run | error e [d_p] | floor on its samples | e / floor | DEM-time speed-up | wall speed-up | "
@@ -190,7 +205,7 @@ def analyse(args):
     with open(os.path.join(args.results, "analysis.md"), "w") as f:
         f.write("\n".join(report) + "\n")
     with open(os.path.join(args.results, "analysis.json"), "w") as f:
-        json.dump(rows, f, indent=1)
+        json.dump({"runs": rows, "noise_floors": floors}, f, indent=1)
     if rows:
         fig, axes = plt.subplots(1, len(SPEEDS), figsize=(11, 4.2), sharey=True)
         for ax, u in zip(np.atleast_1d(axes), SPEEDS):

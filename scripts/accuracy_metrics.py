@@ -41,6 +41,27 @@ def normalized_error(mean, mean_ref, var_ref, r_ref, var_cpi=None, r_cpi=None):
     return rms_error(mean, mean_ref) / float(np.sqrt(np.mean(noise)))
 
 
+def split_floors(members):
+    """How far two halves of one ensemble lie apart, for every way of splitting its R members
+    (R even; members: samples x R x m) into two halves with member 0 in the first:
+    RMS over samples and nodes of mean(half 1) - mean(half 2), one value per split
+    (C(R-1, R/2-1) of them: 35 for R = 8). Each is a noise floor of two independent ensembles
+    of R/2; their range is the draw-to-draw scatter of one such floor, and divided by sqrt(2)
+    they estimate the floor of two ensembles of R (Var(D_a - D_b) = 2 var/R)."""
+    import itertools
+
+    members = np.asarray(members, float)
+    r = members.shape[1]
+    if r < 2 or r % 2:
+        raise ValueError(f"split_floors needs an even number of members >= 2, not {r}")
+    out = []
+    for rest in itertools.combinations(range(1, r), r // 2 - 1):
+        first = [0, *rest]
+        second = [k for k in range(r) if k not in first]
+        out.append(rms_error(members[:, first].mean(axis=1), members[:, second].mean(axis=1)))
+    return np.array(out)
+
+
 def speedup(sim_time, wall, realizations, ref_sim_time, ref_wall, ref_realizations):
     """Effective speed-up: simulated realization-time per wall second of the run, against that
     of the direct ensemble (both on the same ranks), i.e. against a direct ensemble of equal R."""

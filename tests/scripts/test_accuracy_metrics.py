@@ -25,6 +25,22 @@ class Metrics(unittest.TestCase):
         self.assertAlmostEqual(am.rms_error(ref + 0.3, ref), 0.3, places=14)
         self.assertEqual(am.rms_error(ref, ref), 0.0)
 
+    def test_split_floors_count_and_scale(self):
+        # 8 members of pure noise (sd 1), 400 samples x 19 nodes: 35 splits, each the RMS of a
+        # difference of two means of 4, whose sd is sqrt(2/4) = 0.707; with 7,600 values per
+        # split the RMS is within 3 % of it (its relative sd is ~1/sqrt(2 x 7,600) = 0.8 %).
+        rng = np.random.default_rng(5)
+        f = am.split_floors(rng.normal(size=(400, 8, 19)))
+        self.assertEqual(len(f), 35)
+        self.assertTrue(np.all(np.abs(f / math.sqrt(0.5) - 1.0) < 0.03))
+        # A member offset that persists (frozen, as in a packed bed) makes the splits differ:
+        # member 0 shifted by 2 moves every split's floor by ~2/4 in one direction.
+        x = rng.normal(scale=0.01, size=(50, 8, 3))
+        x[:, 0] += 2.0
+        np.testing.assert_allclose(am.split_floors(x), 0.5, atol=0.01)
+        with self.assertRaises(ValueError):
+            am.split_floors(np.zeros((3, 3, 2)))
+
     def test_normalized_error_of_pure_noise_is_about_one(self):
         # Two independent ensembles of R realizations of the same truth: the difference of their
         # means has variance 2 var/R, so the normalized error is ~1 (within 10 % for 19 x 400
