@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -271,33 +272,39 @@ TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the sh
 }
 
 TEST_CASE("an adaptive run resumed from the saved integrator state continues bit for bit", "[unit][coarse][multistep]") {
+    // Saved after six steps, and right after the first burst with healing = window (the history
+    // then holds the curvature-only node of the first burst's earlier window).
     const Eigen::VectorXd k = rates19();
-    MultistepSettings s;
-    s.healing = 2.0;
-    s.window = 4.0;
-    s.steps = 2;
-    s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 60.0};
-    test::OuEnsembleStepper toy(k, 0.05, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
-    MultistepProjectiveIntegrator a(s);
-    a.set_end_time(300.0);
-    for (int i = 0; i < 6; ++i) REQUIRE(a.step(toy).advanced());
-    std::vector<double> reals;
-    std::string text;
-    a.save_state(reals, text);
-    test::OuEnsembleStepper copy = toy;
-    MultistepProjectiveIntegrator b(s);
-    b.restore_state(reals, text);
-    b.set_end_time(300.0);
-    for (int i = 0; i < 8; ++i) {
-        const ProjectiveStepRecord ra = a.step(toy), rb = b.step(copy);
-        CHECK(ra.dt == rb.dt);
-        CHECK(to_string(ra.status) == to_string(rb.status));
+    for (const auto& [healing, before] : {std::pair{2.0, 6}, std::pair{4.0, 1}}) {
+        INFO("healing " << healing << ", saved after " << before << " step(s)");
+        MultistepSettings s;
+        s.healing = healing;
+        s.window = 4.0;
+        s.steps = 2;
+        s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 60.0};
+        test::OuEnsembleStepper toy(k, 0.05, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
+        MultistepProjectiveIntegrator a(s);
+        a.set_end_time(300.0);
+        for (int i = 0; i < before; ++i) REQUIRE(a.step(toy).advanced());
+        std::vector<double> reals;
+        std::string text;
+        a.save_state(reals, text);
+        test::OuEnsembleStepper copy = toy;
+        MultistepProjectiveIntegrator b(s);
+        b.restore_state(reals, text);
+        b.set_end_time(300.0);
+        for (int i = 0; i < 8; ++i) {
+            const ProjectiveStepRecord ra = a.step(toy), rb = b.step(copy);
+            CHECK(ra.dt == rb.dt);
+            CHECK(ra.controller.steps == rb.controller.steps);
+            CHECK(to_string(ra.status) == to_string(rb.status));
+        }
+        CHECK((toy.mean().array() == copy.mean().array()).all());
+        std::vector<double> again;
+        b.save_state(again, text);
+        a.save_state(reals, text);
+        CHECK(again == reals);
     }
-    CHECK((toy.mean().array() == copy.mean().array()).all());
-    std::vector<double> again;
-    b.save_state(again, text);
-    a.save_state(reals, text);
-    CHECK(again == reals);
 }
 
 TEST_CASE("phase_drift and wave_coherence judge the phase signal from the members", "[unit][coarse][multistep]") {
@@ -380,33 +387,4 @@ TEST_CASE("with healing >= window the first burst's two windows give the first j
     const ProjectiveStepRecord jump = capped.step(toy);
     CHECK(jump.dt == Approx(7.0));
     CHECK(jump.controller.limited_by == "first jump (no curvature measured yet)");
-}
-
-TEST_CASE("the first burst's curvature-only slope survives a save and restore", "[unit][coarse][multistep]") {
-    // Saved right after the first burst (history: the curvature-only node and the slope), the
-    // restored integrator plans the same first jump and continues bit for bit.
-    const Eigen::VectorXd k = rates19();
-    MultistepSettings s;
-    s.healing = 4.0;
-    s.window = 4.0;
-    s.steps = 2;
-    s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 60.0};
-    test::OuEnsembleStepper toy(k, 0.05, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
-    MultistepProjectiveIntegrator a(s);
-    a.set_end_time(300.0);
-    REQUIRE(a.step(toy).status == StepStatus::burst_only);
-    std::vector<double> reals;
-    std::string text;
-    a.save_state(reals, text);
-    test::OuEnsembleStepper copy = toy;
-    MultistepProjectiveIntegrator b(s);
-    b.restore_state(reals, text);
-    b.set_end_time(300.0);
-    for (int i = 0; i < 6; ++i) {
-        const ProjectiveStepRecord ra = a.step(toy), rb = b.step(copy);
-        CHECK(ra.dt == rb.dt);
-        CHECK(ra.controller.steps == rb.controller.steps);
-        CHECK(to_string(ra.status) == to_string(rb.status));
-    }
-    CHECK((toy.mean().array() == copy.mean().array()).all());
 }
