@@ -173,6 +173,7 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.recorded = observables.recorded.get();
     ss.bed = bed;
     ss.parameter = s.steady.parameter;
+    ss.lift_members = s.lift_members && s.is_cpi();
     // The run's start (progress counts from there; on the non-root ranks it is not used).
     const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);

@@ -171,8 +171,9 @@ void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
 
 void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
     const bool top = observable_->needs_top_half();
-    broadcast({Command::lift, new_time, top});
-    do_lift(new_time, top, &target);
+    const bool members = settings_.lift_members && observable_->restricts_members();
+    broadcast({members ? Command::lift_members : Command::lift, new_time, top});
+    do_lift(new_time, top, &target, members);
 }
 
 void EnsembleStepper::finish(int exit_code) {
@@ -295,7 +296,8 @@ void EnsembleStepper::serve() {
         const Message m = broadcast({Command::finish, 0.0, false});
         switch (m.command) {
             case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
-            case Command::lift: do_lift(m.value, m.top_half, nullptr); break;
+            case Command::lift: do_lift(m.value, m.top_half, nullptr, false); break;
+            case Command::lift_members: do_lift(m.value, m.top_half, nullptr, true); break;
             case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr, false); break;
             case Command::keep: do_keep(); break;
             case Command::go_back: do_go_back(); break;
@@ -526,22 +528,27 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     if (progress_) progress_->update(rec.time, particle_steps_, "");
 }
 
-void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target,
+void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target, bool members,
                               const std::vector<char>* only) {
     const double start = MPI_Wtime();
     auto lifted_here = [&](long index) {
         return active_[static_cast<std::size_t>(index)] != 0 && (!only || (*only)[static_cast<std::size_t>(index)] != 0);
     };
     const auto m = static_cast<Eigen::Index>(grid_.values().size());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    // cpi.lift = members: every realization's own X now, to move each by the same increment
+    // (a rebuild after a failure lifts to the target itself).
+    EFDEM_EXPECTS(!members || !only);
     std::vector<std::vector<double>> reals;
     std::vector<std::vector<std::uint8_t>> bytes;
-    std::vector<Eigen::VectorXd> top_icdf;
+    std::vector<Eigen::VectorXd> top_icdf, own_icdf;
     std::vector<std::size_t> out_reals, out_bytes;
     for (const auto& r : local_) {
         if (!lifted_here(r->index())) {  // dropped, or not among `only`: nothing sent, nothing changed
             reals.emplace_back();
             bytes.emplace_back();
-            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, std::numeric_limits<double>::quiet_NaN()));
+            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            if (members) own_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
             out_reals.push_back(0);
             out_bytes.push_back(0);
             continue;
@@ -549,7 +556,11 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
         LiftPayload in = r->lift_input();
         reals.push_back(std::move(in.reals));
         bytes.push_back(std::move(in.bytes));
-        if (top) top_icdf.push_back(r->observe(grid_, true).top);
+        if (top || members) {
+            Observation o = r->observe(grid_, top);
+            if (top) top_icdf.push_back(std::move(o.top));
+            if (members) own_icdf.push_back(std::move(o.icdf));
+        }
         const auto [nr, nb] = r->lift_output_sizes();
         out_reals.push_back(nr);
         out_bytes.push_back(nb);
@@ -557,11 +568,29 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
     const auto all_reals = layout_.gather_arrays(reals);
     const auto all_bytes = layout_.gather_arrays(bytes);
     const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+    const Eigen::MatrixXd all_own = members ? layout_.gather_rows(own_icdf) : Eigen::MatrixXd();
 
     std::vector<std::vector<double>> lifted_reals;
     std::vector<std::vector<std::uint8_t>> lifted_bytes;
     if (layout_.is_root()) {
         last_lift_ = LiftRecord{};
+        // Each lifted realization's own X and their mean, in realization order (the same sum on
+        // any layout); the increment target - mean moves every one of them alike.
+        Eigen::MatrixXd own;
+        Eigen::VectorXd increment;
+        if (members) {
+            own = observable_->restrict_members(all_own, all_top);
+            EFDEM_ASSERT(own.rows() == layout_.size() && own.cols() == target->size());
+            Eigen::VectorXd sum = Eigen::VectorXd::Zero(target->size());
+            long n = 0;
+            for (int r = 0; r < layout_.size(); ++r)
+                if (lifted_here(r)) {
+                    sum += own.row(r).transpose();
+                    ++n;
+                }
+            EFDEM_ASSERT(n > 0);
+            increment = *target - sum / static_cast<double>(n);
+        }
         for (int r = 0; r < layout_.size(); ++r) {
             if (!lifted_here(r)) {
                 last_lift_.changed.push_back(0);
@@ -571,12 +600,24 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
                 lifted_bytes.emplace_back();
                 continue;
             }
+            Eigen::VectorXd x = *target;
+            std::string repaired;
+            if (members) {
+                x = own.row(r).transpose() + increment;
+                if (member_repair_) {
+                    const coarse::RepairReport report = member_repair_(x);
+                    if (report.changed())
+                        repaired = fmt::format("its own target (X_r + increment) repaired by up to {:.3g} d_p",
+                                               report.max_adjustment);
+                }
+            }
             const Eigen::VectorXd goal =
-                observable_->lift_target(*target, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
+                observable_->lift_target(x, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
             LiftOutcome res = lifter_.lift(goal, {all_reals[r], all_bytes[r]}, grid_, lifting_[r]);
             last_lift_.changed.push_back(res.changed);
             last_lift_.max_deviation.push_back(res.max_deviation);
-            last_lift_.messages.push_back(res.message);
+            last_lift_.messages.push_back(repaired.empty() || res.message.empty() ? repaired + res.message
+                                                                                   : repaired + "; " + res.message);
             lifted_reals.push_back(std::move(res.payload.reals));
             lifted_bytes.push_back(std::move(res.payload.bytes));
         }
@@ -685,7 +726,8 @@ void EnsembleStepper::do_rebuild(bool top_half) {
                 RandomStream(settings_.seed, static_cast<std::uint64_t>(f + R * failures_), "lifting");
     // 3. Lifted at once to the ensemble's coarse state at the resume point, so that the copy
     //    leaves its donor's trajectory from the first step on.
-    if (replace && lift_flag) do_lift(resume_time_, top_half, layout_.is_root() ? &resume_x_ : nullptr, &lift_these);
+    if (replace && lift_flag)
+        do_lift(resume_time_, top_half, layout_.is_root() ? &resume_x_ : nullptr, false, &lift_these);
     if (layout_.is_root()) {
         last_sample_ = resume_sample_;
         if (recorder_)

@@ -66,6 +66,11 @@ struct StepperSettings {
     std::string parameter;
     /// observe.bed: how the realizations measure the bed (their Observation::bed); none: not gathered.
     std::optional<dem::BedObservationSettings> bed;
+    /// cpi.lift = members: lift(X) moves every realization by the same increment, to its own
+    /// X_r + (X - mean_r X_r), so that each keeps its offset from the ensemble mean (the spread of
+    /// a direct ensemble) instead of all collapsing onto X. Needs an observable that restricts
+    /// members (the ICDF). A realization rebuilt after a failure is still lifted to X itself.
+    bool lift_members = false;
 };
 
 class EnsembleStepper final : public coarse::CoarseStepper {
@@ -151,6 +156,9 @@ public:
     /// the feasible range of a lifting target.
     std::pair<double, double> height_range() const { return height_range_; }
     void set_observable(coarse::EnsembleObservable& observable) { observable_ = &observable; }
+    /// Root, with lift_members: makes each realization's own target liftable (the observable's
+    /// repair hook, as the integrator applies to the mean target); none: targets as computed.
+    void set_member_repair(coarse::RepairHook repair) { member_repair_ = std::move(repair); }
     /// Root: the coarse observable in use (its status_message() says why a sample failed).
     const coarse::EnsembleObservable& observable() const { return *observable_; }
     coarse::EnsembleObservable& observable() { return *observable_; }
@@ -173,7 +181,8 @@ public:
 private:
     enum class Command : int {
         run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7, mark = 8,
-        checkpoint_mark = 9, rebuild = 10, set_parameter = 11
+        checkpoint_mark = 9, rebuild = 10, set_parameter = 11,
+        lift_members = 12  ///< a lift that moves each realization by the same increment
     };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
@@ -201,7 +210,10 @@ private:
     void do_mark();
     void flush_since_mark();
     /// `only` (every rank; null: all): lift just the realizations marked 1.
-    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, const std::vector<char>* only = nullptr);
+    /// `members`: each realization to its own X_r + (target - mean X_r) (the root decides, the
+    /// workers are told by the command: it adds a gather).
+    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members,
+                 const std::vector<char>* only = nullptr);
     bool is_active(const Realization& r) const { return active_[static_cast<std::size_t>(r.index())] != 0; }
     void on_failures(const std::vector<Failure>& failures);
     /// Root: every realization's failure message (empty where none); collective.
@@ -237,6 +249,7 @@ private:
     double total_particles_ = 0;
     std::pair<double, double> height_range_{0.0, 0.0};
     LiftRecord last_lift_;
+    coarse::RepairHook member_repair_;
     SampleRecord last_sample_;
     Overhead overhead_;
     bool provisional_ = false;               ///< between keep_state() and its end

@@ -25,7 +25,10 @@ coarse::CoarseVariable coarse_variable(coarse::EnsembleObservable& observable, E
     v.name = std::string(observable.name());
     v.description = std::string(observable.label());
     v.repair = observable.repair_hook([&stepper] { return stepper.height_range(); });
-    v.select = [&stepper, &observable] { stepper.set_observable(observable); };
+    v.select = [&stepper, &observable, repair = v.repair] {
+        stepper.set_observable(observable);
+        stepper.set_member_repair(repair);  // cpi.lift = members: each realization's own target too
+    };
     v.failure = [&observable] { return observable.failure_reason(); };
     return v;
 }

@@ -61,6 +61,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     const auto observables = coarse::observable_table().names();
     s.observable = cpi.get_or_choice("observable", observables.front(), observables);
     s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval, s.is_cpi());
+    s.lift_members = cpi.get_or_choice("lift", "mean", {"mean", "members"}) == "members";
+    if (s.lift_members && s.is_cpi() && !restricts_members(s.observable, s.observe.quantiles))
+        cpi.fail("lift", "= members moves each realization from its own coarse state, and cpi.observable = " +
+                             s.observable + " cannot restrict a realization on its own",
+                 "mean, or members with cpi.observable = icdf");
     if (s.is_steady()) {
         const auto* row = coarse::observable_table().find(s.observable);
         const long dimension = row ? static_cast<long>(row->make(coarse::ProbabilityGrid(s.observe.quantiles))->dimension())

@@ -33,6 +33,8 @@
 /// | observe.mixing_layer           | layer thickness of the Lacey mixing index           | 2       |
 /// | cpi.observable                 | the coarse variable: `icdf` (the ICDF nodes) or     | icdf    |
 /// |                                | `compact` ((A,B,C,D)); coarse/demixing/observable_table |     |
+/// | cpi.lift                       | `mean`: every realization lifted to the projected X;| mean    |
+/// |                                | `members`: each moved by the same increment         |         |
 /// | cpi.*                          | the coarse run loop: coarse_run_settings.hpp        |         |
 /// | output.directory               | where the run writes (relative: to the scene's      | .       |
 /// |                                | folder; on the command line: to the working dir)    |         |
@@ -88,6 +90,9 @@ struct RunSettings {
     ObserveSettings observe;
     /// cpi.observable: a row of coarse::observable_table().
     std::string observable = "icdf";
+    /// cpi.lift = members: every realization is moved by the jump's increment, keeping its own
+    /// offset from the mean (the ensemble stepper's lift); `mean` (default): all lifted to X.
+    bool lift_members = false;
     /// The other cpi.* keys, read by the coarse layer.
     coarse::CoarseRunSettings cpi;
     /// mode = steady | continuation: the steady.* and continuation.* keys.
