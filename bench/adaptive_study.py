@@ -15,6 +15,7 @@ a later session, or in a fresh clone, and it continues. Most informative first:
   adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values); at
                        U_s = 0.41 with healing 2 + window 20 (two wave periods, see ADAPTIVE_BURST)
   fixed_dt40           seed 303, cpi.dt = 40 (the demo bed's best fixed DT, docs/accuracy_vs_cost.md)
+  adaptive_tol<X>_members  as adaptive_tol<X> (the first X) with cpi.lift = members
   fixed_dt80           seed 505, cpi.dt = 80 (the paper's DT at U_s = 0.19), last
 
 Error of a CPI run: e^2 = (RMS^2(X - D_a) + RMS^2(X - D_b)) / 2 over the CPI run's samples (times
@@ -72,6 +73,7 @@ def runs(u=0.19):
     out.append(("fixed_dt40", "cpi", 303, {"cpi.projection": "fixed", "cpi.dt": 40}))
     for tol in TOLERANCES[1:]:
         out.append((f"adaptive_tol{tol:g}", "cpi", 404, adaptive(tol)))
+    out.append((f"adaptive_tol{TOLERANCES[0]:g}_members", "cpi", 404, {**adaptive(TOLERANCES[0]), "cpi.lift": "members"}))
     out.append(("fixed_dt80", "cpi", 505, {"cpi.projection": "fixed", "cpi.dt": 80}))
     return out
 
