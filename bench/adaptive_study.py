@@ -1,22 +1,27 @@
 #!/usr/bin/python3
-"""Adaptive against fixed-DT CPI, every ensemble with its own seeds (issue 16). A resumable study on
-the 1,000-sphere demo bed, 200 time units, bursts of healing 10 + window 10, warm-up 10, at
-U_s = 0.19 and 0.41:
+"""Adaptive against fixed-DT CPI, every ensemble with its own seeds (issue 16). A resumable study,
+bursts of healing 10 + window 10, warm-up 10, at U_s = 0.19 and 0.41, on one of two beds (--bed):
+
+  demo   the 1,000-sphere demo bed (15.5 d_p tall), 200 time units at both U_s (default)
+  tall   the tall bed of examples/tall_bed (3,120 spheres, the paper's 48 d_p height at a
+         quarter of its area), 200 time units at U_s = 0.41, then 400 at U_s = 0.19
 
     /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --realizations 8
+    /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --bed tall --realizations 4
 
-Runs are made in a working folder each under --out/u<U_s>/ (default runs/adaptive_study_r<R>); what
-the analysis reads of each completed run (its samples, its /cpi records, its attributes and the
-command) is kept in one file per run under --results (default bench/results/adaptive_study_r<R>/
-u<U_s>/<run>.h5, committed). A run whose result file is there is not repeated: rerun the command in
+Runs are made in a working folder each under --out/u<U_s>/ (default runs/<study>_r<R>, <study> =
+adaptive_study for the demo bed, tall_study for the tall one); what the analysis reads of each
+completed run (its samples, its /cpi records, its attributes and the command) is kept in one file
+per run under --results (default bench/results/<study>_r<R>/u<U_s>/<run>.h5, committed). A run whose result file is there is not repeated: rerun the command in
 a later session, or in a fresh clone, and it continues. Most informative first:
 
   direct_a, direct_b   mode=direct, seeds 101, 202: the empirical noise floor is their difference
-  adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values); at
+  adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values; 2 on
+                       the tall bed); at
                        U_s = 0.41 with healing 2 + window 20 (two wave periods, see ADAPTIVE_BURST)
   fixed_dt40           seed 303, cpi.dt = 40 (the demo bed's best fixed DT, docs/accuracy_vs_cost.md)
-  adaptive_tol<X>_members  as adaptive_tol<X> (the first X) with cpi.lift = members
-  fixed_dt80           seed 505, cpi.dt = 80 (the paper's DT at U_s = 0.19), last
+  adaptive_tol<X>_members  as adaptive_tol<X> (the first X) with cpi.lift = members (demo bed)
+  fixed_dt80           seed 505, cpi.dt = 80 (the paper's DT at U_s = 0.19), last (demo bed)
 
 Error of a CPI run: e^2 = (RMS^2(X - D_a) + RMS^2(X - D_b)) / 2 over the CPI run's samples (times
 and p-nodes), X its ensemble-mean light ICDF, D_a, D_b the direct ensembles at the same times. The
@@ -27,6 +32,10 @@ the wall time of the mean direct run over the CPI run's (same ranks and R; the r
 after the other on a shared machine, so wall ratios carry its load).
 
 --realizations R (default 4: ranks x 2) and --np (default 2).
+Cost on 2 cores (AMD EPYC, 2026-12-02): demo bed R = 8, one direct run of 200 time units ~30-45 min;
+tall bed R = 4 (4 x 3,120 spheres at ~6.5e6 particle-steps/s per core, examples/tall_bed/README.md)
+~10 s per time unit: a direct run ~35 min at U_s = 0.41 (200 units) and ~70 min at 0.19 (400), the
+whole tall study (10 runs) about 6 hours, i.e. two sessions of the resumable command.
 --deadline HH:MM (UTC): start no run that, at the direct runs' pace, would end after it.
 --only NAME...: make only these runs (e.g. direct_a direct_b, which do not depend on the controller).
 --analyse-only: no runs. Writes analysis.md, analysis.json and error_vs_speedup.png into --results.
@@ -52,10 +61,25 @@ import accuracy_metrics as am  # noqa: E402
 sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
 
-SCENE = os.path.join(HERE, "scenes", "demo_bed.cfg")  # the demo bed without its cpi block
-DURATION = 200.0
-TOLERANCES = (0.16, 0.08, 0.32)  # d_p per jump; the middle one first
-SPEEDS = (0.19, 0.41)
+
+class Bed:
+    """One bed of the study: its scene (without a cpi block), U_s in the order they are run, the
+    run length per U_s, the adaptive tolerances (d_p per jump; the first is run first) and
+    whether the demo bed's extra runs (cpi.lift = members, fixed DT = 80) are made."""
+
+    def __init__(self, scene, label, study, speeds, duration, tolerances, extras):
+        self.scene = os.path.join(HERE, "scenes", scene)
+        self.label, self.study, self.speeds = label, study, speeds
+        self.duration, self.tolerances, self.extras = duration, tolerances, extras
+
+
+BEDS = {
+    "demo": Bed("demo_bed.cfg", "Demo bed (1,000 spheres, 7.5 x 7.5, 15.5 d_p packed)", "adaptive_study",
+                (0.19, 0.41), {0.19: 200.0, 0.41: 200.0}, (0.16, 0.08, 0.32), True),
+    # The paper's height: U_s = 0.41 first (200 units), then 0.19 over 400 (slower dynamics).
+    "tall": Bed("tall_bed.cfg", "Tall bed (3,120 spheres, 7.5 x 7.5, 48 d_p packed)", "tall_study",
+                (0.41, 0.19), {0.41: 200.0, 0.19: 400.0}, (0.16, 0.32), False),
+}
 
 
 # At U_s = 0.41 the realizations' waves stay in phase (they all fluidize at t = 0), so the ensemble
@@ -65,22 +89,25 @@ SPEEDS = (0.19, 0.41)
 ADAPTIVE_BURST = {0.19: {}, 0.41: {"cpi.healing": 2, "cpi.window": 20}}
 
 
-def runs(u=0.19):
+def runs(u=0.19, bed=BEDS["demo"]):
     """(name, mode, seed, overrides) in the order they are made, at U_s = u."""
     out = [("direct_a", "direct", 101, {}), ("direct_b", "direct", 202, {})]
+    tolerances = bed.tolerances
     adaptive = lambda tol: {"cpi.projection": "adaptive", "cpi.tolerance": tol, **ADAPTIVE_BURST[u]}  # noqa: E731
-    out.append((f"adaptive_tol{TOLERANCES[0]:g}", "cpi", 404, adaptive(TOLERANCES[0])))
+    out.append((f"adaptive_tol{tolerances[0]:g}", "cpi", 404, adaptive(tolerances[0])))
     out.append(("fixed_dt40", "cpi", 303, {"cpi.projection": "fixed", "cpi.dt": 40}))
-    for tol in TOLERANCES[1:]:
+    for tol in tolerances[1:]:
         out.append((f"adaptive_tol{tol:g}", "cpi", 404, adaptive(tol)))
-    out.append((f"adaptive_tol{TOLERANCES[0]:g}_members", "cpi", 404, {**adaptive(TOLERANCES[0]), "cpi.lift": "members"}))
-    out.append(("fixed_dt80", "cpi", 505, {"cpi.projection": "fixed", "cpi.dt": 80}))
+    if bed.extras:
+        out.append((f"adaptive_tol{tolerances[0]:g}_members", "cpi", 404,
+                    {**adaptive(tolerances[0]), "cpi.lift": "members"}))
+        out.append(("fixed_dt80", "cpi", 505, {"cpi.projection": "fixed", "cpi.dt": 80}))
     return out
 
 
-def base(u, realizations, np_):
-    return {"gas_drag.superficial_velocity": u, "run.duration": DURATION, "cpi.warmup": 10, "cpi.healing": 10,
-            "cpi.window": 10, "ensemble.realizations_per_rank": realizations // np_}
+def base(u, bed, realizations, np_):
+    return {"gas_drag.superficial_velocity": u, "run.duration": bed.duration[u], "cpi.warmup": 10,
+            "cpi.healing": 10, "cpi.window": 10, "ensemble.realizations_per_rank": realizations // np_}
 
 
 attr_text = sr.text
@@ -107,13 +134,13 @@ def run_one(args, folder, u, name, mode, seed, extra):
         return True
     if args.deadline:
         pace = direct_pace(args, u) or 4.0 * args.realizations / 4
-        est = pace * DURATION * (1.0 if mode == "direct" else 0.7)
+        est = pace * args.bed.duration[u] * (1.0 if mode == "direct" else 0.7)
         if dt_.datetime.now(dt_.timezone.utc) + dt_.timedelta(seconds=est) > args.deadline:
             print(f"  u{u:g}/{name}: not started: about {est / 60:.0f} min would end after {args.deadline:%H:%M} UTC",
                   flush=True)
             return False
-    over = {**base(u, args.realizations, args.np), "seed": seed, **extra}
-    ok = sr.run_case(args.efdem, args.np, SCENE, folder, name, mode, over, label=f"u{u:g}/{name}")
+    over = {**base(u, args.bed, args.realizations, args.np), "seed": seed, **extra}
+    ok = sr.run_case(args.efdem, args.np, args.bed.scene, folder, name, mode, over, label=f"u{u:g}/{name}")
     if ok:
         sr.archive(folder, name, result(args, u, name))
     return ok
@@ -152,9 +179,10 @@ def score(run, da, db):
 def analyse(args):
     floors = {}
     rows, report = [], ["# Adaptive vs fixed-DT CPI, independent seeds (bench/adaptive_study.py)", "",
-                        f"Demo bed (1,000 spheres), R = {args.realizations}, {DURATION:g} time units, "
-                        "burst 10 + 10, warm-up 10. Error e and noise floor as in the script's docstring.", ""]
-    for u in SPEEDS:
+                        f"{args.bed.label}, R = {args.realizations}, "
+                        + ", ".join(f"{args.bed.duration[u]:g} time units at U_s = {u:g}" for u in args.bed.speeds)
+                        + "; burst 10 + 10, warm-up 10. Error e and noise floor as in the script's docstring.", ""]
+    for u in args.bed.speeds:
         done = lambda name: sr.archived(result(args, u, name))  # noqa: E731
         if not (done("direct_a") and done("direct_b")):
             report.append(f"U_s = {u:g}: the two direct ensembles are not complete yet; nothing to compare.\n")
@@ -180,7 +208,7 @@ def analyse(args):
                    "the other with one binary, on a machine shared with other work: wall ratios carry its load).", "",
                    "| run | error e [d_p] | floor on its samples | e / floor | DEM-time speed-up | wall speed-up | "
                    "jumps kept / rejected / direct bursts | mean DT |", "|---|---|---|---|---|---|---|---|"]
-        for name, mode, _, _ in runs(u):
+        for name, mode, _, _ in runs(u, args.bed):
             if mode != "cpi" or not done(name):
                 continue
             r = load(result(args, u, name))
@@ -209,8 +237,8 @@ def analyse(args):
     with open(os.path.join(args.results, "analysis.json"), "w") as f:
         json.dump({"runs": rows, "noise_floors": floors}, f, indent=1)
     if rows:
-        fig, axes = plt.subplots(1, len(SPEEDS), figsize=(11, 4.2), sharey=True)
-        for ax, u in zip(np.atleast_1d(axes), SPEEDS):
+        fig, axes = plt.subplots(1, len(args.bed.speeds), figsize=(11, 4.2), sharey=True)
+        for ax, u in zip(np.atleast_1d(axes), args.bed.speeds):
             for row in (r for r in rows if r["u"] == u):
                 colour = "C0" if row["run"].startswith("adaptive") else "C3"
                 ax.plot(row["speedup_dem"], row["ratio"], "o", color=colour)
@@ -218,7 +246,7 @@ def analyse(args):
                 ax.annotate(row["run"].replace("adaptive_", ""), (row["speedup_dem"], row["ratio"]), fontsize=8,
                             xytext=(4, 4), textcoords="offset points")
             ax.axhline(1.0, color="k", lw=0.8, ls="--")
-            ax.set_title(f"U_s = {u:g}, R = {args.realizations}")
+            ax.set_title(f"{args.bed.label.split(' (')[0]}, U_s = {u:g}, R = {args.realizations}")
             ax.set_xlabel("speed-up over a direct ensemble [-] (filled: DEM time, open: wall time)")
         np.atleast_1d(axes)[0].set_ylabel("error / empirical noise floor [-]")
         fig.tight_layout()
@@ -231,6 +259,7 @@ def main():
     ap.add_argument("--efdem", default=os.path.join(HERE, "..", "build", "mpi_driver", "efdem"))
     ap.add_argument("--out", help="working folders (default runs/adaptive_study_r<R>)")
     ap.add_argument("--results", help="one result file per run (default bench/results/adaptive_study_r<R>)")
+    ap.add_argument("--bed", choices=sorted(BEDS), default="demo")
     ap.add_argument("--realizations", type=int, default=4)
     ap.add_argument("--only", nargs="*", help="make only these runs (the analysis uses every completed one)")
     ap.add_argument("--np", type=int, default=2)
@@ -238,11 +267,12 @@ def main():
         dt_.datetime.now(dt_.timezone.utc).date(), dt_.time.fromisoformat(s), dt_.timezone.utc))
     ap.add_argument("--analyse-only", action="store_true")
     args = ap.parse_args()
-    args.out = args.out or os.path.join(HERE, "..", "runs", f"adaptive_study_r{args.realizations}")
-    args.results = args.results or os.path.join(HERE, "results", f"adaptive_study_r{args.realizations}")
+    args.bed = BEDS[args.bed]
+    args.out = args.out or os.path.join(HERE, "..", "runs", f"{args.bed.study}_r{args.realizations}")
+    args.results = args.results or os.path.join(HERE, "results", f"{args.bed.study}_r{args.realizations}")
     if not args.analyse_only:
-        for u in SPEEDS:  # U_s = 0.19 (the >= 5x target) first, then 0.41
-            for name, mode, seed, extra in runs(u):
+        for u in args.bed.speeds:  # demo bed: U_s = 0.19 (the >= 5x target) first, then 0.41
+            for name, mode, seed, extra in runs(u, args.bed):
                 if args.only and name not in args.only:
                     continue
                 folder = os.path.join(args.out, f"u{u:g}")
