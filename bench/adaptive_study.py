@@ -5,6 +5,8 @@ bursts of healing 10 + window 10, warm-up 10, at U_s = 0.19 and 0.41, on one of 
   demo   the 1,000-sphere demo bed (15.5 d_p tall), 200 time units at both U_s (default)
   tall   the tall bed of examples/tall_bed (3,120 spheres, the paper's 48 d_p height at a
          quarter of its area), 200 time units at U_s = 0.41, then 400 at U_s = 0.19
+  paper  the paper's bed itself (12,500 spheres, packed by LAMMPS, tests/data), 100 time units at
+         U_s = 0.41: direct_a, direct_b and adaptive_tol0.16 only (--realizations 2)
 
     /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --realizations 8
     /usr/bin/python3 bench/adaptive_study.py --efdem build/mpi_driver/efdem --bed tall --realizations 4
@@ -67,10 +69,10 @@ class Bed:
     run length per U_s, the adaptive tolerances (d_p per jump; the first is run first) and
     whether the demo bed's extra runs (cpi.lift = members, fixed DT = 80) are made."""
 
-    def __init__(self, scene, label, study, speeds, duration, tolerances, extras):
+    def __init__(self, scene, label, study, speeds, duration, tolerances, extras, fixed=True):
         self.scene = os.path.join(HERE, "scenes", scene)
         self.label, self.study, self.speeds = label, study, speeds
-        self.duration, self.tolerances, self.extras = duration, tolerances, extras
+        self.duration, self.tolerances, self.extras, self.fixed = duration, tolerances, extras, fixed
 
 
 BEDS = {
@@ -79,6 +81,10 @@ BEDS = {
     # The paper's height: U_s = 0.41 first (200 units), then 0.19 over 400 (slower dynamics).
     "tall": Bed("tall_bed.cfg", "Tall bed (3,120 spheres, 7.5 x 7.5, 48 d_p packed)", "tall_study",
                 (0.41, 0.19), {0.41: 200.0, 0.19: 400.0}, (0.16, 0.32), False),
+    # The paper's bed itself (LAMMPS-packed, colours permuted per realization): one check at
+    # U_s = 0.41 over 100 time units, direct against adaptive CPI (R = 2 fits 2 cores).
+    "paper": Bed("reference_bed.cfg", "The paper's bed (12,500 spheres, 15 x 15, 48 d_p packed)", "paper_check",
+                 (0.41,), {0.41: 100.0}, (0.16,), False, fixed=False),
 }
 
 
@@ -95,7 +101,8 @@ def runs(u=0.19, bed=BEDS["demo"]):
     tolerances = bed.tolerances
     adaptive = lambda tol: {"cpi.projection": "adaptive", "cpi.tolerance": tol, **ADAPTIVE_BURST[u]}  # noqa: E731
     out.append((f"adaptive_tol{tolerances[0]:g}", "cpi", 404, adaptive(tolerances[0])))
-    out.append(("fixed_dt40", "cpi", 303, {"cpi.projection": "fixed", "cpi.dt": 40}))
+    if bed.fixed:
+        out.append(("fixed_dt40", "cpi", 303, {"cpi.projection": "fixed", "cpi.dt": 40}))
     for tol in tolerances[1:]:
         out.append((f"adaptive_tol{tol:g}", "cpi", 404, adaptive(tol)))
     if bed.extras:
