@@ -11,6 +11,8 @@
 ///                   realization: particle heights and colours), computes each one's lifted
 ///                   state with the Lifter and that realization's `lifting` random stream, and
 ///                   scatters it (MPI_Scatterv); every rank applies it and sets its clock to t.
+///                   With lift_members (cpi.lift = members) the target of realization r is its
+///                   own X_r + (X - mean_r X_r), one more gather of the realizations' ICDFs.
 ///
 /// Only the root runs the macro integrator. The root's run()/lift() first broadcast a command;
 /// the other ranks sit in serve(), which executes the same collectives, until finish().
