@@ -130,24 +130,41 @@ public:
 private:
     std::vector<test::ToyRealization> toys_;
 };
+
+/// The R toy realizations of this rank behind an EnsembleStepper (5 substeps per sample,
+/// the toy's state as a 3-node "ICDF", exact lifting); `lift_members`: cpi.lift = members.
+struct ToyEnsemble {
+    ToyEnsemble(const MpiComm& world, bool lift_members)
+        : layout(world, per_rank(world)), stepper(layout, realizations(layout), settings(lift_members), observable,
+                                                  lifter, nullptr, nullptr) {}
+    static std::vector<std::unique_ptr<Realization>> realizations(const EnsembleLayout& layout) {
+        std::vector<std::unique_ptr<Realization>> local;
+        for (int j = 0; j < layout.per_rank(); ++j) {
+            const long r = layout.first_index() + j;
+            local.push_back(std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH));
+        }
+        return local;
+    }
+    static StepperSettings settings(bool lift_members) {
+        StepperSettings ss;
+        ss.sample_interval = 5 * kH;
+        ss.steps_per_sample = 5;
+        ss.quantiles = 3;
+        ss.lift_members = lift_members;
+        return ss;
+    }
+    EnsembleLayout layout;
+    coarse::IcdfObservable observable{3};
+    test::ToyLifter lifter;
+    EnsembleStepper stepper;
+};
 }  // namespace
 
 TEST_CASE("CPI of a linear toy model through EnsembleStepper equals the serial integrator",
           "[mpi][ensemble][cpi]") {
     const MpiComm world(MPI_COMM_WORLD);
-    const EnsembleLayout layout(world, per_rank(world));
-    std::vector<std::unique_ptr<Realization>> local;
-    for (int j = 0; j < layout.per_rank(); ++j) {
-        const long r = layout.first_index() + j;
-        local.push_back(std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH));
-    }
-    StepperSettings ss;
-    ss.sample_interval = 5 * kH;
-    ss.steps_per_sample = 5;
-    ss.quantiles = 3;
-    coarse::IcdfObservable observable(3);
-    const test::ToyLifter lifter;
-    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, nullptr, nullptr);
+    ToyEnsemble toy(world, false);
+    EnsembleStepper& stepper = toy.stepper;
     coarse::ProjectiveEulerSettings pfe;
     pfe.healing = 0.5;  // 10 fast time constants
     pfe.window = 0.5;
@@ -199,20 +216,8 @@ TEST_CASE("cpi.lift = members moves every realization by the same increment, kee
     // is at X_r + (X* - mean X_r), so the mean is X* and the spread of a direct ensemble stays;
     // the next sample (5 Euler substeps of the toy from there) is reproduced here exactly.
     const MpiComm world(MPI_COMM_WORLD);
-    const EnsembleLayout layout(world, per_rank(world));
-    std::vector<std::unique_ptr<Realization>> local;
-    for (int j = 0; j < layout.per_rank(); ++j) {
-        const long r = layout.first_index() + j;
-        local.push_back(std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH));
-    }
-    StepperSettings ss;
-    ss.sample_interval = 5 * kH;
-    ss.steps_per_sample = 5;
-    ss.quantiles = 3;
-    ss.lift_members = true;
-    coarse::IcdfObservable observable(3);
-    const test::ToyLifter lifter;
-    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, nullptr, nullptr);
+    ToyEnsemble toy(world, true);
+    EnsembleStepper& stepper = toy.stepper;
     if (!world.is_root()) {
         stepper.serve();
         return;
