@@ -230,7 +230,7 @@ def analyse(args):
             st = r.get("status", [])
             kept = sum(1 for s in st if s == "projected")
             rej = sum(1 for s in st if s == "rejected")
-            direct = sum(1 for s in st if s == "burst_only") - 1
+            direct = max(0, sum(1 for s in st if s == "burst_only") - 1)  # less the first burst
             dts = [dt for dt, s in zip(r["dt"], st) if s == "projected"]
             rows.append({"u": u, "run": name, "error": e, "floor": floor, "ratio": e / floor,
                          "ratio_spread": e / floor_spread, "speedup_dem": s_dem,
