@@ -315,6 +315,7 @@ int main(int argc, char** argv) {
     // on collectively, so that all ranks stop together and the root prints one message.
     const bool list_keys = options.action == RunOptions::Action::list_keys;
     const bool check = options.action == RunOptions::Action::check || list_keys;
+    const int ranks = options.ranks > 0 ? options.ranks : mpi.size();  // --ranks=N with --check
     int code = kExitOk;
     std::string message;
     std::optional<ParamTable> table;
@@ -326,7 +327,6 @@ int main(int argc, char** argv) {
         Params root = table->root();
         const dem::DemScene scene = dem::DemScene::from_params(root);
         settings = RunSettings::from_params(root, scene);
-        const int ranks = options.ranks > 0 ? options.ranks : mpi.size();  // --ranks=N with --check
         settings->check_ensemble(root, ranks * settings->realizations_per_rank);
         const int k = check ? 1 : settings->realizations_per_rank;
         // Settling a paper-size bed takes minutes: the root says how its own realizations go
@@ -416,8 +416,7 @@ int main(int argc, char** argv) {
             for (const auto& d : table->declarations())
                 std::printf("%s\t%s\t%s\n", d.key.c_str(), d.expected.c_str(), d.required ? "required" : d.fallback.c_str());
         } else if (mpi.is_root()) {
-            std::printf("%s", check_report(*table, *settings, systems.front(),
-                                           options.ranks > 0 ? options.ranks : mpi.size()).c_str());
+            std::printf("%s", check_report(*table, *settings, systems.front(), ranks).c_str());
         }
         return kExitOk;
     }

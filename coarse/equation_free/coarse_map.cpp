@@ -47,13 +47,12 @@ MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
     double state_noise = 0.0;
     if (!burst.members.empty() && burst.members.back().rows() >= 2) {
         const Eigen::MatrixXd& m = burst.members.back();
-        state_noise = standard_error(m).norm();
+        e.standard_error = standard_error(m);  // in X
+        state_noise = e.standard_error.norm();
         if (coordinates_) {
             Eigen::MatrixXd mu(m.rows(), x.size());
             for (Eigen::Index r = 0; r < m.rows(); ++r) mu.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
-            e.standard_error = standard_error(mu);
-        } else {
-            e.standard_error = standard_error(m);
+            e.standard_error = standard_error(mu);  // in u
         }
     }
     e.noise_norm = e.standard_error.norm();
