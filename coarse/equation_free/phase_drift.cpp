@@ -73,15 +73,23 @@ WaveCoherence wave_coherence(const BurstSamples& b, double t_start) {
     w.measured = true;
     w.ratio = std::sqrt(detrended_square(mean_span) / (members / static_cast<double>(r)));
     w.threshold = 0.5 * (1.0 + std::sqrt(static_cast<double>(r)));
-    w.in_phase = w.ratio > w.threshold;
     PeriodSettings one;
     one.min_periods = 1;
     const PeriodEstimate p = estimate_period(t, mean_span, one);
     if (p.n_periods >= 1) w.period = p.period;
-    w.message = fmt::format("the realizations' waves are {}in phase: the ensemble-mean phase signal fluctuates {:.2f} x "
-                            "as much as independent phases would give (in phase: {:.2f}; threshold {:.2f}){}",
-                            w.in_phase ? "" : "not ", w.ratio, std::sqrt(static_cast<double>(r)), w.threshold,
-                            std::isfinite(w.period) ? fmt::format(", period {:.3g}", w.period) : std::string{});
+    const bool coherent = w.ratio > w.threshold;
+    w.in_phase = coherent && std::isfinite(w.period);
+    const std::string numbers =
+        fmt::format("the ensemble-mean phase signal fluctuates {:.2f} x as much as independent phases would give (in "
+                    "phase: {:.2f}; threshold {:.2f})",
+                    w.ratio, std::sqrt(static_cast<double>(r)), w.threshold);
+    if (coherent && !w.in_phase)
+        w.message = fmt::format("the realizations move together but do not oscillate ({}; no full period of the mean "
+                                "over t = {:.4g}..{:.4g}): a shared relaxation, not a wave",
+                                numbers, t.front(), t.back());
+    else
+        w.message = fmt::format("the realizations' waves are {}in phase: {}{}", w.in_phase ? "" : "not ", numbers,
+                                std::isfinite(w.period) ? fmt::format(", period {:.3g}", w.period) : std::string{});
     return w;
 }
 

@@ -47,14 +47,21 @@ struct WaveCoherence {
     /// ~1 for independent phases, sqrt(R) for members in phase.
     double ratio = std::numeric_limits<double>::quiet_NaN();
     double threshold = std::numeric_limits<double>::quiet_NaN();  ///< (1 + sqrt(R))/2
-    bool in_phase = false;                                          ///< ratio > threshold
     /// Period of the ensemble-mean phase signal (NaN when fewer than two upward crossings).
     double period = std::numeric_limits<double>::quiet_NaN();
+    /// ratio > threshold **and** the ensemble mean oscillates (a period was measured). Members
+    /// that move together without oscillating are no wave: after a lift every realization
+    /// relaxes from the same colour perturbation, and the shared relaxation (one bend, at most
+    /// one upward crossing of its trend line) lifts the ratio above the threshold at U_s = 0.19,
+    /// where there are no waves (measured: 2.17-2.24 > 1.9 at R = 8). That relaxation is the
+    /// healing's business, not a bias of the slope the guard is for.
+    bool in_phase = false;
     std::string message;
 };
 
 /// Wave coherence over the samples of `burst` with t >= t_start (linear trends removed per
 /// member). Not measured without members' phase signals, with < 2 members or < 8 samples.
+/// in_phase needs both a coherent ensemble mean and a measured period (see in_phase).
 WaveCoherence wave_coherence(const BurstSamples& burst, double t_start);
 
 }  // namespace efdem::coarse

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -330,6 +331,28 @@ TEST_CASE("phase_drift and wave_coherence judge the phase signal from the member
     const WaveCoherence out = wave_coherence(burst(spread, 0.0), 0.0);
     CHECK(out.ratio < 1e-6);  // the phases cancel in the mean
     CHECK(!out.in_phase);
+    // After a lift every member relaxes from the same perturbation (0.5 e^{-t/3}) with its own
+    // noise (s.d. 0.01): the mean moves like each member (ratio near sqrt(R) = 2, above the
+    // threshold 1.5), but a relaxation bends once and has no period: no wave, no hold. The
+    // noise of the mean (0.005) is far below the crossing detector's band (0.3 x the detrended
+    // RMS of the relaxation, ~0.03), so it cannot fake a period.
+    BurstSamples relax;
+    std::mt19937_64 gen(7);
+    std::normal_distribution<double> noise(0.0, 0.01);
+    for (int k = 1; k <= 80; ++k) {
+        const double t = 0.25 * k;
+        Eigen::VectorXd m(4);
+        for (int r = 0; r < 4; ++r) m[r] = 0.5 * std::exp(-t / 3.0) + noise(gen);
+        relax.t.push_back(t);
+        relax.member_phase.push_back(m);
+        relax.phase_signal.push_back(m.mean());
+    }
+    const WaveCoherence shared = wave_coherence(relax, 0.0);
+    REQUIRE(shared.measured);
+    CHECK(shared.ratio > shared.threshold);
+    CHECK(!std::isfinite(shared.period));
+    CHECK(!shared.in_phase);
+    CHECK(shared.message.find("not a wave") != std::string::npos);
     // A drift of 0.05 over a window of 10: significant against the members' spread of slopes
     // (the waves, out of phase, make it) and faster than an allowed 0.01; not with 0.1 allowed.
     const PhaseDrift d = phase_drift(burst(spread, 0.05), 10.0, 0.01);
