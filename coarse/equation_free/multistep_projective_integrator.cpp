@@ -100,13 +100,11 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         if (d.drifting) {
             out.hold_kind = "fast transient";
             out.hold = "still in a fast transient (" + d.message + ")";
-        } else if (w.in_phase && !(std::isfinite(w.period) && settings_.window >= 2.0 * w.period * (1.0 - 1e-9))) {
+        } else if (w.in_phase && settings_.window < 2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
             out.hold_kind = "in-phase wave";
             out.hold = fmt::format("{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
-                                    "by the common wave beyond its standard error; use cpi.window >= {}",
-                                    w.message, settings_.window,
-                                    std::isfinite(w.period) ? fmt::format("{:.3g}", 2.0 * w.period)
-                                                            : std::string("two wave periods"));
+                                    "by the common wave beyond its standard error; use cpi.window >= {:.3g}",
+                                    w.message, settings_.window, 2.0 * w.period);
         }
     }
     rec.window = slope.t_last - slope.t_first;

@@ -309,18 +309,22 @@ TEST_CASE("an adaptive run resumed from the saved integrator state continues bit
 }
 
 TEST_CASE("phase_drift and wave_coherence judge the phase signal from the members", "[unit][coarse][multistep]") {
-    // Four members: a wave of period 9 and amplitude 0.1 on a drift of 0.05 per time unit.
-    auto burst = [](const double phases[4], double drift) {
+    // Four members' phase signals member(t, r), sampled every 0.25 over t = 0.25..20.
+    auto samples = [](auto member) {
         BurstSamples b;
         for (int k = 1; k <= 80; ++k) {
             const double t = 0.25 * k;
             Eigen::VectorXd m(4);
-            for (int r = 0; r < 4; ++r) m[r] = drift * t + 0.1 * std::sin(2 * M_PI * t / 9.0 + phases[r]);
+            for (int r = 0; r < 4; ++r) m[r] = member(t, r);
             b.t.push_back(t);
             b.member_phase.push_back(m);
             b.phase_signal.push_back(m.mean());
         }
         return b;
+    };
+    // A wave of period 9 and amplitude 0.1 on a drift of 0.05 per time unit.
+    auto burst = [&](const double phases[4], double drift) {
+        return samples([&](double t, int r) { return drift * t + 0.1 * std::sin(2 * M_PI * t / 9.0 + phases[r]); });
     };
     const double together[4] = {0, 0, 0, 0}, spread[4] = {0, M_PI / 2, M_PI, 3 * M_PI / 2};
     const WaveCoherence in = wave_coherence(burst(together, 0.0), 0.0);
@@ -336,17 +340,9 @@ TEST_CASE("phase_drift and wave_coherence judge the phase signal from the member
     // threshold 1.5), but a relaxation bends once and has no period: no wave, no hold. The
     // noise of the mean (0.005) is far below the crossing detector's band (0.3 x the detrended
     // RMS of the relaxation, ~0.03), so it cannot fake a period.
-    BurstSamples relax;
     std::mt19937_64 gen(7);
     std::normal_distribution<double> noise(0.0, 0.01);
-    for (int k = 1; k <= 80; ++k) {
-        const double t = 0.25 * k;
-        Eigen::VectorXd m(4);
-        for (int r = 0; r < 4; ++r) m[r] = 0.5 * std::exp(-t / 3.0) + noise(gen);
-        relax.t.push_back(t);
-        relax.member_phase.push_back(m);
-        relax.phase_signal.push_back(m.mean());
-    }
+    const BurstSamples relax = samples([&](double t, int) { return 0.5 * std::exp(-t / 3.0) + noise(gen); });
     const WaveCoherence shared = wave_coherence(relax, 0.0);
     REQUIRE(shared.measured);
     CHECK(shared.ratio > shared.threshold);
