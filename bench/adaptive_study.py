@@ -4,7 +4,7 @@ bursts of healing 10 + window 10, warm-up 10, at U_s = 0.19 and 0.41, on one of 
 
   demo   the 1,000-sphere demo bed (15.5 d_p tall), 200 time units at both U_s (default)
   tall   the tall bed of examples/tall_bed (3,120 spheres, the paper's 48 d_p height at a
-         quarter of its area), 200 time units at U_s = 0.41, then 400 at U_s = 0.19
+         quarter of its area), 400 time units at U_s = 0.19 and 200 at U_s = 0.41
   paper  the paper's bed itself (12,500 spheres, packed by LAMMPS, tests/data), 100 time units at
          U_s = 0.41: direct_a, direct_b and adaptive_tol0.16 only (--realizations 2)
 
@@ -18,8 +18,9 @@ per run under --results (default bench/results/<study>_r<R>/u<U_s>/<run>.h5, com
 a later session, or in a fresh clone, and it continues. Most informative first:
 
   direct_a, direct_b   mode=direct, seeds 101, 202: the empirical noise floor is their difference
-  adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values; 2 on
-                       the tall bed); at
+  adaptive_tol<X>      seed 404, cpi.projection = adaptive, cpi.tolerance = X (3 values; on
+                       the tall bed, whose noise floor is 3 x the demo bed's, 0.32 and 0.64 at
+                       U_s = 0.19, 0.16, 0.32 and 0.64 at 0.41); at
                        U_s = 0.41 with healing 2 + window 20 (two wave periods, see ADAPTIVE_BURST)
   fixed_dt40           seed 303, cpi.dt = 40 (the demo bed's best fixed DT, docs/accuracy_vs_cost.md)
   adaptive_tol<X>_members  as adaptive_tol<X> (the first X) with cpi.lift = members (demo bed)
@@ -34,10 +35,10 @@ the wall time of the mean direct run over the CPI run's (same ranks and R; the r
 after the other on a shared machine, so wall ratios carry its load).
 
 --realizations R (default 4: ranks x 2) and --np (default 2).
-Cost on 2 cores (AMD EPYC, 2026-12-02): demo bed R = 8, one direct run of 200 time units ~30-45 min;
-tall bed R = 4 (4 x 3,120 spheres at ~6.5e6 particle-steps/s per core, examples/tall_bed/README.md)
-~10 s per time unit: a direct run ~35 min at U_s = 0.41 (200 units) and ~70 min at 0.19 (400), the
-whole tall study (10 runs) about 6 hours, i.e. two sessions of the resumable command.
+Cost on 2 cores (AMD EPYC, 2026-12-02/03): demo bed R = 8, one direct run of 200 time units
+~20-45 min; tall bed R = 4: a direct run of 200 time units at U_s = 0.41 took 13-15 min
+(1.4-1.6e7 particle-steps/s per core, fluidized; settling included), 400 units at U_s = 0.19 are
+slower per step (a barely fluidized bed).
 --deadline HH:MM (UTC): start no run that, at the direct runs' pace, would end after it.
 --only NAME...: make only these runs (e.g. direct_a direct_b, which do not depend on the controller).
 --analyse-only: no runs. Writes analysis.md, analysis.json and error_vs_speedup.png into --results.
@@ -66,7 +67,7 @@ import study_runs as sr  # noqa: E402
 
 class Bed:
     """One bed of the study: its scene (without a cpi block), U_s in the order they are run, the
-    run length per U_s, the adaptive tolerances (d_p per jump; the first is run first) and
+    run length per U_s, the adaptive tolerances per U_s (d_p per jump; the first is run first) and
     whether the demo bed's extra runs (cpi.lift = members, fixed DT = 80) are made."""
 
     def __init__(self, scene, label, study, speeds, duration, tolerances, extras, fixed=True):
@@ -77,14 +78,19 @@ class Bed:
 
 BEDS = {
     "demo": Bed("demo_bed.cfg", "Demo bed (1,000 spheres, 7.5 x 7.5, 15.5 d_p packed)", "adaptive_study",
-                (0.19, 0.41), {0.19: 200.0, 0.41: 200.0}, (0.16, 0.08, 0.32), True),
-    # The paper's height: U_s = 0.41 first (200 units), then 0.19 over 400 (slower dynamics).
+                (0.19, 0.41), {0.19: 200.0, 0.41: 200.0}, {u: (0.16, 0.08, 0.32) for u in (0.19, 0.41)}, True),
+    # The paper's height: U_s = 0.41 over 200 units (made first), 0.19 over 400 (slower dynamics).
+    # Its noise floor at R = 4 is ~0.4 d_p, three times the demo bed's, so a tolerance in d_p
+    # means a third as much there: at U_s = 0.41, 0.16 allowed no jump (the statistical error of
+    # one DT_min jump was 0.11-0.13 d_p). U_s = 0.19 is therefore run at 0.32 and 0.64, and 0.64
+    # is added at 0.41 (last: the runs made before keep their names and results).
     "tall": Bed("tall_bed.cfg", "Tall bed (3,120 spheres, 7.5 x 7.5, 48 d_p packed)", "tall_study",
-                (0.41, 0.19), {0.41: 200.0, 0.19: 400.0}, (0.16, 0.32), False),
+                (0.19, 0.41), {0.41: 200.0, 0.19: 400.0}, {0.41: (0.16, 0.32, 0.64), 0.19: (0.32, 0.64)},
+                False),
     # The paper's bed itself (LAMMPS-packed, colours permuted per realization): one check at
     # U_s = 0.41 over 100 time units, direct against adaptive CPI (R = 2 fits 2 cores).
     "paper": Bed("reference_bed.cfg", "The paper's bed (12,500 spheres, 15 x 15, 48 d_p packed)", "paper_check",
-                 (0.41,), {0.41: 100.0}, (0.16,), False, fixed=False),
+                 (0.41,), {0.41: 100.0}, {0.41: (0.16,)}, False, fixed=False),
 }
 
 
@@ -98,7 +104,7 @@ ADAPTIVE_BURST = {0.19: {}, 0.41: {"cpi.healing": 2, "cpi.window": 20}}
 def runs(u=0.19, bed=BEDS["demo"]):
     """(name, mode, seed, overrides) in the order they are made, at U_s = u."""
     out = [("direct_a", "direct", 101, {}), ("direct_b", "direct", 202, {})]
-    tolerances = bed.tolerances
+    tolerances = bed.tolerances[u]
     adaptive = lambda tol: {"cpi.projection": "adaptive", "cpi.tolerance": tol, **ADAPTIVE_BURST[u]}  # noqa: E731
     out.append((f"adaptive_tol{tolerances[0]:g}", "cpi", 404, adaptive(tolerances[0])))
     if bed.fixed:
@@ -138,6 +144,10 @@ def direct_pace(args, u):
 def run_one(args, folder, u, name, mode, seed, extra):
     if sr.archived(result(args, u, name)):
         print(f"  u{u:g}/{name}: done before, skipped", flush=True)
+        return True
+    if sr.completed(folder, name):  # the study was stopped after this run ended, before archiving
+        sr.archive(folder, name, result(args, u, name))
+        print(f"  u{u:g}/{name}: completed in {folder}, archived", flush=True)
         return True
     if args.deadline:
         pace = direct_pace(args, u) or 4.0 * args.realizations / 4
