@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 #include <utility>
 
@@ -17,19 +18,33 @@ namespace efdem::coarse {
 
 namespace {
 
-/// The slope node of a burst's samples in [t_a, t_b): the ensemble's least-squares slope and its
-/// members' standard error. False when the window holds too few samples or no members.
-bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
-    const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
-    const auto n = static_cast<std::size_t>(
-        std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) - b.t.begin());  // samples before t_b
-    if (b.members.size() != b.t.size()) return false;
+/// The ensemble's least-squares slope over a burst's samples in [t_a, t_b) and its members'
+/// standard error (empty when the burst has no members or the slope failed).
+struct WindowFit {
+    SlopeEstimate slope;
+    Eigen::VectorXd se;
+};
+
+WindowFit fit_window(const BurstSamples& b, double t_a, double t_b = std::numeric_limits<double>::infinity()) {
+    std::size_t n = b.t.size();
+    if (std::isfinite(t_b)) {
+        const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
+        n = static_cast<std::size_t>(std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) - b.t.begin());
+    }
     const std::span<const double> t(b.t.data(), n);
-    const SlopeEstimate slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
-    if (!slope.ok) return false;
-    Eigen::VectorXd se = member_slope_standard_error(t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
-    if (se.size() != slope.slope.size()) return false;
-    out = SlopeNode{slope.t_mean, slope.slope, std::move(se)};
+    WindowFit f;
+    f.slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
+    if (f.slope.ok && b.members.size() == b.t.size())
+        f.se = member_slope_standard_error(t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
+    return f;
+}
+
+/// The slope node of a burst's samples in [t_a, t_b). False when the window holds too few
+/// samples or no members.
+bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
+    WindowFit f = fit_window(b, t_a, t_b);
+    if (!f.slope.ok || f.se.size() != f.slope.slope.size()) return false;
+    out = SlopeNode{f.slope.t_mean, std::move(f.slope.slope), std::move(f.se)};
     return true;
 }
 
@@ -73,14 +88,15 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     rec.x_end = std::move(origin_x);
     if (!valid) return false;
     const double t_window = t_start + length - settings_.window;  // the last `window` of the burst
-    const SlopeEstimate slope = least_squares_slope(rec.burst.t, rec.burst.x, t_window);
+    WindowFit fit = fit_window(rec.burst, t_window);
+    const SlopeEstimate& slope = fit.slope;
     if (!slope.ok) {
         rec.status = StepStatus::invalid_burst;
         append_message(rec, slope.message);
         return false;
     }
     out.node.slope = slope.slope;
-    out.node.se = member_slope_standard_error(rec.burst.t, rec.burst.members, t_window);
+    out.node.se = std::move(fit.se);
     if (out.node.se.size() != slope.slope.size()) {
         if (settings_.adaptive) {
             rec.status = StepStatus::invalid_burst;
