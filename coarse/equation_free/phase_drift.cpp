@@ -76,7 +76,9 @@ WaveCoherence wave_coherence(const BurstSamples& b, double t_start) {
     PeriodSettings one;
     one.min_periods = 1;
     const PeriodEstimate p = estimate_period(t, mean_span, one);
-    if (p.n_periods >= 1) w.period = p.period;
+    // A period is evidence of a wave only when two of it fit in the samples (see
+    // WaveCoherence::period); a longer one was seen once.
+    if (p.n_periods >= 1 && 2.0 * p.period <= (t.back() - t.front()) * (1.0 + 1e-9)) w.period = p.period;
     const bool coherent = w.ratio > w.threshold;
     w.in_phase = coherent && std::isfinite(w.period);
     const std::string numbers =
@@ -84,7 +86,7 @@ WaveCoherence wave_coherence(const BurstSamples& b, double t_start) {
                     "phase: {:.2f}; threshold {:.2f})",
                     w.ratio, std::sqrt(static_cast<double>(r)), w.threshold);
     if (coherent && !w.in_phase)
-        w.message = fmt::format("the realizations move together but do not oscillate ({}; no full period of the mean "
+        w.message = fmt::format("the realizations move together but do not oscillate ({}; no period of the mean that fits twice "
                                 "over t = {:.4g}..{:.4g}): a shared relaxation, not a wave",
                                 numbers, t.front(), t.back());
     else

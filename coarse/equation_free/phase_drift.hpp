@@ -47,7 +47,11 @@ struct WaveCoherence {
     /// ~1 for independent phases, sqrt(R) for members in phase.
     double ratio = std::numeric_limits<double>::quiet_NaN();
     double threshold = std::numeric_limits<double>::quiet_NaN();  ///< (1 + sqrt(R))/2
-    /// Period of the ensemble-mean phase signal (NaN when fewer than two upward crossings).
+    /// Period of the ensemble-mean phase signal: NaN when no full period is seen or when two
+    /// of it do not fit in the samples (then it was seen once, which is no evidence of a wave:
+    /// at U_s = 0.19 on the tall bed, which has no waves, a slow common swing of the mean gave
+    /// one "period" of 15.6 in a 20-unit burst, ratio 1.70 > 1.5 at R = 4, and held a jump).
+    /// The waves the guard is for (T ~ 9 at U_s = 0.41) fit twice in bursts of 20-22.
     double period = std::numeric_limits<double>::quiet_NaN();
     /// ratio > threshold **and** the ensemble mean oscillates (a period was measured). Members
     /// that move together without oscillating are no wave: after a lift every realization

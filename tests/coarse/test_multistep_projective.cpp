@@ -15,6 +15,7 @@
 
 #include "coarse/equation_free/multistep_projection.hpp"
 #include "coarse/equation_free/multistep_projective_integrator.hpp"
+#include "coarse/equation_free/period_estimator.hpp"
 #include "coarse/equation_free/phase_drift.hpp"
 #include "coarse/equation_free/projective_stability.hpp"
 #include "coarse/equation_free/step_size_controller.hpp"
@@ -349,6 +350,21 @@ TEST_CASE("phase_drift and wave_coherence judge the phase signal from the member
     CHECK(!std::isfinite(shared.period));
     CHECK(!shared.in_phase);
     CHECK(shared.message.find("not a wave") != std::string::npos);
+    // A common swing of period 15 seen over 20 time units: one cycle, two of it do not fit, so
+    // it is no evidence of a wave (the tall bed at U_s = 0.19 held a jump on such a swing).
+    const double slow_period = 15.0;
+    const BurstSamples swing =
+        samples([&](double t, int) { return 0.1 * std::sin(2 * M_PI * (t - 2.0) / slow_period) + noise(gen); });
+    PeriodSettings one;
+    one.min_periods = 1;
+    const PeriodEstimate seen = estimate_period(swing.t, swing.phase_signal, one);
+    REQUIRE(seen.n_periods == 1);  // the detector sees the one cycle (upward crossings near 2 and 17) ...
+    CHECK(seen.period == Approx(slow_period).epsilon(0.1));
+    const WaveCoherence once = wave_coherence(swing, 0.0);  // ... which the guard does not count
+    REQUIRE(once.measured);
+    CHECK(once.ratio > once.threshold);
+    CHECK(!std::isfinite(once.period));
+    CHECK(!once.in_phase);
     // A drift of 0.05 over a window of 10: significant against the members' spread of slopes
     // (the waves, out of phase, make it) and faster than an allowed 0.01; not with 0.1 allowed.
     const PhaseDrift d = phase_drift(burst(spread, 0.05), 10.0, 0.01);
