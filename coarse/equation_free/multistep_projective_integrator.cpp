@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <span>
 #include <utility>
 
@@ -18,19 +17,14 @@ namespace efdem::coarse {
 
 namespace {
 
-/// The ensemble's least-squares slope over a burst's samples in [t_a, t_b) and its members'
-/// standard error (empty when the burst has no members or the slope failed).
+/// The ensemble's least-squares slope over the first n samples of a burst from t_a on, and its
+/// members' standard error (empty when the burst has no members or the slope failed).
 struct WindowFit {
     SlopeEstimate slope;
     Eigen::VectorXd se;
 };
 
-WindowFit fit_window(const BurstSamples& b, double t_a, double t_b = std::numeric_limits<double>::infinity()) {
-    std::size_t n = b.t.size();
-    if (std::isfinite(t_b)) {
-        const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
-        n = static_cast<std::size_t>(std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) - b.t.begin());
-    }
+WindowFit fit_window(const BurstSamples& b, double t_a, std::size_t n) {
     const std::span<const double> t(b.t.data(), n);
     WindowFit f;
     f.slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
@@ -42,7 +36,10 @@ WindowFit fit_window(const BurstSamples& b, double t_a, double t_b = std::numeri
 /// The slope node of a burst's samples in [t_a, t_b). False when the window holds too few
 /// samples or no members.
 bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
-    WindowFit f = fit_window(b, t_a, t_b);
+    const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
+    const auto n = static_cast<std::size_t>(
+        std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) - b.t.begin());  // samples before t_b
+    WindowFit f = fit_window(b, t_a, n);
     if (!f.slope.ok || f.se.size() != f.slope.slope.size()) return false;
     out = SlopeNode{f.slope.t_mean, std::move(f.slope.slope), std::move(f.se)};
     return true;
@@ -88,7 +85,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     rec.x_end = std::move(origin_x);
     if (!valid) return false;
     const double t_window = t_start + length - settings_.window;  // the last `window` of the burst
-    WindowFit fit = fit_window(rec.burst, t_window);
+    WindowFit fit = fit_window(rec.burst, t_window, rec.burst.t.size());
     const SlopeEstimate& slope = fit.slope;
     if (!slope.ok) {
         rec.status = StepStatus::invalid_burst;

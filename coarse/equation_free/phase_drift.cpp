@@ -86,8 +86,8 @@ WaveCoherence wave_coherence(const BurstSamples& b, double t_start) {
                     "phase: {:.2f}; threshold {:.2f})",
                     w.ratio, std::sqrt(static_cast<double>(r)), w.threshold);
     if (coherent && !w.in_phase)
-        w.message = fmt::format("the realizations move together but do not oscillate ({}; no period of the mean that fits twice "
-                                "over t = {:.4g}..{:.4g}): a shared relaxation, not a wave",
+        w.message = fmt::format("the realizations move together but show no wave ({}; no period of the mean that fits "
+                                "twice in t = {:.4g}..{:.4g}): a shared relaxation or a single swing, not a wave",
                                 numbers, t.front(), t.back());
     else
         w.message = fmt::format("the realizations' waves are {}in phase: {}{}", w.in_phase ? "" : "not ", numbers,
