@@ -218,10 +218,12 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         c.limited_by = "end of run";
     }
     // Never a jump the measured transient would be amplified by: shorten until stable.
+    // The record keeps the assessment of the DT taken (or of the last one refused).
     CpiCycle cycle{SlopeEstimator::least_squares, burst, settings_.window, dt, static_cast<int>(model.nodes.size())};
     for (int i = 0; i < 20 && dt > 0.0; ++i) {
         cycle.dt = dt;
         const StabilityAssessment a = assess_stability(decay_, cycle);
+        rec.stability = a;
         if (a.stable) break;
         dt = dt * 0.5 >= s.dt_min ? dt * 0.5 : 0.0;
         c.limited_by = "stability";

@@ -423,3 +423,30 @@ TEST_CASE("with healing >= window the first burst's two windows give the first j
     CHECK(jump.dt == Approx(7.0));
     CHECK(jump.controller.limited_by == "first jump (no curvature measured yet)");
 }
+
+TEST_CASE("an adaptive jump limited by stability records the monitor's decay rate and amplification",
+          "[unit][coarse][multistep]") {
+    // One fast mode (k = 0.1 in every component, no noise): the monitor measures lambda = -0.1
+    // from the window's halves (exact for an exponential sampled evenly). With a tolerance that
+    // never binds, DT starts at dt_max = 200 and is halved until the forward Euler cycle
+    // e^(lambda 8) (1 + lambda DT) is at most 1 in modulus, i.e. DT <= 32.3: 200 -> 100 -> 50 -> 25.
+    // The record must carry that assessment (it was NaN for adaptive runs before).
+    const Eigen::VectorXd k = Eigen::VectorXd::Constant(19, 0.1);
+    test::OuEnsembleStepper toy(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(19, 3.0), 3);
+    MultistepSettings s;
+    s.healing = 4.0;
+    s.window = 4.0;
+    s.steps = 1;
+    s.control = {.tolerance = 1e3, .dt_min = 0.5, .dt_max = 200.0};
+    MultistepProjectiveIntegrator integrator(s);
+    integrator.set_end_time(1000.0);
+    REQUIRE(integrator.step(toy).status == StepStatus::burst_only);
+    const ProjectiveStepRecord jump = integrator.step(toy);
+    INFO(jump.message << " DT " << jump.dt << ", limited by " << jump.controller.limited_by);
+    CHECK(jump.controller.limited_by == "stability");
+    CHECK(jump.dt == Approx(25.0));
+    REQUIRE(jump.stability.assessed);
+    CHECK(jump.stability.stable);
+    CHECK(jump.stability.rate == Approx(-0.1).epsilon(0.01));
+    CHECK(std::abs(jump.stability.amplification) <= 1.0);
+}
