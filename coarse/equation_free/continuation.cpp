@@ -80,6 +80,24 @@ Eigen::VectorXd PseudoArclengthContinuation::first_tangent(const Eigen::VectorXd
     return (direction >= 0 ? 1.0 : -1.0) * t.normalized();
 }
 
+std::pair<double, bool> PseudoArclengthContinuation::predictor_step(double ds, double lambda,
+                                                                     double t_lambda) const {
+    const double speed = std::abs(t_lambda);
+    if (settings_.max_parameter_step > 0.0 && ds * speed > settings_.max_parameter_step)
+        ds = settings_.max_parameter_step / speed;
+    if (t_lambda == 0.0) return {ds, false};
+    const double bound = t_lambda > 0.0 ? settings_.parameter_max : settings_.parameter_min;
+    const double to_bound = (bound - lambda) / t_lambda;  // arclength to the end it heads for
+    if (to_bound <= ds) return {std::max(to_bound, 0.0), true};
+    return {ds, false};
+}
+
+std::string PseudoArclengthContinuation::reached_end(double lambda) const {
+    const double k = settings_.display_scale;
+    return fmt::format("reached the end of the parameter range [{:.6g}, {:.6g}] at {:.6g}",
+                       settings_.parameter_min * k, settings_.parameter_max * k, lambda * k);
+}
+
 Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda0, double direction) {
     const long evaluations0 = map_.evaluations();
     const double micro0 = map_.micro_time();
@@ -107,15 +125,22 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
         branch.end_reason = fmt::format("{} points (the limit)", settings_.max_points);
         while (static_cast<int>(branch.points.size()) < settings_.max_points) {
             before = map_.micro_time();
-            const Eigen::VectorXd predicted = y + ds * t;
-            ArclengthSystem system(map_, t, predicted);
+            const auto [step, lands] = predictor_step(ds, y[n], t[n]);
+            if (step < settings_.min_step) {  // on the end of the range, heading out of it
+                branch.end_reason = reached_end(y[n]);
+                break;
+            }
+            const Eigen::VectorXd predicted = y + step * t;
+            // The last point is solved at the end of the range itself: its constraint row is
+            // lambda = end instead of the arclength (regular unless a fold sits exactly there).
+            ArclengthSystem system(map_, lands ? Eigen::VectorXd(Eigen::VectorXd::Unit(n + 1, n)) : t, predicted);
             rec = newton_.solve(system, predicted);
             if (rec.reason == SteadyStopReason::stopped) {
                 branch.end_reason = fmt::format("stopped after parameter = {:.6g}: {}", y[n] * settings_.display_scale, rec.message);
                 break;
             }
             if (!rec.converged()) {
-                ds *= 0.5;
+                ds = step * 0.5;
                 if (ds < settings_.min_step) {
                     branch.end_reason = fmt::format("the step fell below {:.3g} after parameter = {:.6g}: {}",
                                                     settings_.min_step, y[n] * settings_.display_scale, rec.message);
@@ -125,7 +150,7 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             }
             t = (rec.x - y).normalized();
             y = rec.x;
-            branch.points.push_back(make_point(rec, n, ds, before));
+            branch.points.push_back(make_point(rec, n, step, before));
             if (settings_.on_point) settings_.on_point(branch);
             if (y[n] < settings_.parameter_min || y[n] > settings_.parameter_max) {
                 const double k = settings_.display_scale;
@@ -133,9 +158,13 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
                                                 settings_.parameter_min * k, settings_.parameter_max * k, y[n] * k);
                 break;
             }
+            if (lands) {
+                branch.end_reason = reached_end(y[n]);
+                break;
+            }
             const double factor = std::clamp(static_cast<double>(settings_.target_iterations) /
                                                  std::max(1, rec.iterations), 0.5, 2.0);
-            ds = std::clamp(ds * factor, settings_.min_step, settings_.max_step);
+            ds = std::clamp(step * factor, settings_.min_step, settings_.max_step);
         }
     }
     branch.micro_time = map_.micro_time() - micro0;

@@ -16,6 +16,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -38,8 +39,13 @@ struct ContinuationSettings {
     double parameter_step = 0.0;
     double min_step = 1e-4;
     double max_step = 1.0;
+    /// > 0: no predictor moves lambda by more than this (ds <= max_parameter_step / |t_lambda|).
+    /// A noisy corrector stops at the noise level in one or two Newton steps, which the
+    /// iteration-count rule would read as an easy branch and double ds every point.
+    double max_parameter_step = 0.0;
     int max_points = 50;  ///< branch points, the first included
-    /// The continuation stops after the first point outside [parameter_min, parameter_max].
+    /// The continuation stops after the first point outside [parameter_min, parameter_max]. A
+    /// predictor heading out of the range is shortened to land on its end (the last point).
     double parameter_min = -1e300;
     double parameter_max = 1e300;
     int target_iterations = 3;  ///< Newton steps per corrector the step size aims at
@@ -92,6 +98,10 @@ class PseudoArclengthContinuation {
     BranchPoint make_point(const SteadySolveRecord& rec, Eigen::Index n, double step, double micro_before);
     /// The unit tangent at (x, lambda) from F_X z = -F_lambda.
     Eigen::VectorXd first_tangent(const Eigen::VectorXd& x, double lambda, double direction);
+    /// The predictor's arclength step from the planned ds: at most max_parameter_step in lambda,
+    /// and shortened to land on the end of the range it heads for (then `true`).
+    std::pair<double, bool> predictor_step(double ds, double lambda, double t_lambda) const;
+    std::string reached_end(double lambda) const;
 
     CoarseMap& map_;
     ContinuationSettings settings_;

@@ -79,7 +79,7 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     s.spectrum.tolerance = 1e-3;
 
     if (!continuation) {
-        for (const char* key : {"parameter", "end", "step", "scale", "max_points"})
+        for (const char* key : {"parameter", "end", "step", "max_step", "scale", "max_points"})
             if (cont.contains(key))
                 cont.fail(key, "is read only with mode = continuation", "remove it, or set mode = continuation");
         return s;
@@ -96,6 +96,9 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     if (step > range)
         cont.fail("step", fmt::format("is larger than the range |continuation.end - start| = {:g}", range),
                   fmt::format("(0, {:g}]", range));
+    // Noisy correctors stop at the noise level within a step or two, which the iteration-count
+    // rule reads as an easy branch: by default the parameter moves by at most `step` a point.
+    const double max_step = cont.get_or<double>("max_step", step, Bounds::open_closed(0.0, 1e3));
     s.branch.max_points = cont.get_or<int>("max_points", 12, Bounds::closed(1, 10000));
     // In the scaled parameter lambda = value / scale (the arclength's units: d_p-equivalents).
     ContinuationSettings& b = s.branch;
@@ -104,6 +107,7 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     b.step = b.parameter_step;
     b.max_step = 4.0 * b.parameter_step * std::sqrt(static_cast<double>(dim) + 1.0);
     b.min_step = b.parameter_step / 16.0;
+    b.max_parameter_step = max_step / s.parameter_scale;
     b.step = std::clamp(b.step, b.min_step, b.max_step);
     b.parameter_min = std::min(s.parameter_start, s.parameter_end) / s.parameter_scale;
     b.parameter_max = std::max(s.parameter_start, s.parameter_end) / s.parameter_scale;

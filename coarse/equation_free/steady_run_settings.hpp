@@ -26,6 +26,7 @@
 /// | continuation.parameter    | the scene key continued in                                  | required |
 /// | continuation.end          | the other end of the parameter range (start: the scene's)  | required |
 /// | continuation.step         | parameter change of the first predictor                     | range/4  |
+/// | continuation.max_step     | most parameter change of any predictor                      | step     |
 /// | continuation.scale        | parameter change that weighs as 1 unit of the coarse vector | 0.01     |
 /// |                           | in the arclength                                            |          |
 /// | continuation.max_points   | branch points, the first included                           | 12       |

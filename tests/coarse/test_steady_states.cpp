@@ -198,7 +198,10 @@ TEST_CASE("pseudo-arclength continuation turns round a fold, where the leading e
     const Branch b = PseudoArclengthContinuation(map, cs).run(Eigen::Vector2d(-1.05, -0.95), -0.7, +1.0);
     INFO(b.end_reason);
     REQUIRE(b.points.size() >= 8);
-    CHECK(b.end_reason.find("left the parameter range") != std::string::npos);
+    // Back on the stable side, the predictor heading below -0.7 is shortened to land there,
+    // and the last corrector holds lambda = -0.7 (to its tolerance 1e-9).
+    CHECK(b.end_reason.find("reached the end of the parameter range") != std::string::npos);
+    CHECK(b.points.back().parameter == Approx(-0.7).margin(1e-8));
     // Every point is a steady state: lambda = -x^2 - 0.3 x and y = x. The corrector stops at
     // |G| <= 1e-9 and the extended Jacobian stays regular through the fold (that is what the
     // arclength row is for), so a condition number up to ~100 leaves errors below 1e-7.
