@@ -39,6 +39,8 @@ def main():
             # A run still going (or cut short) has no /steady/best yet: its best iterate so far.
             x = s["best"][:] if "best" in s else it["x"][int(np.argmin(it["residual"][:]))]
             noise = it["noise"][int(np.argmin(it["residual"][:]))]
+            residual = float(np.min(it["residual"][:]))
+            tau = float(s.attrs["tau"])
             status = run_files.text(s.attrs.get("end_status", "running"))
             newton_dem = float(n.attrs.get("dem_time", 0.0))
             eig = [(s["eigenvalue_real"][k], s["eigenvalue_rate"][k], s["eigenvalue_residual"][k])
@@ -75,6 +77,16 @@ def main():
               f"[{t[fit].min():.0f}, {t[fit].max():.0f}] (mean height within {dist[fit].min():.2f}..{dist[fit].max():.2f} d_p)")
     for re, rate, res in eig:
         print(f"eigenvalue mu = {re:.4f}, rate {rate:.4f} per time unit (residual {res:.2g})")
+    # The answer's own band: a solve that stops at |F| <= 2 |SE| leaves x off the steady state by
+    # |x - x*| <= |J_F^-1| (|F| + |e|) ~ (|F| + |SE|) / (1 - mu) along the slowest mode (docs/
+    # steady_states.md), mu = e^(rate tau) from the direct ensemble's approach rate: the SE of Phi
+    # alone ('Newton noise' above) is the band of Phi(x), not of x.
+    if fit.sum() >= 10:
+        mu = float(np.exp(slope * tau))
+        band_x = (residual + noise) / (1.0 - mu) / np.sqrt(n_nodes)
+        together = np.sqrt(band_x ** 2 + np.mean(se_direct ** 2))
+        print(f"answer's band (|F| + |SE|)/(1 - mu)/sqrt(n) = ({residual:.3f} + {noise:.3f})/(1 - {mu:.2f})/sqrt({n_nodes}) "
+              f"= {band_x:.3f} d_p per node; with the direct s.e. {together:.3f}: ratio {rms / together:.2f}")
     if a.output:
         import matplotlib
 

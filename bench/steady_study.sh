@@ -1,26 +1,30 @@
 #!/usr/bin/env bash
-# Issue 18's DEM check on the demo bed (1,000 spheres, U_s = 0.41, R = 4 on 2 ranks):
+# Issue 18's DEM check on the demo bed (1,000 spheres, U_s = 0.41, R = 4 on 2 ranks), most
+# informative first:
+#   newton.h5  mode = steady (Newton-GMRES, CRN derivatives) from a 60-unit warm-up, tau = 20,
+#              difference step h = 2 d_p: what CRN leaves of the noise after tau = 20 of chaotic
+#              paths is up to sqrt(2) x the noise of Phi (|SE| ~ 0.35 d_p on this bed), so J v
+#              carries an error of ~0.5/h; h = 0.5 (2026-12-02, results in
+#              bench/results/steady_study_2026-12-02.txt) made it as large as J_F v itself
+#              (|J_F v| >= 1 - mu ~ 0.6), h = 2 makes it ~0.25 of it;
 #   direct.h5  a direct ensemble with its own seeds over 300 time units, whose time average
 #              after complete demixing is the reference steady ICDF;
-#   newton.h5  mode = steady (Newton-GMRES, CRN derivatives) from a 60-unit warm-up;
-#   newton_gaps.h5  the same in gap coordinates (steady.coordinates = gaps), at most 500 of DEM time;
+#   branch.h5  mode = continuation in U_s from 0.6 down to 0.2 (steps of 0.1, tau = 10, h = 2:
+#              from the vigorously fluidized end, where the slow mode decays fastest), with
+#              the leading eigenvalue at every point (recorded point by point: a run cut short
+#              keeps the points it reached);
 #   anderson.h5  steady.solver = anderson (no derivatives: Anderson-accelerated fixed point on
-#              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 400 of
-#              DEM time: the robust option against which Newton is compared;
-#   newton_gaps_h1_tau10.h5  gap coordinates with a larger difference step (1 in log gap) and a
-#              shorter tau (10: less divergence of the CRN paths), the next try for resolvable
-#              derivatives;
-#   branch.h5  mode = continuation in U_s from 0.2 to 0.6 (steps of 0.1, tau = 10), with the
-#              leading eigenvalue at every point (recorded point by point: a run cut short
-#              keeps the points it reached).
+#              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 200 of
+#              DEM time: the cheap option against which Newton is compared.
 # Resumable: a run whose run file says it ended is skipped; every ended run file is also copied
 # to bench/results/steady_study/ (committed), and a run whose copy is there is not made again (a
 # fresh clone continues). Compare with
 #   /usr/bin/python3 bench/steady_compare.py bench/results/steady_study [--run anderson]
-#   bash bench/steady_study.sh [OUT_DIR]      (default runs/steady_study; needs build/)
+#   bash bench/steady_study.sh [OUT_DIR [RUN...]]   (default runs/steady_study, every run; needs build/)
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 out=${1:-$src/runs/steady_study}
+only=" ${*:2} "
 efdem=${EFDEM:-$src/build/mpi_driver/efdem}
 scene=$src/examples/demo_small/scene.cfg
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -32,6 +36,7 @@ ended() {  # FILE: the run file exists and is not 'running'
 }
 run() {  # NAME overrides...
   local name=$1; shift
+  if [ "$only" != "  " ] && [[ "$only" != *" $name "* ]]; then return; fi
   if ended "$kept/$name.h5"; then echo "skip $name (kept in bench/results/steady_study)"; return; fi
   if ! ended "$out/$name.h5"; then
     echo "run $name: $*"
@@ -40,17 +45,12 @@ run() {  # NAME overrides...
   fi
   if ended "$out/$name.h5"; then cp "$out/$name.h5" "$kept/$name.h5.part" && mv "$kept/$name.h5.part" "$kept/$name.h5"; fi
 }
+run newton mode=steady seed=1 run.duration=0 steady.warmup=60 steady.tau=20 steady.difference_step=2 \
+  steady.max_krylov=4 steady.max_iterations=4 steady.eigenvalues=2 steady.eigenvalue_products=4
 run direct mode=direct seed=101 run.duration=300
-run newton mode=steady seed=1 run.duration=0 steady.warmup=60 steady.tau=20 steady.max_krylov=6 \
-  steady.max_iterations=4 steady.eigenvalues=2 steady.eigenvalue_products=6
-run newton_gaps mode=steady seed=1 run.duration=500 steady.coordinates=gaps steady.warmup=60 steady.tau=20 \
-  steady.max_krylov=6 steady.max_iterations=3 steady.eigenvalues=2 steady.eigenvalue_products=4
-run anderson mode=steady seed=1 run.duration=400 steady.solver=anderson steady.warmup=60 steady.tau=20 \
-  steady.max_iterations=16 steady.eigenvalues=0
-run newton_gaps_h1_tau10 mode=steady seed=1 run.duration=400 steady.coordinates=gaps steady.difference_step=1 \
-  steady.warmup=60 steady.tau=10 steady.max_krylov=6 steady.max_iterations=3 steady.eigenvalues=2 \
-  steady.eigenvalue_products=4
-run branch mode=continuation seed=7 run.duration=0 gas_drag.superficial_velocity=0.2 \
-  continuation.parameter=gas_drag.superficial_velocity continuation.end=0.6 continuation.step=0.1 \
-  continuation.max_points=6 steady.warmup=40 steady.tau=10 steady.max_krylov=4 steady.max_iterations=3 \
-  steady.eigenvalues=1 steady.eigenvalue_products=3
+run branch mode=continuation seed=7 run.duration=0 gas_drag.superficial_velocity=0.6 \
+  continuation.parameter=gas_drag.superficial_velocity continuation.end=0.2 continuation.step=0.1 \
+  continuation.max_points=6 steady.warmup=40 steady.tau=10 steady.difference_step=2 steady.max_krylov=4 \
+  steady.max_iterations=3 steady.eigenvalues=1 steady.eigenvalue_products=3
+run anderson mode=steady seed=1 run.duration=200 steady.solver=anderson steady.warmup=60 steady.tau=20 \
+  steady.max_iterations=10 steady.eigenvalues=0
