@@ -150,6 +150,11 @@ double MultistepProjectiveIntegrator::prior_curvature() const {
     return slope_divided_difference(nodes).norm;
 }
 
+double MultistepProjectiveIntegrator::direct_burst_length(const CoarseStepper& stepper) const {
+    const double burst = settings_.healing + settings_.window, left = end_time() - stepper.time();
+    return left < 2.0 * burst - time_tolerance(end_time()) ? left : burst;
+}
+
 double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     const double burst = settings_.healing + settings_.window;
     ControllerRecord& c = rec.controller;
@@ -245,7 +250,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     Measured m;
     if (history_.empty()) {  // the first slope: one burst, no jump
-        if (!measure_burst(stepper, rec, m)) return rec;
+        if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
         // No lift before it: with healing >= window its start is a second window, whose slope
         // gives the first jump a curvature (for the error model only).
         const double w = settings_.window;
@@ -285,10 +290,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     rec.dt = rec.dt_requested;
     if (rec.dt == 0.0) {  // one burst of direct simulation from where we are
         if (c.limited_by == "tolerance below dt_min") ++totals_.direct;
-        // Near the end, a burst that would leave less than one burst runs on to the end.
-        const double burst = settings_.healing + settings_.window, left = end_time() - stepper.time();
-        const double length = left < 2.0 * burst - time_tolerance(end_time()) ? left : burst;
-        if (!measure_burst(stepper, rec, m, length)) return rec;
+        if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
         accept_burst(m);
         rec.status = StepStatus::burst_only;
         rec.x_projected = rec.x_end;

@@ -124,6 +124,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out, double length = 0.0) const;
+    /// The length of a burst of direct simulation starting now: one burst, or the rest of the
+    /// run when one burst would leave less than one more (the run then ends at its end time).
+    double direct_burst_length(const CoarseStepper& stepper) const;
     void accept_burst(const Measured& m);
     /// The method's nodes (q_eff of them) and the error model of the next jump.
     std::vector<SlopeNode> method_nodes() const;

@@ -450,3 +450,21 @@ TEST_CASE("an adaptive jump limited by stability records the monitor's decay rat
     CHECK(jump.stability.rate == Approx(-0.1).epsilon(0.01));
     CHECK(std::abs(jump.stability.amplification) <= 1.0);
 }
+
+TEST_CASE("a first burst that would leave less than one burst runs on to the end of the run",
+          "[unit][coarse][multistep]") {
+    // The paper's bed at U_s = 0.41 over 100 time units: the warm-up waited 62 units for the
+    // expansion, the first burst (22) ended at 84 and the run stopped there, 16 short of its
+    // end. Bursts of 4 + 4 from t = 0 with the end at 14: the first burst runs to 14.
+    test::OuEnsembleStepper toy(rates19(), 0.0, 2, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
+    MultistepSettings s;
+    s.healing = 4.0;
+    s.window = 4.0;
+    s.control = {.tolerance = 0.05, .dt_min = 1.0, .dt_max = 60.0};
+    MultistepProjectiveIntegrator integrator(s);
+    integrator.set_end_time(14.0);
+    const ProjectiveStepRecord first = integrator.step(toy);
+    CHECK(first.status == StepStatus::burst_only);
+    CHECK(toy.time() == Approx(14.0).margin(1e-9));
+    CHECK(first.t_end == Approx(14.0).margin(1e-9));
+}
