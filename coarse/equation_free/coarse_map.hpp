@@ -67,6 +67,9 @@ struct MapEvaluation {
     /// Standard error of each component of phi from the members' spread at the last sample
     /// (sqrt(var/R)); zeros when the stepper reports no members or only one.
     Eigen::VectorXd standard_error;
+    /// Each member's restriction at the burst's last sample, in the map's coordinates (one row
+    /// per member; empty when the stepper reports no members).
+    Eigen::MatrixXd members;
     /// |standard_error|_2: the expected norm of the noise in phi (and F), what the stopping
     /// rule compares |F| with.
     double noise_norm = 0;
@@ -92,6 +95,10 @@ class CoarseMap {
     /// micro state; the step h is taken along (v, dparameter)/|(v, dparameter)|.
     /// Zero for a zero direction (no evaluation). \pre a base; dparameter = 0 without a hook.
     Eigen::VectorXd derivative(const Eigen::VectorXd& v, double dparameter = 0.0);
+    /// The noise of the last derivative(): |SE| of the mean of the members' own differences
+    /// (Phi_r(X + h v) - Phi_r(X)) |v|/h, i.e. what common random numbers left of the noise in
+    /// that product (0 without members, or before the first derivative).
+    double derivative_noise() const { return derivative_noise_; }
     /// Forgets the kept state; the micro model continues from the last evaluation's end.
     void end();
     /// Phi at (x, parameter) from the current micro state, no base involved.
@@ -131,6 +138,7 @@ class CoarseMap {
     CoarseCoordinates coordinates_;
     long repairs_ = 0;
     double largest_repair_ = 0;
+    double derivative_noise_ = 0;
     MapEvaluation base_;
     bool has_base_ = false;
     double micro_time_ = 0;

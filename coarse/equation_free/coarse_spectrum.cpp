@@ -63,9 +63,16 @@ CoarseSpectrum leading_eigenvalues(const LinearOperator& jacobian, Eigen::Index 
 CoarseSpectrum coarse_spectrum(CoarseMap& map, const Eigen::VectorXd& x, const SpectrumSettings& settings,
                                double parameter) {
     map.begin(x, parameter);
-    const CoarseSpectrum out = leading_eigenvalues([&map](const Eigen::VectorXd& v) { return map.derivative(v); },
-                                                   x.size(), map.settings().tau, settings);
+    double noise2 = 0.0;  // Arnoldi's basis vectors are unit vectors: |e_j| is the product's noise
+    CoarseSpectrum out = leading_eigenvalues(
+        [&map, &noise2](const Eigen::VectorXd& v) {
+            Eigen::VectorXd jv = map.derivative(v);
+            noise2 += map.derivative_noise() * map.derivative_noise() / std::max(v.squaredNorm(), 1e-300);
+            return jv;
+        },
+        x.size(), map.settings().tau, settings);
     map.end();
+    for (CoarseEigenvalue& e : out.leading) e.noise = std::sqrt(noise2);
     return out;
 }
 

@@ -43,6 +43,11 @@ struct CoarseEigenvalue {
     /// normal Jacobian, an error estimate otherwise; it includes what the products' noise does
     /// to the Arnoldi relation only through the Hessenberg entries.
     double residual = 0;
+    /// The products' noise over the Krylov basis, sqrt(sum_j |e_j|^2) with |e_j| the members'
+    /// standard error of product j (CoarseMap::derivative_noise): a bound on |V^T E| that
+    /// perturbs the Hessenberg matrix, so |mu error| <~ residual + noise for a normal Jacobian.
+    /// 0 for a deterministic operator.
+    double noise = 0;
 };
 
 struct CoarseSpectrum {

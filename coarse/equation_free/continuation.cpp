@@ -59,7 +59,8 @@ BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec
     p.micro_time = map_.micro_time() - micro_before;
     log::info("branch point: parameter = {:.6g}, |F| = {:.3e}, {} Newton step(s){}", p.parameter * settings_.display_scale, p.residual,
               p.newton_iterations,
-              p.has_leading ? fmt::format(", leading mu = {:.6g}{:+.3g}i", p.leading.mu.real(), p.leading.mu.imag())
+              p.has_leading ? fmt::format(", leading mu = {:.6g}{:+.3g}i (residual {:.2g}, products' noise {:.2g})",
+                                          p.leading.mu.real(), p.leading.mu.imag(), p.leading.residual, p.leading.noise)
                             : std::string{});
     return p;
 }

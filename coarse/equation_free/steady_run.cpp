@@ -114,8 +114,9 @@ void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
         ss.eigenvalues = settings_.eigenvalues;
         out.spectrum = coarse_spectrum(map, out.converged ? out.solve.x : out.solve.best, ss);  // in u: same eigenvalues
         for (const CoarseEigenvalue& e : out.spectrum.leading)
-            log::info("steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual {:.2g})", e.mu.real(),
-                      e.mu.imag(), e.rate, e.residual);
+            log::info("steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual {:.2g}, products' "
+                      "noise {:.2g})",
+                      e.mu.real(), e.mu.imag(), e.rate, e.residual, e.noise);
     }
     // Report in the coarse vector.
     const Eigen::Index n = out.x0.size();

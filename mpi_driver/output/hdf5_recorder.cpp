@@ -304,6 +304,7 @@ void Hdf5Recorder::branch_point(const coarse::BranchPoint& p) {
     series("/branch/leading_imag", {}, T::real).append(p.has_leading ? p.leading.mu.imag() : nan);
     series("/branch/leading_rate", {}, T::real).append(p.has_leading ? p.leading.rate : nan);
     series("/branch/leading_residual", {}, T::real).append(p.has_leading ? p.leading.residual : nan);
+    series("/branch/leading_noise", {}, T::real).append(p.has_leading ? p.leading.noise : nan);
     series("/branch/dem_time", {}, T::real).append(p.micro_time);
     file_.flush();
 }
@@ -369,17 +370,19 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         integers("/steady/gmres_newton_step", step);
     }
     if (!o.spectrum.leading.empty()) {
-        std::vector<double> re, im, rate, residual;
+        std::vector<double> re, im, rate, residual, noise;
         for (const coarse::CoarseEigenvalue& e : o.spectrum.leading) {
             re.push_back(e.mu.real());
             im.push_back(e.mu.imag());
             rate.push_back(e.rate);
             residual.push_back(e.residual);
+            noise.push_back(e.noise);
         }
         reals("/steady/eigenvalue_real", re);
         reals("/steady/eigenvalue_imag", im);
         reals("/steady/eigenvalue_rate", rate);
         reals("/steady/eigenvalue_residual", residual);
+        reals("/steady/eigenvalue_noise", noise);
         file_.attribute("/steady", "eigenvalue_products", std::int64_t{o.spectrum.products});
     }
     file_.flush();

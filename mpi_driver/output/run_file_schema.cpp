@@ -109,7 +109,8 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/steady/eigenvalue_real", "1", "real part of a leading eigenvalue mu of dPhi_tau/dX at the answer", eigen},
         {"/steady/eigenvalue_imag", "1", "imaginary part of mu", eigen},
         {"/steady/eigenvalue_rate", "1/sqrt(d_p/g)", "log|mu| / tau: the decay (< 0) or growth rate of the mode", eigen},
-        {"/steady/eigenvalue_residual", "1", "Arnoldi residual estimate of the Ritz pair: the uncertainty of mu", eigen},
+        {"/steady/eigenvalue_residual", "1", "Arnoldi residual estimate of the Ritz pair (noise-free part of the uncertainty of mu)", eigen},
+        {"/steady/eigenvalue_noise", "1", "noise of the J v products over the Krylov basis (members' standard errors): with the residual, the uncertainty of mu", eigen},
         // /branch: mode = continuation, one row per branch point, as it comes.
         {"/branch/parameter", "scene unit", "the continuation parameter at the point (continuation.parameter)", point},
         {"/branch/x", "d_p", "the steady coarse vector at the point", point_node},
@@ -123,6 +124,7 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/branch/leading_imag", "1", "imaginary part of the leading mu", point},
         {"/branch/leading_rate", "1/sqrt(d_p/g)", "log|mu| / tau of the leading eigenvalue: > 0 an unstable steady state", point},
         {"/branch/leading_residual", "1", "Arnoldi residual estimate of the leading eigenvalue", point},
+        {"/branch/leading_noise", "1", "noise of the J v products over the Krylov basis: with the residual, the uncertainty of the leading mu", point},
         {"/branch/dem_time", "sqrt(d_p/g)", "DEM time the point cost (its corrector and eigenvalue, per realization)", point},
         {"/branch/fold_parameter", "scene unit", "where the parameter turns along the branch (vertex of a parabola through three points)", fold},
         // /failures: one row per realization failure the run survived.
