@@ -43,7 +43,9 @@ def main():
             tau = float(s.attrs["tau"])
             status = run_files.text(s.attrs.get("end_status", "running"))
             newton_dem = float(n.attrs.get("dem_time", 0.0))
-            eig = [(s["eigenvalue_real"][k], s["eigenvalue_rate"][k], s["eigenvalue_residual"][k])
+            # The products' noise is recorded since efdem 70b6021 (NaN before).
+            eig = [(s["eigenvalue_real"][k], s["eigenvalue_rate"][k], s["eigenvalue_residual"][k],
+                    s["eigenvalue_noise"][k] if "eigenvalue_noise" in s else float("nan"))
                    for k in range(len(s["eigenvalue_real"]))] if "eigenvalue_real" in s else []
     except run_files.UsageError as e:
         run_files.fail("steady_compare.py", e)
@@ -75,8 +77,8 @@ def main():
         slope = np.polyfit(t[fit], np.log(dist[fit]), 1)[0]
         print(f"direct approach to the steady state: rate {slope:.4f} per time unit over t in "
               f"[{t[fit].min():.0f}, {t[fit].max():.0f}] (mean height within {dist[fit].min():.2f}..{dist[fit].max():.2f} d_p)")
-    for re, rate, res in eig:
-        print(f"eigenvalue mu = {re:.4f}, rate {rate:.4f} per time unit (residual {res:.2g})")
+    for re, rate, res, noise_mu in eig:
+        print(f"eigenvalue mu = {re:.4f}, rate {rate:.4f} per time unit (residual {res:.2g}, products' noise {noise_mu:.2g})")
     # The answer's own band: a solve that stops at |F| <= 2 |SE| leaves x off the steady state by
     # |x - x*| <= |J_F^-1| (|F| + |e|) ~ (|F| + |SE|) / (1 - mu) along the slowest mode (docs/
     # steady_states.md), mu = e^(rate tau) from the direct ensemble's approach rate: the SE of Phi
