@@ -83,6 +83,7 @@ def main():
     # |x - x*| <= |J_F^-1| (|F| + |e|) ~ (|F| + |SE|) / (1 - mu) along the slowest mode (docs/
     # steady_states.md), mu = e^(rate tau) from the direct ensemble's approach rate: the SE of Phi
     # alone ('Newton noise' above) is the band of Phi(x), not of x.
+    band_x = None
     if fit.sum() >= 10:
         mu = float(np.exp(slope * tau))
         band_x = (residual + noise) / (1.0 - mu) / np.sqrt(n_nodes)
@@ -98,7 +99,11 @@ def main():
         fig, ax = plt.subplots(figsize=(6, 4.2))
         ax.fill_between(p, avg - 2 * se_direct, avg + 2 * se_direct, alpha=0.3, label="direct time average ± 2 s.e.")
         ax.plot(p, avg, label=f"direct ensemble (R = {R}), t ≥ {a.t_from:g}")
-        ax.errorbar(p, x, yerr=2 * se_newton, fmt="o", ms=3, capsize=2, label=("Newton best iterate (not converged)" if status.startswith("not converged") else "Newton steady state") + " ± 2 noise")
+        what = "Newton best iterate (not converged)" if status.startswith("not converged") else "Newton steady state"
+        if band_x is not None:  # the answer's own band (RMS per node), not only Phi's noise
+            ax.errorbar(p, x, yerr=band_x, fmt="o", ms=3, capsize=2, label=what + " ± its band (|F| + |SE|)/(1 - μ)/√n")
+        else:
+            ax.errorbar(p, x, yerr=2 * se_newton, fmt="o", ms=3, capsize=2, label=what + " ± 2 noise of Φ")
         ax.set(xlabel="p [-]", ylabel=r"light-particle height $Q_L(p)$ [$d_p$]",
                title=f"coarse steady state vs direct: RMS {rms:.2f} $d_p$")
         ax.grid(alpha=0.3)
