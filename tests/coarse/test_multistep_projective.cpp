@@ -50,6 +50,14 @@ std::vector<ProjectiveStepRecord> run_to(MultistepProjectiveIntegrator& integrat
     return out;
 }
 
+MultistepSettings adaptive_settings(double healing, double window, StepSizeSettings control) {
+    MultistepSettings s;
+    s.healing = healing;
+    s.window = window;
+    s.control = control;
+    return s;
+}
+
 MultistepSettings fixed_settings(int steps, double dt) {
     MultistepSettings s;
     s.healing = 0.0;
@@ -433,11 +441,8 @@ TEST_CASE("an adaptive jump limited by stability records the monitor's decay rat
     // The record must carry that assessment (it was NaN for adaptive runs before).
     const Eigen::VectorXd k = Eigen::VectorXd::Constant(19, 0.1);
     test::OuEnsembleStepper toy(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(19, 3.0), 3);
-    MultistepSettings s;
-    s.healing = 4.0;
-    s.window = 4.0;
-    s.steps = 1;
-    s.control = {.tolerance = 1e3, .dt_min = 0.5, .dt_max = 200.0};
+    MultistepSettings s = adaptive_settings(4.0, 4.0, {.tolerance = 1e3, .dt_min = 0.5, .dt_max = 200.0});
+    s.steps = 1;  // forward Euler: the amplification above
     MultistepProjectiveIntegrator integrator(s);
     integrator.set_end_time(1000.0);
     REQUIRE(integrator.step(toy).status == StepStatus::burst_only);
@@ -457,11 +462,7 @@ TEST_CASE("a first burst that would leave less than one burst runs on to the end
     // expansion, the first burst (22) ended at 84 and the run stopped there, 16 short of its
     // end. Bursts of 4 + 4 from t = 0 with the end at 14: the first burst runs to 14.
     test::OuEnsembleStepper toy(rates19(), 0.0, 2, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
-    MultistepSettings s;
-    s.healing = 4.0;
-    s.window = 4.0;
-    s.control = {.tolerance = 0.05, .dt_min = 1.0, .dt_max = 60.0};
-    MultistepProjectiveIntegrator integrator(s);
+    MultistepProjectiveIntegrator integrator(adaptive_settings(4.0, 4.0, {.tolerance = 0.05, .dt_min = 1.0, .dt_max = 60.0}));
     integrator.set_end_time(14.0);
     const ProjectiveStepRecord first = integrator.step(toy);
     CHECK(first.status == StepStatus::burst_only);
