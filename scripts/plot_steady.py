@@ -72,6 +72,13 @@ def plot_branch(f, name, out):
     ax_e.plot(lam, rate, "-", color="C1")
     ax_e.plot(lam[stable], rate[stable], "o", color="C1", label=r"stable ($|\mu| < 1$)")
     ax_e.plot(lam[~stable], rate[~stable], "o", mfc="none", color="C1", label=r"unstable ($|\mu| \geq 1$)")
+    # The rate's upper end, log(|mu| + residual + products' noise)/tau: how close to 0 (neutral)
+    # the mode may be. /branch/leading_noise is recorded since efdem 70b6021.
+    tau = float(f["steady"].attrs["tau"]) if "steady" in f and "tau" in f["steady"].attrs else float("nan")
+    if "leading_noise" in b and np.isfinite(tau):
+        upper = np.log(mu + b["leading_residual"][:] + b["leading_noise"][:]) / tau
+        ax_e.errorbar(lam, rate, yerr=[np.zeros_like(rate), upper - rate], fmt="none", ecolor="C1", capsize=3,
+                      label=r"upper end: $\log(|\mu|$ + residual + products' noise$)/\tau$")
     ax_e.axhline(0, color="0.5", lw=0.8)
     ax_e.set(xlabel=f"{par} [scene unit]", ylabel=r"leading rate $\log|\mu|/\tau$ [$1/\sqrt{d_p/g}$]",
              title="coarse stability of each point")
