@@ -60,12 +60,12 @@ def main():
     diff = x - avg
     rms = np.sqrt(np.mean(diff ** 2))
     band = np.sqrt(se_newton ** 2 + np.mean(se_direct ** 2))
-    print(f"newton: {status}")
+    print(f"{a.run}: {status}")
     print(f"direct: R = {R}, time average over t >= {a.t_from:g} ({sel.sum()} samples, {nb} blocks of {a.block:g})")
-    print(f"RMS(Newton - direct average) = {rms:.3f} d_p; Newton noise {se_newton:.3f}, direct s.e. "
+    print(f"RMS({a.run} - direct average) = {rms:.3f} d_p; its noise of Phi {se_newton:.3f}, direct s.e. "
           f"{np.sqrt(np.mean(se_direct ** 2)):.3f}, together {band:.3f} d_p: ratio {rms / band:.2f}")
     print(f"largest node difference {np.abs(diff).max():.3f} d_p at p = {p[np.argmax(np.abs(diff))]:.2f}")
-    print(f"DEM time per realization: Newton {newton_dem:.0f} (warm-up included), direct {direct_dem:.0f}")
+    print(f"DEM time per realization: {a.run} {newton_dem:.0f} (warm-up included), direct {direct_dem:.0f}")
     # The direct ensemble's own slowest decay rate near the steady state: a log-linear fit of
     # the distance of its mean height from the final average, over the part of the approach
     # where that distance is well above the noise (between 20x and 3x the block s.e.).
