@@ -37,9 +37,10 @@ def main():
             s = n["steady"]
             it = s["iterate"]
             # A run still going (or cut short) has no /steady/best yet: its best iterate so far.
-            x = s["best"][:] if "best" in s else it["x"][int(np.argmin(it["residual"][:]))]
-            noise = it["noise"][int(np.argmin(it["residual"][:]))]
-            residual = float(np.min(it["residual"][:]))
+            residuals = it["residual"][:]
+            best = int(np.argmin(residuals))
+            x = s["best"][:] if "best" in s else it["x"][best]
+            noise, residual = it["noise"][best], float(residuals[best])
             tau = float(s.attrs["tau"])
             status = run_files.text(s.attrs.get("end_status", "running"))
             newton_dem = float(n.attrs.get("dem_time", 0.0))

@@ -93,10 +93,10 @@ std::pair<double, bool> PseudoArclengthContinuation::predictor_step(double ds, d
     return {ds, false};
 }
 
-std::string PseudoArclengthContinuation::reached_end(double lambda) const {
+std::string PseudoArclengthContinuation::range_end(const char* what, double lambda) const {
     const double k = settings_.display_scale;
-    return fmt::format("reached the end of the parameter range [{:.6g}, {:.6g}] at {:.6g}",
-                       settings_.parameter_min * k, settings_.parameter_max * k, lambda * k);
+    return fmt::format("{} the parameter range [{:.6g}, {:.6g}] at {:.6g}", what, settings_.parameter_min * k,
+                       settings_.parameter_max * k, lambda * k);
 }
 
 Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda0, double direction) {
@@ -128,7 +128,7 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             before = map_.micro_time();
             const auto [step, lands] = predictor_step(ds, y[n], t[n]);
             if (step < settings_.min_step) {  // on the end of the range, heading out of it
-                branch.end_reason = reached_end(y[n]);
+                branch.end_reason = range_end("reached the end of", y[n]);
                 break;
             }
             const Eigen::VectorXd predicted = y + step * t;
@@ -154,13 +154,11 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             branch.points.push_back(make_point(rec, n, step, before));
             if (settings_.on_point) settings_.on_point(branch);
             if (y[n] < settings_.parameter_min || y[n] > settings_.parameter_max) {
-                const double k = settings_.display_scale;
-                branch.end_reason = fmt::format("left the parameter range [{:.6g}, {:.6g}] at {:.6g}",
-                                                settings_.parameter_min * k, settings_.parameter_max * k, y[n] * k);
+                branch.end_reason = range_end("left", y[n]);
                 break;
             }
             if (lands) {
-                branch.end_reason = reached_end(y[n]);
+                branch.end_reason = range_end("reached the end of", y[n]);
                 break;
             }
             const double factor = std::clamp(static_cast<double>(settings_.target_iterations) /

@@ -101,7 +101,8 @@ class PseudoArclengthContinuation {
     /// The predictor's arclength step from the planned ds: at most max_parameter_step in lambda,
     /// and shortened to land on the end of the range it heads for (then `true`).
     std::pair<double, bool> predictor_step(double ds, double lambda, double t_lambda) const;
-    std::string reached_end(double lambda) const;
+    /// "<what> the parameter range [min, max] at lambda", in the display scale.
+    std::string range_end(const char* what, double lambda) const;
 
     CoarseMap& map_;
     ContinuationSettings settings_;
