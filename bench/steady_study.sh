@@ -14,6 +14,11 @@
 #              Newton step costs ~1 + 3 + 1 evaluations, direct simulation gets the first guess
 #              closer for less), with the leading eigenvalue at every point (recorded point by
 #              point: a run cut short keeps the points it reached);
+#   branch_low.h5  the continuation's low end, U_s 0.4 -> 0.2 (minimum fluidization of the mixture
+#              ~0.16-0.18): four points 0.067 apart, tau = 20 (the slow mode nears mu = 1 there,
+#              and F = (mu - 1)(X - X*) shrinks against the noise: a longer tau keeps 1 - mu
+#              away from 0), from a warm-up of 100 at 0.4 (which overlaps branch.h5's 0.388);
+#              the corrector's predictor fallback (continuation.predictor_fallback) on;
 #   anderson.h5  steady.solver = anderson (no derivatives: Anderson-accelerated fixed point on
 #              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 120 of
 #              DEM time: the cheap option against which Newton is compared.
@@ -52,6 +57,10 @@ run direct mode=direct seed=101 run.duration=300
 run branch mode=continuation seed=7 run.duration=0 gas_drag.superficial_velocity=0.6 \
   continuation.parameter=gas_drag.superficial_velocity continuation.end=0.2 continuation.step=0.1 \
   continuation.max_points=4 steady.warmup=100 steady.tau=10 steady.difference_step=2 steady.max_krylov=3 \
+  steady.max_iterations=3 steady.eigenvalues=1 steady.eigenvalue_products=2
+run branch_low mode=continuation seed=17 run.duration=0 gas_drag.superficial_velocity=0.4 \
+  continuation.parameter=gas_drag.superficial_velocity continuation.end=0.2 continuation.step=0.0667 \
+  continuation.max_points=4 steady.warmup=100 steady.tau=20 steady.difference_step=2 steady.max_krylov=3 \
   steady.max_iterations=3 steady.eigenvalues=1 steady.eigenvalue_products=2
 run anderson mode=steady seed=1 run.duration=120 steady.solver=anderson steady.warmup=60 steady.tau=20 \
   steady.max_iterations=8 steady.eigenvalues=0

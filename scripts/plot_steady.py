@@ -8,11 +8,13 @@
   (filled markers: stable, mu inside the unit circle; open: unstable).
 
     /usr/bin/python3 scripts/plot_steady.py RUN.h5 -o steady.png
+    /usr/bin/python3 scripts/plot_steady.py BRANCH_A.h5 BRANCH_B.h5 -o branch.png   (one diagram)
 
 Needs Debian's python3-matplotlib, python3-h5py and python3-numpy (run it with /usr/bin/python3).
 Exit code 2 with a message for a file that is missing, not a run file, or not of these modes.
 """
 import argparse
+import contextlib
 import os
 import sys
 
@@ -54,59 +56,76 @@ def plot_steady(f, name, out):
     fig.savefig(out, dpi=110)
 
 
-def plot_branch(f, name, out):
-    b = f["branch"]
-    if "parameter" not in b or len(b["parameter"]) == 0:
-        raise run_files.UsageError(f"{name}: /branch has no points (end status "
-                                   f"'{run_files.text(f.attrs.get('end_status', '?'))}')")
-    lam = b["parameter"][:]
-    par = run_files.text(b.attrs.get("parameter", "parameter"))
+def plot_branch(runs, out):
+    """runs: (file, name) of one or more continuation runs in the same parameter, on one diagram."""
     fig, (ax_m, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
-    ax_m.errorbar(lam, b["mean_height"][:], yerr=b["mean_height_error"][:], fmt="o-", capsize=3,
-                  label="mean of the ICDF nodes (bound on its s.e.)")
+    reasons = []
+    for k, (f, name) in enumerate(runs):
+        b = f["branch"]
+        if "parameter" not in b or len(b["parameter"]) == 0:
+            raise run_files.UsageError(f"{name}: /branch has no points (end status "
+                                       f"'{run_files.text(f.attrs.get('end_status', '?'))}')")
+        color = f"C{k}"
+        lam = b["parameter"][:]
+        par = run_files.text(b.attrs.get("parameter", "parameter"))
+        tau = float(f["steady"].attrs["tau"]) if "steady" in f and "tau" in f["steady"].attrs else float("nan")
+        label = f"{name} (tau = {tau:g})" if len(runs) > 1 else "mean of the ICDF nodes (bound on its s.e.)"
+        ax_m.errorbar(lam, b["mean_height"][:], yerr=b["mean_height_error"][:], fmt="o-", capsize=3, color=color,
+                      label=label)
+        # /branch/from_last_point is recorded since the predictor fallback (efdem, 2026-12-03).
+        if "from_last_point" in b:
+            held = b["from_last_point"][:] == 1
+            if held.any():
+                ax_m.plot(lam[held], b["mean_height"][:][held], "x", ms=10, color="k",
+                          label="corrector started from the last point" if k == len(runs) - 1 else None)
+        rate = b["leading_rate"][:]
+        mu = np.hypot(b["leading_real"][:], b["leading_imag"][:])
+        stable = mu < 1
+        ax_e.plot(lam, rate, "-", color=color)
+        ax_e.plot(lam[stable], rate[stable], "o", color=color, label=r"stable ($|\mu| < 1$)" if k == 0 else None)
+        ax_e.plot(lam[~stable], rate[~stable], "o", mfc="none", color=color,
+                  label=r"unstable ($|\mu| \geq 1$)" if k == 0 else None)
+        # The rate's upper end, log(|mu| + residual + products' noise)/tau: how close to 0 (neutral)
+        # the mode may be. /branch/leading_noise is recorded since efdem 70b6021.
+        if "leading_noise" in b and np.isfinite(tau):
+            upper = np.log(mu + b["leading_residual"][:] + b["leading_noise"][:]) / tau
+            ax_e.errorbar(lam, rate, yerr=[np.zeros_like(rate), upper - rate], fmt="none", ecolor=color, capsize=3,
+                          label=r"upper end: $\log(|\mu|$ + residual + products' noise$)/\tau$" if k == 0 else None)
+        reasons.append(f"{name}: " + run_files.text(b.attrs.get("end_reason", "")))
     ax_m.set(xlabel=f"{par} [scene unit]", ylabel=r"mean light-particle height [$d_p$]",
-             title=f"{name}: steady segregation along the branch")
-    rate = b["leading_rate"][:]
-    mu = np.hypot(b["leading_real"][:], b["leading_imag"][:])
-    stable = mu < 1
-    ax_e.plot(lam, rate, "-", color="C1")
-    ax_e.plot(lam[stable], rate[stable], "o", color="C1", label=r"stable ($|\mu| < 1$)")
-    ax_e.plot(lam[~stable], rate[~stable], "o", mfc="none", color="C1", label=r"unstable ($|\mu| \geq 1$)")
-    # The rate's upper end, log(|mu| + residual + products' noise)/tau: how close to 0 (neutral)
-    # the mode may be. /branch/leading_noise is recorded since efdem 70b6021.
-    tau = float(f["steady"].attrs["tau"]) if "steady" in f and "tau" in f["steady"].attrs else float("nan")
-    if "leading_noise" in b and np.isfinite(tau):
-        upper = np.log(mu + b["leading_residual"][:] + b["leading_noise"][:]) / tau
-        ax_e.errorbar(lam, rate, yerr=[np.zeros_like(rate), upper - rate], fmt="none", ecolor="C1", capsize=3,
-                      label=r"upper end: $\log(|\mu|$ + residual + products' noise$)/\tau$")
+             title="steady segregation along the branch")
     ax_e.axhline(0, color="0.5", lw=0.8)
     ax_e.set(xlabel=f"{par} [scene unit]", ylabel=r"leading rate $\log|\mu|/\tau$ [$1/\sqrt{d_p/g}$]",
              title="coarse stability of each point")
     for ax in (ax_m, ax_e):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle(run_files.text(b.attrs.get("end_reason", ""))[:140], fontsize=8)
+    fig.suptitle("\n".join(r[:140] for r in reasons), fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("run")
+    ap.add_argument("run", nargs="+", help="a run file; several continuation runs share one diagram")
     ap.add_argument("-o", "--output", required=True)
     a = ap.parse_args()
     try:
-        with run_files.open_run(a.run) as f:
-            mode = run_files.text(f.attrs["mode"])
-            name = os.path.basename(a.run)
+        with contextlib.ExitStack() as stack:
+            files = [stack.enter_context(run_files.open_run(r)) for r in a.run]
+            modes = [run_files.text(f.attrs["mode"]) for f in files]
+            f, mode = files[0], modes[0]
+            if len(files) > 1 and any(m != "continuation" for m in modes):
+                raise run_files.UsageError(f"{', '.join(a.run)}: several run files are drawn together only if all "
+                                           f"are of mode = continuation (modes: {', '.join(modes)})")
             if mode == "continuation":
-                plot_branch(f, name, a.output)
+                plot_branch([(g, os.path.basename(r)) for g, r in zip(files, a.run)], a.output)
             elif mode == "steady":
                 if "steady/iterate/residual" not in f or len(f["steady/iterate/residual"]) == 0:
-                    raise run_files.UsageError(f"{a.run}: the steady run recorded no iterate")
-                plot_steady(f, name, a.output)
+                    raise run_files.UsageError(f"{a.run[0]}: the steady run recorded no iterate")
+                plot_steady(f, os.path.basename(a.run[0]), a.output)
             else:
-                raise run_files.UsageError(f"{a.run}: a run of mode = {mode}; this script plots mode = steady or "
+                raise run_files.UsageError(f"{a.run[0]}: a run of mode = {mode}; this script plots mode = steady or "
                                            "continuation (plot_icdf.py plots direct and cpi runs)")
     except run_files.UsageError as e:
         run_files.fail("plot_steady.py", e)

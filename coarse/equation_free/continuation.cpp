@@ -39,7 +39,7 @@ PseudoArclengthContinuation::PseudoArclengthContinuation(CoarseMap& map, const C
     EFDEM_EXPECTS(map_.has_parameter() && !map_.has_base());
     EFDEM_EXPECTS(0.0 < settings_.min_step && settings_.min_step <= settings_.step &&
                   settings_.step <= settings_.max_step && settings_.max_points >= 1 &&
-                  settings_.target_iterations >= 1);
+                  settings_.target_iterations >= 1 && settings_.fallback_ratio >= 0.0);
 }
 
 BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec, Eigen::Index n, double step,
@@ -51,14 +51,15 @@ BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec
     p.noise = rec.state_noise.back();
     p.newton_iterations = rec.iterations;
     p.step = step;
+    p.from_fallback = rec.from_fallback;
     if (settings_.stability) {
         const CoarseSpectrum s = coarse_spectrum(map_, p.x, settings_.spectrum, p.parameter);
         p.has_leading = !s.leading.empty();
         if (p.has_leading) p.leading = s.leading.front();
     }
     p.micro_time = map_.micro_time() - micro_before;
-    log::info("branch point: parameter = {:.6g}, |F| = {:.3e}, {} Newton step(s){}", p.parameter * settings_.display_scale, p.residual,
-              p.newton_iterations,
+    log::info("branch point: parameter = {:.6g}, |F| = {:.3e}, {} Newton step(s){}{}", p.parameter * settings_.display_scale, p.residual,
+              p.newton_iterations, p.from_fallback ? " from the last point" : "",
               p.has_leading ? fmt::format(", leading mu = {:.6g}{:+.3g}i (residual {:.2g}, products' noise {:.2g})",
                                           p.leading.mu.real(), p.leading.mu.imag(), p.leading.residual, p.leading.noise)
                             : std::string{});
@@ -135,7 +136,9 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             // The last point is solved at the end of the range itself: its constraint row is
             // lambda = end instead of the arclength (regular unless a fold sits exactly there).
             ArclengthSystem system(map_, lands ? Eigen::VectorXd(Eigen::VectorXd::Unit(n + 1, n)) : t, predicted);
-            rec = newton_.solve(system, predicted);
+            FallbackGuess held{y, settings_.fallback_ratio};
+            held.y[n] = predicted[n];
+            rec = newton_.solve(system, predicted, &held);
             if (rec.reason == SteadyStopReason::stopped) {
                 branch.end_reason = fmt::format("stopped after parameter = {:.6g}: {}", y[n] * settings_.display_scale, rec.message);
                 break;

@@ -8,7 +8,10 @@
 ///                F_X z = -F_lambda (GMRES on CRN differences), oriented by `direction`;
 ///   predictor:   y_pred = y_k + ds t (t: the secant (y_k - y_{k-1})/|.| after the first step,
 ///                which keeps its orientation through a fold);
-///   corrector:   Newton-Krylov on [F(X; lambda); t . (y - y_pred)] = 0 (ArclengthSystem);
+///   corrector:   Newton-Krylov on [F(X; lambda); t . (y - y_pred)] = 0 (ArclengthSystem),
+///                from y_pred or, when |F(y_pred)| is above fallback_ratio x the stopping
+///                threshold and the last point at the predicted parameter, (X_k, lambda_pred),
+///                is closer to steady, from that (a noisy secant can overshoot the branch);
 ///   step size:   ds *= clamp(target / Newton steps, 1/2, 2) within [min_step, max_step];
 ///                a failed corrector halves ds and tries again from the same point.
 ///
@@ -49,6 +52,9 @@ struct ContinuationSettings {
     double parameter_min = -1e300;
     double parameter_max = 1e300;
     int target_iterations = 3;  ///< Newton steps per corrector the step size aims at
+    /// A predicted point with |F| above this multiple of the stopping threshold is compared
+    /// with the last point at the predicted parameter (FallbackGuess: one or two extra bursts).
+    double fallback_ratio = 2.0;
     bool stability = true;      ///< the leading eigenvalue at each point
     SpectrumSettings spectrum = SpectrumSettings{1};  // the leading eigenvalue only
     BranchObserver on_point;  ///< may be empty
@@ -64,6 +70,8 @@ struct BranchPoint {
     double noise = 0;     ///< the noise norm measured with it, in X
     int newton_iterations = 0;
     double step = 0;  ///< the arclength step that reached it (0 for the first point)
+    /// Its corrector started from the last point at the predicted parameter, not the predictor.
+    bool from_fallback = false;
     bool has_leading = false;
     CoarseEigenvalue leading;  ///< largest |mu| (if has_leading)
     double micro_time = 0;     ///< micro time this point cost, its spectrum included

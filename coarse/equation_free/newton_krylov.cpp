@@ -1,6 +1,7 @@
 #include "coarse/equation_free/newton_krylov.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -23,14 +24,40 @@ NewtonKrylov::NewtonKrylov(const NewtonKrylovSettings& settings) : settings_(set
                   settings_.forcing < 1.0 && settings_.max_backtracks >= 0);
 }
 
-SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorXd& y0) const {
+SystemEvaluation NewtonKrylov::choose_start(NewtonSystem& system, Eigen::VectorXd& y, SystemEvaluation e,
+                                            const FallbackGuess& fallback, SteadySolveRecord& rec) const {
+    EFDEM_EXPECTS(fallback.y.size() == y.size() && fallback.ratio >= 0.0);
+    const double r = e.steady_residual();
+    rec.first_guess_residual = r;
+    // Only a noisy first guess is in doubt: a noise-free map's secant predictor is as good as
+    // the branch's smoothness makes it, and would be compared at every point for nothing.
+    const double threshold = settings_.stop.threshold(e.steady_noise());
+    if (e.steady_noise() <= 0.0 || r <= fallback.ratio * threshold) return e;
+    system.end();
+    SystemEvaluation f = system.begin(fallback.y);
+    rec.fallback_residual = f.steady_residual();
+    rec.from_fallback = rec.fallback_residual < r;
+    log::info("newton   0: |F| = {:.4e} at the first guess ({:.3g} x the stopping threshold), {:.4e} at the "
+              "fallback guess: starting from the {}",
+              r, r / threshold, rec.fallback_residual, rec.from_fallback ? "fallback" : "first guess");
+    if (rec.from_fallback) {
+        y = fallback.y;
+        return f;
+    }
+    system.end();
+    return system.begin(y);  // afresh: the kept micro state is the fallback's
+}
+
+SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorXd& y0,
+                                      const FallbackGuess* fallback) const {
     EFDEM_EXPECTS(y0.size() == system.dimension());
     const long evaluations0 = system.evaluations();
     const double micro0 = system.micro_time();
     SteadySolveRecord rec;
     Eigen::VectorXd y = y0;
     while (true) {
-        const SystemEvaluation e = system.begin(y);
+        SystemEvaluation e = system.begin(y);
+        if (fallback != nullptr && rec.residuals.empty()) e = choose_start(system, y, std::move(e), *fallback, rec);
         const double r = e.g.norm();
         rec.add_iterate(y, r, e.noise_norm, e.state_residual, e.state_noise);
         log::info("newton {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);

@@ -30,15 +30,33 @@ struct NewtonKrylovSettings {
     IterateObserver observer;
 };
 
+/// A second first guess for NewtonKrylov::solve, evaluated only when the first guess is noisy and
+/// far from steady: |F| there above `ratio` x the stopping threshold (both without appended
+/// rows, see SystemEvaluation::steady_residual) and a noise norm > 0. The solve starts from whichever has the smaller |F|;
+/// when that is the first guess, it is evaluated afresh (the kept micro state is the
+/// fallback's), so a fallback costs one or two extra bursts. In continuation the first guess is
+/// the secant predictor, which extrapolates the noise of two corrected points, and the
+/// fallback is the last point at the predicted parameter.
+struct FallbackGuess {
+    Eigen::VectorXd y;
+    double ratio = 2.0;
+};
+
 class NewtonKrylov {
   public:
     explicit NewtonKrylov(const NewtonKrylovSettings& settings);
     /// Solves G(y) = 0 from y0. Leaves no base on `system`. Never throws for a numerical
     /// condition: the record says why it stopped.
-    SteadySolveRecord solve(NewtonSystem& system, const Eigen::VectorXd& y0) const;
+    SteadySolveRecord solve(NewtonSystem& system, const Eigen::VectorXd& y0,
+                            const FallbackGuess* fallback = nullptr) const;
     const NewtonKrylovSettings& settings() const { return settings_; }
 
   private:
+    /// The first iterate's evaluation: of y (evaluated as e) or, if closer to steady, of the
+    /// fallback (then y becomes it); records both residuals in rec.
+    SystemEvaluation choose_start(NewtonSystem& system, Eigen::VectorXd& y, SystemEvaluation e,
+                                  const FallbackGuess& fallback, SteadySolveRecord& rec) const;
+
     NewtonKrylovSettings settings_;
 };
 

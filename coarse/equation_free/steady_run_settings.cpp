@@ -79,7 +79,7 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     s.spectrum.tolerance = 1e-3;
 
     if (!continuation) {
-        for (const char* key : {"parameter", "end", "step", "max_step", "scale", "max_points"})
+        for (const char* key : {"parameter", "end", "step", "max_step", "scale", "max_points", "predictor_fallback"})
             if (cont.contains(key))
                 cont.fail(key, "is read only with mode = continuation", "remove it, or set mode = continuation");
         return s;
@@ -100,6 +100,7 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     // rule reads as an easy branch: by default the parameter moves by at most `step` a point.
     const double max_step = cont.get_or<double>("max_step", step, Bounds::open_closed(0.0, 1e3));
     s.branch.max_points = cont.get_or<int>("max_points", 12, Bounds::closed(1, 10000));
+    s.branch.fallback_ratio = cont.get_or<double>("predictor_fallback", 2.0, Bounds::closed(0.0, 1e6));
     // In the scaled parameter lambda = value / scale (the arclength's units: d_p-equivalents).
     ContinuationSettings& b = s.branch;
     b.corrector = s.newton;

@@ -300,6 +300,7 @@ void Hdf5Recorder::branch_point(const coarse::BranchPoint& p) {
     series("/branch/mean_height_error", {}, T::real).append(coarse::mean_height_error_bound(p.noise, p.x.size()));
     series("/branch/newton_steps", {}, T::integer).append_integer(p.newton_iterations);
     series("/branch/arclength_step", {}, T::real).append(p.step);
+    series("/branch/from_last_point", {}, T::integer).append_integer(p.from_fallback ? 1 : 0);
     series("/branch/leading_real", {}, T::real).append(p.has_leading ? p.leading.mu.real() : nan);
     series("/branch/leading_imag", {}, T::real).append(p.has_leading ? p.leading.mu.imag() : nan);
     series("/branch/leading_rate", {}, T::real).append(p.has_leading ? p.leading.rate : nan);

@@ -120,6 +120,7 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/branch/mean_height_error", "d_p", "upper bound on the standard error of /branch/mean_height: noise / sqrt(nodes)", point},
         {"/branch/newton_steps", "1", "Newton steps of the point's corrector", point},
         {"/branch/arclength_step", "1", "arclength step that reached the point in (X [d_p], parameter / continuation.scale); 0 for the first", point},
+        {"/branch/from_last_point", "1", "1: the point's corrector started from the last point at the predicted parameter (the predictor was farther from steady, continuation.predictor_fallback), 0: from the predictor", point},
         {"/branch/leading_real", "1", "real part of the leading eigenvalue mu of dPhi_tau/dX at the point (NaN: not computed)", point},
         {"/branch/leading_imag", "1", "imaginary part of the leading mu", point},
         {"/branch/leading_rate", "1/sqrt(d_p/g)", "log|mu| / tau of the leading eigenvalue: > 0 an unstable steady state", point},

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -261,6 +262,39 @@ struct NoisyCase {
     }
 };
 
+/// Passes a FixedPointSystem through and writes down the calls that cost a burst or change the
+/// kept micro state: 'b' begin, 'e' end, 'j' a derivative, 't' a trial.
+class CallLog final : public NewtonSystem {
+  public:
+    explicit CallLog(NewtonSystem& inner) : inner_(inner) {}
+    Eigen::Index dimension() const override { return inner_.dimension(); }
+    SystemEvaluation begin(const Eigen::VectorXd& y) override {
+        calls += 'b';
+        begun.push_back(y);
+        return inner_.begin(y);
+    }
+    Eigen::VectorXd jacobian_times(const Eigen::VectorXd& v) override {
+        calls += 'j';
+        return inner_.jacobian_times(v);
+    }
+    SystemEvaluation trial(const Eigen::VectorXd& y) override {
+        calls += 't';
+        return inner_.trial(y);
+    }
+    void end() override {
+        calls += 'e';
+        inner_.end();
+    }
+    long evaluations() const override { return inner_.evaluations(); }
+    double micro_time() const override { return inner_.micro_time(); }
+
+    std::string calls;
+    std::vector<Eigen::VectorXd> begun;
+
+  private:
+    NewtonSystem& inner_;
+};
+
 CoarseMapSettings noisy_map(bool crn, double h) {
     CoarseMapSettings s;
     s.tau = kTau;
@@ -339,4 +373,70 @@ TEST_CASE("common random numbers make the ensemble's directional derivatives acc
     WARN("spread of J v over 12 micro states: with CRN " << with << " (reported " << with_reported << "), without "
                                                           << without << " (reported " << without_reported << "; ratio "
                                                           << without / with << ")");
+}
+
+
+TEST_CASE("a fallback first guess is tried only when the first guess is noisy and far, and the closer one starts",
+          "[unit][steady]") {
+    const NoisyCase c;
+    test::SdeEnsembleStepper toy = c.stepper(5);
+    CoarseMap map(toy, noisy_map(true, 1e-2));
+    FixedPointSystem fixed(map, 3);
+    CallLog system(fixed);
+    const NewtonKrylov newton{NewtonKrylovSettings{}};
+    // The noise norm of F is ~0.01 (64 members, sigma = 0.1), the threshold 2 x that; F at an
+    // offset d is ~(1 - e^(-k tau)) d, so an offset of 1 is ~30 x the threshold, 0.02 below it.
+    const Eigen::Vector3d far = c.c + Eigen::Vector3d::Constant(1.0);
+    const Eigen::Vector3d near = c.c + Eigen::Vector3d::Constant(0.3);
+    const Eigen::Vector3d steady = c.c + Eigen::Vector3d::Constant(0.002);
+
+    SECTION("far first guess, closer fallback: the solve starts from the fallback's kept state") {
+        const FallbackGuess fallback{near, 2.0};
+        const SteadySolveRecord rec = newton.solve(system, far, &fallback);
+        INFO(rec.message << "; calls " << system.calls);
+        CHECK(rec.from_fallback);
+        CHECK(rec.first_guess_residual > rec.fallback_residual);
+        // Iterate 0 is the fallback's evaluation itself (no burst in between), and the first
+        // Newton step's derivatives are taken from its kept micro state: b e b j...
+        CHECK(rec.residuals.front() == rec.fallback_residual);
+        CHECK(system.calls.substr(0, 4) == "bebj");
+        CHECK(system.begun[1] == Eigen::VectorXd(near));
+        CHECK(rec.converged());
+    }
+    SECTION("the first guess closer after all: it is evaluated afresh and its state kept") {
+        const FallbackGuess fallback{far, 2.0};
+        const SteadySolveRecord rec = newton.solve(system, near, &fallback);
+        INFO(rec.message << "; calls " << system.calls);
+        CHECK_FALSE(rec.from_fallback);
+        CHECK(rec.first_guess_residual < rec.fallback_residual);
+        CHECK(system.calls.substr(0, 6) == "bebebj");
+        CHECK(system.begun[2] == Eigen::VectorXd(near));
+        // A fresh evaluation at the same point: the same |F| up to the noise (4 x its norm
+        // bounds the difference of two independent errors, as in the stopping rule).
+        CHECK(rec.residuals.front() == Approx(rec.first_guess_residual).margin(4.0 * rec.noise.front()));
+        CHECK(rec.converged());
+    }
+    SECTION("a first guess within the ratio: the fallback is never evaluated") {
+        const FallbackGuess fallback{far, 2.0};
+        const SteadySolveRecord rec = newton.solve(system, steady, &fallback);
+        INFO(rec.message << "; calls " << system.calls);
+        CHECK(std::isnan(rec.fallback_residual));
+        CHECK_FALSE(rec.from_fallback);
+        // One evaluation per iterate, none for the fallback (here: at the noise level at once).
+        CHECK(system.begun.size() == rec.residuals.size());
+        CHECK(system.begun.front() == Eigen::VectorXd(steady));
+    }
+}
+
+TEST_CASE("a noise-free map never evaluates the fallback: its predictor is as good as the branch is smooth",
+          "[unit][steady]") {
+    const LinearCase c;
+    test::AffineToyStepper toy = c.stepper();
+    CoarseMap map(toy, deterministic_map());
+    FixedPointSystem fixed(map, 4);
+    CallLog system(fixed);
+    const FallbackGuess fallback{c.x_star, 0.0};  // even with ratio 0 and the exact answer
+    const SteadySolveRecord rec = NewtonKrylov{NewtonKrylovSettings{}}.solve(system, Eigen::Vector4d::Zero(), &fallback);
+    CHECK(std::isnan(rec.fallback_residual));
+    CHECK(system.calls.substr(0, 2) == "bj");
 }

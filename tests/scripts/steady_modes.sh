@@ -65,9 +65,11 @@ assert abs(lam[0] - 0.41) < 1e-12 and lam[1] > lam[0], lam  # from the scene val
 assert b["x"].shape == (2, 19)
 assert np.all(np.isfinite(b["leading_rate"][:]))
 assert np.allclose(b["mean_height"][:], b["x"][:].mean(axis=1))
-print("continuation: branch", lam)
+held = b["from_last_point"][:]
+assert held[0] == 0 and set(held) <= {0, 1}, held  # the first point has no predictor
+print("continuation: branch", lam, "corrector from the last point:", held)
 PY
-/usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/branch.h5" -o "$work/branch.png"
+/usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/branch.h5" "$work/branch.h5" -o "$work/branch.png"
 /usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/np2.h5" -o "$work/steady.png"
 [ -s "$work/branch.png" ] && [ -s "$work/steady.png" ]
 
