@@ -17,8 +17,11 @@
 #   branch_low.h5  the continuation's low end, U_s 0.4 -> 0.2 (minimum fluidization of the mixture
 #              ~0.16-0.18): four points 0.067 apart, tau = 20 (the slow mode nears mu = 1 there,
 #              and F = (mu - 1)(X - X*) shrinks against the noise: a longer tau keeps 1 - mu
-#              away from 0), from a warm-up of 100 at 0.4 (which overlaps branch.h5's 0.388);
-#              the corrector's predictor fallback (continuation.predictor_fallback) on;
+#              away from 0), from a warm-up of 200 at 0.4 (which overlaps branch.h5's 0.388) and
+#              up to 5 Newton steps a point: a first try (2026-12-03, warm-up 100, 3 steps) ended
+#              with the first point at |F| = 1.53 against a threshold of 0.63 after 440 units,
+#              the line search taking 1/8, 1/2, 1/4 of noisy GMRES steps; the corrector's
+#              predictor fallback (continuation.predictor_fallback) on;
 #   anderson.h5  steady.solver = anderson (no derivatives: Anderson-accelerated fixed point on
 #              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 120 of
 #              DEM time: the cheap option against which Newton is compared.
@@ -60,7 +63,7 @@ run branch mode=continuation seed=7 run.duration=0 gas_drag.superficial_velocity
   steady.max_iterations=3 steady.eigenvalues=1 steady.eigenvalue_products=2
 run branch_low mode=continuation seed=17 run.duration=0 gas_drag.superficial_velocity=0.4 \
   continuation.parameter=gas_drag.superficial_velocity continuation.end=0.2 continuation.step=0.0667 \
-  continuation.max_points=4 steady.warmup=100 steady.tau=20 steady.difference_step=2 steady.max_krylov=3 \
-  steady.max_iterations=3 steady.eigenvalues=1 steady.eigenvalue_products=2
+  continuation.max_points=4 steady.warmup=200 steady.tau=20 steady.difference_step=2 steady.max_krylov=3 \
+  steady.max_iterations=5 steady.eigenvalues=1 steady.eigenvalue_products=2
 run anderson mode=steady seed=1 run.duration=120 steady.solver=anderson steady.warmup=60 steady.tau=20 \
   steady.max_iterations=8 steady.eigenvalues=0

@@ -9,15 +9,6 @@
 
 namespace efdem::coarse {
 
-namespace {
-
-/// Standard error of the members' mean, per component (one row per member, at least two).
-Eigen::VectorXd member_standard_error(const Eigen::MatrixXd& m) {
-    return (ensemble_variance(m, ensemble_mean(m)) / static_cast<double>(m.rows())).cwiseSqrt();
-}
-
-}  // namespace
-
 CoarseMap::CoarseMap(CoarseStepper& stepper, const CoarseMapSettings& settings,
                      std::function<void(double)> set_parameter)
     : stepper_(stepper), settings_(settings), set_parameter_(std::move(set_parameter)) {
@@ -53,13 +44,13 @@ MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
     double state_noise = 0.0;
     if (!burst.members.empty() && burst.members.back().rows() >= 2) {
         const Eigen::MatrixXd& m = burst.members.back();
-        e.standard_error = member_standard_error(m);  // in X
+        e.standard_error = ensemble_standard_error(m);  // in X
         state_noise = e.standard_error.norm();
         e.members = m;
         if (coordinates_) {
             for (Eigen::Index r = 0; r < m.rows(); ++r)
                 e.members.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
-            e.standard_error = member_standard_error(e.members);  // in u
+            e.standard_error = ensemble_standard_error(e.members);  // in u
         }
     }
     e.noise_norm = e.standard_error.norm();
@@ -98,7 +89,7 @@ Eigen::VectorXd CoarseMap::derivative(const Eigen::VectorXd& v, double dparamete
     derivative_noise_ = 0.0;
     if (base_.members.rows() >= 2 && e.members.rows() == base_.members.rows()) {
         const Eigen::MatrixXd d = (e.members - base_.members) * (length / h);
-        derivative_noise_ = member_standard_error(d).norm();
+        derivative_noise_ = ensemble_standard_error(d).norm();
     }
     return (e.phi - base_.phi) * (length / h);
 }

@@ -108,6 +108,7 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
     double before = map_.micro_time();
     FixedPointSystem first(map_, n, lambda0);
     SteadySolveRecord rec = newton_.solve(first, x0);
+    branch.first_solve = rec;
     if (!rec.converged()) {
         branch.end_reason = fmt::format("the first point at parameter = {:.6g} did not converge: {}",
                                         lambda0 * settings_.display_scale, rec.message);

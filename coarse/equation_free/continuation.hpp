@@ -88,6 +88,9 @@ struct FoldEstimate {
 struct Branch {
     std::vector<BranchPoint> points;
     std::string end_reason;
+    /// The first point's Newton solve (in the solver's coordinates): its residual history is
+    /// what a user needs when the first point did not converge.
+    SteadySolveRecord first_solve;
     double micro_time = 0;
     long evaluations = 0;
     /// Where the parameter turns (consecutive differences change sign).

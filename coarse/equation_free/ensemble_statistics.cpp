@@ -18,4 +18,9 @@ Eigen::VectorXd ensemble_variance(const Eigen::MatrixXd& rows, const Eigen::Vect
     return var / static_cast<double>(rows.rows() - 1);
 }
 
+Eigen::VectorXd ensemble_standard_error(const Eigen::MatrixXd& rows) {
+    EFDEM_EXPECTS(rows.rows() >= 2);
+    return (ensemble_variance(rows, ensemble_mean(rows)) / static_cast<double>(rows.rows())).cwiseSqrt();
+}
+
 }  // namespace efdem::coarse

@@ -13,5 +13,7 @@ namespace efdem::coarse {
 Eigen::VectorXd ensemble_mean(const Eigen::MatrixXd& rows);
 /// Unbiased column variances (divisor R - 1; zeros when R = 1).
 Eigen::VectorXd ensemble_variance(const Eigen::MatrixXd& rows, const Eigen::VectorXd& mean);
+/// Standard error of the column means, sqrt(variance / R). \pre R >= 2.
+Eigen::VectorXd ensemble_standard_error(const Eigen::MatrixXd& rows);
 
 }  // namespace efdem::coarse

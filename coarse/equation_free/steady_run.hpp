@@ -34,6 +34,10 @@ struct SteadyRunOutcome {
     std::string solver;     ///< "newton" or "anderson"
     std::string coordinates = "heights";  ///< what the solver worked in (CoarseCoordinates::name)
     double tau = 0;         ///< micro time of one evaluation
+    /// h of the CRN differences, in the solver's coordinates, and where it came from (the scene
+    /// key, or the noise measured at the end of the warm-up).
+    double difference_step = 0;
+    std::string difference_step_origin;
     double warmup_end = 0;  ///< micro clock at the end of the warm-up
     Eigen::VectorXd x0;     ///< the initial guess (last warm-up sample)
     /// mode = steady: the solve, and the spectrum at its answer (empty: not computed).
@@ -72,6 +76,10 @@ class SteadyRun {
     SteadyRunOutcome header() const;
 
   private:
+    /// h for the CRN differences after the warm-up `warm`: steady.difference_step, or
+    /// difference_noise_multiple x the noise norm of its last sample's members in the solver's
+    /// coordinates (the scene's fallback without two members). Sets out.difference_step(_origin).
+    double difference_step(const BurstSamples& warm, SteadyRunOutcome& out) const;
     void solve_steady(CoarseMap& map, SteadyRunOutcome& out);
     void continue_branch(CoarseMap& map, SteadyRunOutcome& out);
     Branch unscaled(const Branch& branch) const;

@@ -40,7 +40,10 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     s.map.tau = steady.get_or<double>("tau", 20.0, Bounds::open_closed(0.0, 1e7));
     whole_multiple(steady, "tau", s.map.tau, sample_interval, interval);
     s.gap_coordinates = steady.get_or_choice("coordinates", "heights", {"heights", "gaps"}) == "gaps";
-    // In log gaps 0.2 changes the gaps by about 20 % at most; in heights 0.5 d_p over the nodes.
+    // Absent: derived from the noise at the end of the warm-up (SteadyRun::run); what it falls
+    // back to without members to measure it (in log gaps 0.2 changes the gaps by about 20 % at
+    // most; in heights 0.5 d_p over the nodes).
+    s.difference_step_from_noise = newton && !steady.contains("difference_step");
     s.map.difference_step =
         steady.get_or<double>("difference_step", s.gap_coordinates ? 0.2 : 0.5, Bounds::open_closed(0.0, 1e3));
     s.map.common_random_numbers = newton;  // Anderson needs no kept state

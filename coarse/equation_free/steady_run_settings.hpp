@@ -12,7 +12,7 @@
 /// |                           | sample is the initial guess                                 |          |
 /// | steady.tau                | micro time of one evaluation of Phi_tau                     | 20       |
 /// | steady.coordinates        | `heights` (the ICDF nodes) or `gaps` (first node, log gaps) | heights  |
-/// | steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 0.5/0.2  |
+/// | steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 6 x noise|
 /// | steady.tolerance          | absolute floor of the stopping rule on \|F\|                | 1e-10    |
 /// | steady.noise_factor       | stop at \|F\| <= this x the noise of F                      | 2        |
 /// | steady.max_iterations     | Newton steps (newton) / iterations (anderson)               | 8 / 40   |
@@ -55,6 +55,16 @@ struct SteadyRunSettings {
     bool gap_coordinates = false;
     double warmup = 20.0;
     CoarseMapSettings map;
+    /// steady.difference_step absent (newton): h = difference_noise_multiple x the noise norm of
+    /// the warm-up's last sample, measured from the members in the solver's coordinates
+    /// (SteadyRun::difference_step); map.difference_step is the fallback without members.
+    bool difference_step_from_noise = false;
+    /// The CRN difference leaves up to sqrt(2) |SE| of noise in Phi(X + h v) - Phi(X) after a
+    /// chaotic burst (measured on the demo bed), so J v carries ~sqrt(2)/6 = 0.24 per unit |v|:
+    /// a quarter to a half of |J_F v| >= 1 - |mu| for the slow modes (|mu| <= 0.5), while h stays
+    /// a few noise widths, where the ICDF's response is still nearly linear (DEM: h = 2 d_p
+    /// converged, 0.5 gave J v as noisy as itself; docs/steady_states.md).
+    double difference_noise_multiple = 6.0;
     NewtonKrylovSettings newton;
     FixedPointSettings fixed_point;
     /// eigenvalues == 0 in `spectrum_wanted`: no spectrum.

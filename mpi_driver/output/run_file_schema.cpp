@@ -101,7 +101,7 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/steady/iterate/x", "d_p", "the iterate's coarse vector", iterate_node},
         {"/steady/x0", "d_p", "the initial guess: the ensemble mean at the end of the warm-up", steady_node},
         {"/steady/x", "d_p", "mode = steady: the last iterate (the answer when the solve converged)", steady_node},
-        {"/steady/best", "d_p", "mode = steady: the iterate with the smallest |F| (saved also when the solve did not converge)", steady_node},
+        {"/steady/best", "d_p", "mode = steady: the iterate with the smallest |F| (saved also when the solve did not converge); mode = continuation: the first point's, when it did not converge", steady_node},
         {"/steady/krylov_products", "1", "newton: GMRES products (J v, one burst each) per Newton step", newton_step},
         {"/steady/step_length", "1", "line-search factor (newton) or damping (anderson) per step", newton_step},
         {"/steady/gmres_residual", "d_p", "newton: GMRES residual |F + J d| before the first product and after each product", gmres},

@@ -228,3 +228,60 @@ TEST_CASE("gap coordinates: every lifted point is an increasing ICDF, the answer
     REQUIRE(out.spectrum.leading.size() == 1);
     CHECK(out.spectrum.leading.front().rate == Approx(-0.1).margin(1e-5));
 }
+
+TEST_CASE("SteadyRun: without steady.difference_step, h is 6 x the noise at the end of the warm-up",
+          "[unit][steady]") {
+    // Three independent Ornstein-Uhlenbeck components dY = -k (Y - c) dt + sigma dW in 64
+    // members, all started at c: after the warm-up T a member's variance is
+    // sigma^2 (1 - e^{-2kT}) / 2k, so the noise norm of the mean is known in closed form.
+    const Eigen::Vector3d k(0.5, 1.0, 2.0), c(1.0, -2.0, 3.0);
+    constexpr double kSigma = 0.1, kWarmup = 4.0;
+    constexpr int kMembers = 64;
+    auto drift = [k, c](const Eigen::VectorXd& y, double) -> Eigen::VectorXd {
+        return (-k.array() * (y - c).array()).matrix();
+    };
+    SteadyRunSettings s = newton_settings();
+    s.warmup = kWarmup;
+    s.map.tau = 2.0;
+    s.map.common_random_numbers = true;
+    s.map.difference_step = 0.5;  // what the scene's default would be
+    s.difference_step_from_noise = true;
+    s.newton.max_iterations = 2;
+    s.eigenvalues = 0;
+    double expected2 = 0;
+    for (int i = 0; i < 3; ++i)
+        expected2 += kSigma * kSigma * (1.0 - std::exp(-2.0 * k[i] * kWarmup)) / (2.0 * k[i]) / kMembers;
+    const double expected = std::sqrt(expected2);  // 0.0164
+
+    SECTION("derived from the members' spread") {
+        test::SdeEnsembleStepper toy(drift, kSigma, kMembers, 0.05, 10, c, 3);
+        const SteadyRunOutcome out = SteadyRun(s, toy, {}).run();
+        // The sample variance of 64 members has 63 degrees of freedom: ~9 % relative spread
+        // per component, ~5 % in the norm over three; 25 % is five of those.
+        CHECK(out.difference_step == Approx(s.difference_noise_multiple * expected).epsilon(0.25));
+        CHECK(out.difference_step_origin.find("x the noise norm") != std::string::npos);
+        // Exactly what the same warm-up's members give (the same seed).
+        test::SdeEnsembleStepper twin(drift, kSigma, kMembers, 0.05, 10, c, 3);
+        BurstSamples warm;
+        twin.run(kWarmup, warm);
+        const Eigen::MatrixXd& m = warm.members.back();
+        const Eigen::VectorXd mean = m.colwise().mean().transpose();
+        double se2 = 0;
+        for (Eigen::Index i = 0; i < m.cols(); ++i)
+            se2 += (m.col(i).array() - mean[i]).square().sum() / (kMembers - 1) / kMembers;
+        CHECK(out.difference_step == Approx(s.difference_noise_multiple * std::sqrt(se2)).epsilon(1e-12));
+    }
+    SECTION("set in the scene: used as it is") {
+        s.difference_step_from_noise = false;
+        test::SdeEnsembleStepper toy(drift, kSigma, kMembers, 0.05, 10, c, 3);
+        const SteadyRunOutcome out = SteadyRun(s, toy, {}).run();
+        CHECK(out.difference_step == 0.5);
+        CHECK(out.difference_step_origin == "steady.difference_step");
+    }
+    SECTION("one member: no spread to measure, the default") {
+        test::SdeEnsembleStepper toy(drift, kSigma, 1, 0.05, 10, c, 3);
+        const SteadyRunOutcome out = SteadyRun(s, toy, {}).run();
+        CHECK(out.difference_step == 0.5);
+        CHECK(out.difference_step_origin.find("fewer than two realizations") != std::string::npos);
+    }
+}

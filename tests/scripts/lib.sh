@@ -11,3 +11,11 @@ launcher=("$@")
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# expect_exit CODE LOG COMMAND...: runs COMMAND with its output to LOG and fails the script
+# (showing LOG) unless COMMAND exits with CODE.
+expect_exit() {
+  local code=$1 log=$2 rc=0
+  shift 2
+  "$@" > "$log" 2>&1 || rc=$?
+  [ "$rc" = "$code" ] || { echo "${*:1:3}...: exit $rc, expected $code"; cat "$log"; exit 1; }
+}

@@ -47,7 +47,10 @@ assert len(s["gmres_residual"]) == s["krylov_products"][0] + 1
 assert s.attrs["dem_time"] == s.attrs["evaluations"] * 1.0
 # Out of iterations: the leading eigenvalue is computed at the best iterate (2 products).
 assert len(s["eigenvalue_real"]) == 1 and s.attrs["eigenvalue_products"] == 2
-print("steady: not converged as asked, best iterate saved; |F| =", r)
+# No steady.difference_step in the scene: h from the noise at the end of the warm-up (R = 4).
+assert "x the noise norm" in str(s.attrs["difference_step_origin"]), s.attrs["difference_step_origin"]
+assert s.attrs["difference_step"] > 0
+print("steady: not converged as asked, best iterate saved; |F| =", r, "; h =", s.attrs["difference_step"])
 PY
 
 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=continuation continuation.parameter=gas_drag.superficial_velocity \
@@ -70,6 +73,23 @@ assert held[0] == 0 and set(held) <= {0, 1}, held  # the first point has no pred
 print("continuation: branch", lam, "corrector from the last point:", held)
 PY
 /usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/branch.h5" "$work/branch.h5" -o "$work/branch.png"
+
+# 3b. A continuation whose first point cannot converge (no Newton step, a stopping rule far below
+#     the noise) exits 3 with the first point's residual history and its best iterate saved.
+expect_exit 3 "$work/branch_failed.log" "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=continuation \
+  continuation.parameter=gas_drag.superficial_velocity continuation.end=0.5 continuation.step=0.05 \
+  continuation.max_points=2 run.duration=0 steady.warmup=1 steady.tau=1 steady.max_iterations=0 steady.eigenvalues=0 \
+  steady.noise_factor=0.001 output.directory="$work" output.prefix=branch_failed
+grep -qE "residual history \|F\| \[d_p\]: [0-9]" "$work/branch_failed.log" || { echo "no residual history"; cat "$work/branch_failed.log"; exit 1; }
+/usr/bin/python3 "$here/check_run_file.py" "$work/branch_failed.h5"
+/usr/bin/python3 - "$work/branch_failed.h5" <<'PY'
+import sys, h5py, numpy as np
+s = h5py.File(sys.argv[1])["steady"]
+assert str(s.attrs["end_status"]).startswith("not converged"), s.attrs["end_status"]
+assert np.array_equal(s["best"][:], s["iterate/x"][0])  # the only iterate: the warm-up's end
+assert s.attrs["best_residual"] == s["iterate/residual"][0]
+print("continuation: first point not converged, best iterate saved")
+PY
 /usr/bin/python3 "$here/../../scripts/plot_steady.py" "$work/np2.h5" -o "$work/steady.png"
 [ -s "$work/branch.png" ] && [ -s "$work/steady.png" ]
 
