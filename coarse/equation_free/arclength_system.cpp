@@ -1,16 +1,21 @@
 #include "coarse/equation_free/arclength_system.hpp"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "core/contracts.hpp"
+#include "core/log.hpp"
 
 namespace efdem::coarse {
 
-ArclengthSystem::ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted)
-    : map_(map), tangent_(std::move(tangent)), predicted_(std::move(predicted)) {
+ArclengthSystem::ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted,
+                                 double lambda_min, double lambda_max)
+    : map_(map), tangent_(std::move(tangent)), predicted_(std::move(predicted)), lambda_min_(lambda_min),
+      lambda_max_(lambda_max) {
     EFDEM_EXPECTS(map_.has_parameter() && tangent_.size() == predicted_.size() && tangent_.size() >= 2);
     EFDEM_EXPECTS(std::abs(tangent_.norm() - 1.0) < 1e-12);
+    EFDEM_EXPECTS(lambda_min_ <= predicted_[predicted_.size() - 1] && predicted_[predicted_.size() - 1] <= lambda_max_);
 }
 
 SystemEvaluation ArclengthSystem::assemble(const MapEvaluation& e, const Eigen::VectorXd& y) const {
@@ -26,7 +31,7 @@ SystemEvaluation ArclengthSystem::assemble(const MapEvaluation& e, const Eigen::
 }
 
 SystemEvaluation ArclengthSystem::begin(const Eigen::VectorXd& y) {
-    EFDEM_EXPECTS(y.size() == dimension());
+    EFDEM_EXPECTS(y.size() == dimension() && lambda_min_ <= y[y.size() - 1] && y[y.size() - 1] <= lambda_max_);
     const Eigen::Index n = y.size() - 1;
     return assemble(map_.begin(y.head(n), y[n]), y);
 }
@@ -43,6 +48,13 @@ Eigen::VectorXd ArclengthSystem::jacobian_times(const Eigen::VectorXd& v) {
 SystemEvaluation ArclengthSystem::trial(const Eigen::VectorXd& y) {
     EFDEM_EXPECTS(y.size() == dimension());
     const Eigen::Index n = y.size() - 1;
+    if (!(lambda_min_ <= y[n] && y[n] <= lambda_max_)) {  // not run: no decrease
+        log::info("arclength trial at lambda = {:.6g} outside [{:.6g}, {:.6g}]: not evaluated", y[n], lambda_min_,
+                  lambda_max_);
+        SystemEvaluation out;
+        out.g = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::infinity());
+        return out;
+    }
     return assemble(map_.evaluate_from_base(y.head(n), y[n]), y);
 }
 

@@ -126,6 +126,10 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             ds = std::clamp(settings_.parameter_step / std::max(std::abs(t[n]), 1e-12), settings_.min_step,
                             settings_.max_step);
         branch.end_reason = fmt::format("{} points (the limit)", settings_.max_points);
+        // No corrector runs the micro model beyond one parameter step outside the range.
+        const double margin = settings_.max_parameter_step > 0.0 ? settings_.max_parameter_step
+                                                                   : settings_.parameter_max - settings_.parameter_min;
+        const double lambda_lo = settings_.parameter_min - margin, lambda_hi = settings_.parameter_max + margin;
         while (static_cast<int>(branch.points.size()) < settings_.max_points) {
             before = map_.micro_time();
             const auto [step, lands] = predictor_step(ds, y[n], t[n]);
@@ -136,9 +140,15 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             const Eigen::VectorXd predicted = y + step * t;
             // The last point is solved at the end of the range itself: its constraint row is
             // lambda = end instead of the arclength (regular unless a fold sits exactly there).
-            ArclengthSystem system(map_, lands ? Eigen::VectorXd(Eigen::VectorXd::Unit(n + 1, n)) : t, predicted);
-            FallbackGuess held{y, settings_.fallback_ratio};
+            const Eigen::VectorXd hold_lambda = Eigen::VectorXd::Unit(n + 1, n);
+            ArclengthSystem system(map_, lands ? hold_lambda : t, predicted, lambda_lo, lambda_hi);
+            // The fallback: the last point at the predicted parameter, corrected with lambda held
+            // there (its constraint row is 0 at the start; in the arclength row of a noisy
+            // tangent it would be -ds |t_X|^2, which the line search would trade against |F|).
+            FallbackGuess held{y, settings_.fallback_ratio, nullptr};
             held.y[n] = predicted[n];
+            ArclengthSystem natural(map_, hold_lambda, held.y, lambda_lo, lambda_hi);
+            held.system = &natural;
             rec = newton_.solve(system, predicted, &held);
             if (rec.reason == SteadyStopReason::stopped) {
                 branch.end_reason = fmt::format("stopped after parameter = {:.6g}: {}", y[n] * settings_.display_scale, rec.message);

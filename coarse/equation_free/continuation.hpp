@@ -9,9 +9,12 @@
 ///   predictor:   y_pred = y_k + ds t (t: the secant (y_k - y_{k-1})/|.| after the first step,
 ///                which keeps its orientation through a fold);
 ///   corrector:   Newton-Krylov on [F(X; lambda); t . (y - y_pred)] = 0 (ArclengthSystem),
-///                from y_pred or, when |F(y_pred)| is above fallback_ratio x the stopping
-///                threshold and the last point at the predicted parameter, (X_k, lambda_pred),
-///                is closer to steady, from that (a noisy secant can overshoot the branch);
+///                from y_pred or, when |G(y_pred)| is above fallback_ratio x the stopping
+///                threshold of a noisy map and the last point at the predicted parameter,
+///                (X_k, lambda_pred), is closer to steady, from that with lambda held there
+///                (row e_lambda instead of t: a noisy tangent can overshoot the branch);
+///   guard:       no corrector runs the micro model at lambda more than max_parameter_step
+///                (or the range's width) outside [parameter_min, parameter_max];
 ///   step size:   ds *= clamp(target / Newton steps, 1/2, 2) within [min_step, max_step];
 ///                a failed corrector halves ds and tries again from the same point.
 ///

@@ -24,40 +24,44 @@ NewtonKrylov::NewtonKrylov(const NewtonKrylovSettings& settings) : settings_(set
                   settings_.forcing < 1.0 && settings_.max_backtracks >= 0);
 }
 
-SystemEvaluation NewtonKrylov::choose_start(NewtonSystem& system, Eigen::VectorXd& y, SystemEvaluation e,
+SystemEvaluation NewtonKrylov::choose_start(NewtonSystem*& system, Eigen::VectorXd& y, SystemEvaluation e,
                                             const FallbackGuess& fallback, SteadySolveRecord& rec) const {
-    EFDEM_EXPECTS(fallback.y.size() == y.size() && fallback.ratio >= 0.0);
-    const double r = e.steady_residual();
+    NewtonSystem& other = fallback.system != nullptr ? *fallback.system : *system;
+    EFDEM_EXPECTS(fallback.y.size() == other.dimension() && fallback.ratio >= 0.0);
+    const double r = e.g.norm();
     rec.first_guess_residual = r;
     // Only a noisy first guess is in doubt: a noise-free map's secant predictor is as good as
     // the branch's smoothness makes it, and would be compared at every point for nothing.
-    const double threshold = settings_.stop.threshold(e.steady_noise());
-    if (e.steady_noise() <= 0.0 || r <= fallback.ratio * threshold) return e;
-    system.end();
-    SystemEvaluation f = system.begin(fallback.y);
-    rec.fallback_residual = f.steady_residual();
+    const double threshold = settings_.stop.threshold(e.noise_norm);
+    if (e.noise_norm <= 0.0 || r <= fallback.ratio * threshold) return e;
+    system->end();
+    SystemEvaluation f = other.begin(fallback.y);
+    rec.fallback_residual = f.g.norm();
     rec.from_fallback = rec.fallback_residual < r;
-    log::info("newton   0: |F| = {:.4e} at the first guess ({:.3g} x the stopping threshold), {:.4e} at the "
+    log::info("newton   0: |G| = {:.4e} at the first guess ({:.3g} x the stopping threshold), {:.4e} at the "
               "fallback guess: starting from the {}",
               r, r / threshold, rec.fallback_residual, rec.from_fallback ? "fallback" : "first guess");
     if (rec.from_fallback) {
         y = fallback.y;
+        system = &other;
         return f;
     }
-    system.end();
-    return system.begin(y);  // afresh: the kept micro state is the fallback's
+    other.end();
+    return system->begin(y);  // afresh: the kept micro state is the fallback's
 }
 
-SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorXd& y0,
+SteadySolveRecord NewtonKrylov::solve(NewtonSystem& first_system, const Eigen::VectorXd& y0,
                                       const FallbackGuess* fallback) const {
-    EFDEM_EXPECTS(y0.size() == system.dimension());
-    const long evaluations0 = system.evaluations();
-    const double micro0 = system.micro_time();
+    EFDEM_EXPECTS(y0.size() == first_system.dimension());
+    const long evaluations0 = first_system.evaluations();
+    const double micro0 = first_system.micro_time();
     SteadySolveRecord rec;
+    NewtonSystem* solving = &first_system;  // the fallback's own system, if it wins
     Eigen::VectorXd y = y0;
     while (true) {
-        SystemEvaluation e = system.begin(y);
-        if (fallback != nullptr && rec.residuals.empty()) e = choose_start(system, y, std::move(e), *fallback, rec);
+        SystemEvaluation e = solving->begin(y);
+        if (fallback != nullptr && rec.residuals.empty()) e = choose_start(solving, y, std::move(e), *fallback, rec);
+        NewtonSystem& system = *solving;
         const double r = e.g.norm();
         rec.add_iterate(y, r, e.noise_norm, e.state_residual, e.state_noise);
         log::info("newton {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
@@ -122,8 +126,8 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& system, const Eigen::VectorX
         ++rec.iterations;
         y += s * lin.x;
     }
-    rec.evaluations = system.evaluations() - evaluations0;
-    rec.micro_time = system.micro_time() - micro0;
+    rec.evaluations = solving->evaluations() - evaluations0;
+    rec.micro_time = solving->micro_time() - micro0;
     return rec;
 }
 

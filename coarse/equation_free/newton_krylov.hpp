@@ -31,15 +31,17 @@ struct NewtonKrylovSettings {
 };
 
 /// A second first guess for NewtonKrylov::solve, evaluated only when the first guess is noisy and
-/// far from steady: |F| there above `ratio` x the stopping threshold (both without appended
-/// rows, see SystemEvaluation::steady_residual) and a noise norm > 0. The solve starts from whichever has the smaller |F|;
-/// when that is the first guess, it is evaluated afresh (the kept micro state is the
-/// fallback's), so a fallback costs one or two extra bursts. In continuation the first guess is
-/// the secant predictor, which extrapolates the noise of two corrected points, and the
-/// fallback is the last point at the predicted parameter.
+/// far: |G| there above `ratio` x the stopping threshold, with a noise norm > 0. It may come
+/// with its own system (e.g. a different constraint row), in which the solve then goes on; it
+/// must work on the same micro model (the same evaluation counters). The solve starts from
+/// whichever guess has the smaller |G| in its own system; when that is the first guess, it is
+/// evaluated afresh (the kept micro state is the fallback's): one or two extra bursts. In
+/// continuation the first guess is the predictor, whose tangent carries the noise of the points
+/// it came from, and the fallback is the last point at the predicted parameter, held there.
 struct FallbackGuess {
     Eigen::VectorXd y;
     double ratio = 2.0;
+    NewtonSystem* system = nullptr;  ///< nullptr: the solve's own system
 };
 
 class NewtonKrylov {
@@ -47,14 +49,14 @@ class NewtonKrylov {
     explicit NewtonKrylov(const NewtonKrylovSettings& settings);
     /// Solves G(y) = 0 from y0. Leaves no base on `system`. Never throws for a numerical
     /// condition: the record says why it stopped.
-    SteadySolveRecord solve(NewtonSystem& system, const Eigen::VectorXd& y0,
+    SteadySolveRecord solve(NewtonSystem& first_system, const Eigen::VectorXd& y0,
                             const FallbackGuess* fallback = nullptr) const;
     const NewtonKrylovSettings& settings() const { return settings_; }
 
   private:
-    /// The first iterate's evaluation: of y (evaluated as e) or, if closer to steady, of the
-    /// fallback (then y becomes it); records both residuals in rec.
-    SystemEvaluation choose_start(NewtonSystem& system, Eigen::VectorXd& y, SystemEvaluation e,
+    /// The first iterate's evaluation: of y in *system (evaluated as e) or, if closer to steady,
+    /// of the fallback (then y and system become its); records both residuals in rec.
+    SystemEvaluation choose_start(NewtonSystem*& system, Eigen::VectorXd& y, SystemEvaluation e,
                                   const FallbackGuess& fallback, SteadySolveRecord& rec) const;
 
     NewtonKrylovSettings settings_;

@@ -5,7 +5,6 @@
 /// FixedPointSystem is G = F = Phi_tau - X; ArclengthSystem (continuation) appends the
 /// pseudo-arclength row.
 
-#include <cmath>
 #include <limits>
 
 #include <Eigen/Core>
@@ -19,10 +18,6 @@ struct SystemEvaluation {
     /// state_noise_norm), for the record; NaN: the same as |g| and noise_norm.
     double state_residual = std::numeric_limits<double>::quiet_NaN();
     double state_noise = std::numeric_limits<double>::quiet_NaN();
-
-    /// |F| of the point in X, without rows a system appends (an arclength constraint).
-    double steady_residual() const { return std::isnan(state_residual) ? g.norm() : state_residual; }
-    double steady_noise() const { return std::isnan(state_noise) ? noise_norm : state_noise; }
 };
 
 class NewtonSystem {

@@ -1,5 +1,6 @@
 #include "coarse/equation_free/steady_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -57,40 +58,53 @@ SteadyRunOutcome SteadyRun::header() const {
     out.coordinates = coordinates_ ? coordinates_.name : "heights";
     out.parameter = settings_.parameter;
     out.parameter_scale = settings_.parameter_scale;
+    out.difference_step = difference_step_;
+    out.difference_step_origin = difference_step_origin_;
     return out;
 }
 
-double SteadyRun::difference_step(const BurstSamples& warm, SteadyRunOutcome& out) const {
-    out.difference_step = settings_.map.difference_step;
+double SteadyRun::difference_step(const BurstSamples& warm) {
+    difference_step_ = settings_.map.difference_step;
     if (settings_.solver == SteadyRunSettings::Solver::anderson) {
-        out.difference_step_origin = "unused: steady.solver = anderson takes no derivatives";
-        return out.difference_step;
+        difference_step_origin_ = "unused: steady.solver = anderson takes no derivatives";
+        return difference_step_;
     }
     if (!settings_.difference_step_from_noise) {
-        out.difference_step_origin = "steady.difference_step";
-        return out.difference_step;
+        difference_step_origin_ = "steady.difference_step";
+        return difference_step_;
     }
     if (warm.members.empty() || warm.members.back().rows() < 2) {
-        out.difference_step_origin = "default (fewer than two realizations: no noise to derive it from)";
+        difference_step_origin_ = "default (fewer than two realizations: no noise to derive it from)";
         log::info("steady: difference step h = {:g}, the default: with fewer than two realizations there is no "
                   "noise to derive it from",
-                  out.difference_step);
-        return out.difference_step;
+                  difference_step_);
+        return difference_step_;
     }
     Eigen::MatrixXd m = warm.members.back();
     if (coordinates_)
         for (Eigen::Index r = 0; r < m.rows(); ++r) m.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
     const double noise = ensemble_standard_error(m).norm();
     if (!(noise > 0.0)) {
-        out.difference_step_origin = "default (the realizations agree exactly: no noise to derive it from)";
-        return out.difference_step;
+        difference_step_origin_ = "default (the realizations agree exactly: no noise to derive it from)";
+        return difference_step_;
     }
-    out.difference_step = settings_.difference_noise_multiple * noise;
-    out.difference_step_origin =
-        fmt::format("{:g} x the noise norm {:.4g} at the end of the warm-up", settings_.difference_noise_multiple, noise);
-    log::info("steady: difference step h = {:.4g} ({}; set steady.difference_step to choose it)", out.difference_step,
-              out.difference_step_origin);
-    return out.difference_step;
+    // A perturbation of norm 1 in log gaps changes a gap by up to a factor e; in heights a
+    // quarter of |X| moves the nodes by about a quarter of their mean: beyond either the
+    // response is no longer a derivative.
+    const double cap = coordinates_ ? 1.0 : 0.25 * warm.x.back().norm();
+    const double wanted = settings_.difference_noise_multiple * noise;
+    difference_step_ = std::min(wanted, cap);
+    difference_step_origin_ = fmt::format("{:g} x the noise norm {:.4g} at the end of the warm-up{}",
+                                          settings_.difference_noise_multiple, noise,
+                                          wanted > cap ? fmt::format(", capped at {:.3g}", cap) : std::string{});
+    log::info("steady: difference step h = {:.4g} ({}; set steady.difference_step to choose it)", difference_step_,
+              difference_step_origin_);
+    if (wanted > cap)
+        log::warn("steady: the noise asks for a difference step of {:.3g}, more than the {:.3g} at which the "
+                  "coarse map's response stops being a derivative: J v will be noisy; more realizations lower "
+                  "the noise (as 1/sqrt(R)){}",
+                  wanted, cap, coordinates_ ? ", and steady.coordinates = heights measures it in d_p" : "");
+    return difference_step_;
 }
 
 SteadyRunOutcome SteadyRun::run() {
@@ -110,7 +124,9 @@ SteadyRunOutcome SteadyRun::run() {
         hook = [this, scale](double lambda) { set_parameter_(lambda * scale); };
     }
     CoarseMapSettings map_settings = settings_.map;
-    map_settings.difference_step = difference_step(warm, out);
+    map_settings.difference_step = difference_step(warm);
+    out.difference_step = difference_step_;
+    out.difference_step_origin = difference_step_origin_;
     CoarseMap map(stepper_, map_settings, hook);
     if (repair_) map.set_repair(repair_);
     if (coordinates_) map.set_coordinates(coordinates_);

@@ -78,8 +78,9 @@ class SteadyRun {
   private:
     /// h for the CRN differences after the warm-up `warm`: steady.difference_step, or
     /// difference_noise_multiple x the noise norm of its last sample's members in the solver's
-    /// coordinates (the scene's fallback without two members). Sets out.difference_step(_origin).
-    double difference_step(const BurstSamples& warm, SteadyRunOutcome& out) const;
+    /// coordinates (the scene's fallback without two members), at most a curvature cap (1 in
+    /// log gaps, a quarter of |X| in heights). Kept for header().
+    double difference_step(const BurstSamples& warm);
     void solve_steady(CoarseMap& map, SteadyRunOutcome& out);
     void continue_branch(CoarseMap& map, SteadyRunOutcome& out);
     Branch unscaled(const Branch& branch) const;
@@ -95,6 +96,8 @@ class SteadyRun {
     std::function<void(double)> set_parameter_;
     IterateObserver iterate_observer_;
     BranchObserver point_observer_;
+    double difference_step_ = 0;  ///< once the warm-up is done (0 before)
+    std::string difference_step_origin_;
 };
 
 /// Segregation measure of a coarse ICDF: the mean of its nodes, an estimate of the observed

@@ -30,6 +30,8 @@
 /// | continuation.scale        | parameter change that weighs as 1 unit of the coarse vector | 0.01     |
 /// |                           | in the arclength                                            |          |
 /// | continuation.max_points   | branch points, the first included                           | 12       |
+/// | continuation.predictor_fallback | |G| at the predictor above this x the stopping        | 2        |
+/// |                           | threshold: try the last point, the parameter held there     |          |
 ///
 /// Newton-only keys are refused with steady.solver = anderson and the other way round;
 /// continuation.* keys are refused outside mode = continuation, which always uses Newton.
@@ -61,7 +63,7 @@ struct SteadyRunSettings {
     bool difference_step_from_noise = false;
     /// The CRN difference leaves up to sqrt(2) |SE| of noise in Phi(X + h v) - Phi(X) after a
     /// chaotic burst (measured on the demo bed), so J v carries ~sqrt(2)/6 = 0.24 per unit |v|:
-    /// a quarter to a half of |J_F v| >= 1 - |mu| for the slow modes (|mu| <= 0.5), while h stays
+    /// a quarter to a half of |J_F v| >= 1 - |mu| for the slow modes (0.6 on the demo bed), while h stays
     /// a few noise widths, where the ICDF's response is still nearly linear (DEM: h = 2 d_p
     /// converged, 0.5 gave J v as noisy as itself; docs/steady_states.md).
     double difference_noise_multiple = 6.0;

@@ -61,8 +61,9 @@ struct SteadySolveRecord {
     /// product j (krylov_iterations[k] + 1 values; empty: fixed point).
     std::vector<std::vector<double>> gmres_residuals;
     std::vector<double> step_lengths;    ///< line-search / damping factor per step
-    /// With a fallback guess (NewtonKrylov::solve): |F| at the first guess and at the fallback
-    /// (NaN: not evaluated, the first guess was close enough), and which the solve started from.
+    /// With a fallback guess (NewtonKrylov::solve): |G| at the first guess and at the fallback,
+    /// each in its own system (NaN: not evaluated, the first guess was close enough or the map
+    /// noise-free), and which the solve started from.
     double first_guess_residual = std::numeric_limits<double>::quiet_NaN();
     double fallback_residual = std::numeric_limits<double>::quiet_NaN();
     bool from_fallback = false;

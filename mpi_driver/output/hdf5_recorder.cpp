@@ -320,8 +320,10 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
     file_.attribute("/steady", "solver", o.solver);
     file_.attribute("/steady", "coordinates", o.coordinates);
     file_.attribute("/steady", "tau", o.tau);
-    file_.attribute("/steady", "difference_step", o.difference_step);
-    file_.attribute("/steady", "difference_step_origin", o.difference_step_origin);
+    if (!o.difference_step_origin.empty()) {  // known once the warm-up is done
+        file_.attribute("/steady", "difference_step", o.difference_step);
+        file_.attribute("/steady", "difference_step_origin", o.difference_step_origin);
+    }
     file_.attribute("/steady", "warmup_end", o.warmup_end);
     file_.attribute("/steady", "evaluations", std::int64_t{o.evaluations});
     file_.attribute("/steady", "dem_time", o.micro_time);
@@ -340,7 +342,7 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
             file_.write("/branch/fold_parameter", folds, {static_cast<hsize_t>(folds.size())});
             document("/branch/fold_parameter");
         }
-        if (!o.converged && o.solve.best.size() == dim_) {  // the first point did not converge
+        if (o.branch.points.empty() && o.solve.best.size() == dim_) {  // the first point did not converge
             file_.attribute("/steady", "best_residual", o.solve.best_state_residual());
             vector("/steady/best", o.solve.best);
         }

@@ -271,6 +271,13 @@ TEST_CASE("SteadyRun: without steady.difference_step, h is 6 x the noise at the 
             se2 += (m.col(i).array() - mean[i]).square().sum() / (kMembers - 1) / kMembers;
         CHECK(out.difference_step == Approx(s.difference_noise_multiple * std::sqrt(se2)).epsilon(1e-12));
     }
+    SECTION("more than the map's curvature allows: capped at a quarter of |X|, with a warning") {
+        s.difference_noise_multiple = 1e4;  // ~160, against |X| = |(1, -2, 3)| = 3.7
+        test::SdeEnsembleStepper toy(drift, kSigma, kMembers, 0.05, 10, c, 3);
+        const SteadyRunOutcome out = SteadyRun(s, toy, {}).run();
+        CHECK(out.difference_step == Approx(0.25 * out.x0.norm()).epsilon(1e-12));
+        CHECK(out.difference_step_origin.find("capped at") != std::string::npos);
+    }
     SECTION("set in the scene: used as it is") {
         s.difference_step_from_noise = false;
         test::SdeEnsembleStepper toy(drift, kSigma, kMembers, 0.05, 10, c, 3);

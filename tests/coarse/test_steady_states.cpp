@@ -5,7 +5,9 @@
 // iteration against Newton.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +16,7 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include "coarse/equation_free/arclength_system.hpp"
 #include "coarse/equation_free/coarse_map.hpp"
 #include "coarse/equation_free/coarse_spectrum.hpp"
 #include "coarse/equation_free/continuation.hpp"
@@ -385,7 +388,7 @@ TEST_CASE("a fallback first guess is tried only when the first guess is noisy an
     CallLog system(fixed);
     const NewtonKrylov newton{NewtonKrylovSettings{}};
     // The noise norm of F is ~0.01 (64 members, sigma = 0.1), the threshold 2 x that; F at an
-    // offset d is ~(1 - e^(-k tau)) d, so an offset of 1 is ~30 x the threshold, 0.02 below it.
+    // offset d is ~(1 - e^(-k tau)) d, so an offset of 1 is ~30 x the threshold, 0.002 below it.
     const Eigen::Vector3d far = c.c + Eigen::Vector3d::Constant(1.0);
     const Eigen::Vector3d near = c.c + Eigen::Vector3d::Constant(0.3);
     const Eigen::Vector3d steady = c.c + Eigen::Vector3d::Constant(0.002);
@@ -439,4 +442,102 @@ TEST_CASE("a noise-free map never evaluates the fallback: its predictor is as go
     const SteadySolveRecord rec = NewtonKrylov{NewtonKrylovSettings{}}.solve(system, Eigen::Vector4d::Zero(), &fallback);
     CHECK(std::isnan(rec.fallback_residual));
     CHECK(system.calls.substr(0, 2) == "bj");
+}
+
+TEST_CASE("a predictor that overshoots a sharp turn of the branch hands over to the last point held at the new parameter",
+          "[unit][steady]") {
+    // x' = -2 (x - tanh((lambda - 0.15)/0.03)) in two components: the steady state jumps from
+    // -1 to +1 within ~0.1 of lambda. Past the jump the secant through the two points on its
+    // flanks extrapolates the jump (|F| ~ 2 at the predictor) while the last point is already
+    // on the upper plateau: the corrector starts from it, with lambda held.
+    auto drift = [](const Eigen::VectorXd& y, double lambda) -> Eigen::VectorXd {
+        return -2.0 * (y.array() - std::tanh((lambda - 0.15) / 0.03)).matrix();
+    };
+    test::SdeEnsembleStepper toy(drift, 1e-3, 16, 0.01, 10, Eigen::Vector2d(-1, -1), 9);
+    CoarseMap map(toy, noisy_map(true, 1e-2), [&toy](double lambda) { toy.set_parameter(lambda); });
+    ContinuationSettings cs;
+    cs.parameter_step = 0.1;
+    cs.max_parameter_step = 0.1;
+    cs.step = 0.1;
+    cs.max_step = 10.0;
+    cs.min_step = 1e-3;
+    cs.parameter_min = 0.0;
+    cs.parameter_max = 0.6;
+    cs.stability = false;
+    const Branch b = PseudoArclengthContinuation(map, cs).run(Eigen::Vector2d(-1, -1), 0.0, +1.0);
+    INFO(b.end_reason);
+    REQUIRE(b.points.size() >= 5);
+    CHECK(b.end_reason.find("reached the end of the parameter range") != std::string::npos);
+    int held = 0;
+    for (std::size_t k = 0; k < b.points.size(); ++k) {
+        const BranchPoint& p = b.points[k];
+        INFO("point " << k << " at lambda = " << p.parameter << (p.from_fallback ? " (from the last point)" : ""));
+        // Every point is steady to its noise band: F = (e^{-2 tau} - 1)(x - x*) + noise, |F| <=
+        // 2 noise at the stop and |noise| <= 2 noise, so |x - x*| <= 4 noise / (1 - e^{-4})
+        // (noise ~ 1e-4 for sigma = 1e-3 over 16 members).
+        const double x_star = std::tanh((p.parameter - 0.15) / 0.03);
+        CHECK((p.x.array() - x_star).abs().maxCoeff() <= 4.0 * p.noise / (1.0 - std::exp(-4.0)));
+        if (p.from_fallback && k >= 2) {
+            ++held;
+            // Held at the predicted parameter: lambda_{k-1} + ds t_lambda with t the secant
+            // through the two points before, or the end of the range the predictor landed on
+            // (GMRES meets the linear constraint row to its forcing x |G|: 1e-6 is ample).
+            const BranchPoint& q = b.points[k - 1];
+            const BranchPoint& o = b.points[k - 2];
+            const double chord = std::sqrt((q.x - o.x).squaredNorm() + std::pow(q.parameter - o.parameter, 2));
+            const double predicted = std::min(q.parameter + p.step * (q.parameter - o.parameter) / chord, 0.6);
+            CHECK(p.parameter == Approx(predicted).margin(1e-6));
+        }
+    }
+    // At least the first point past the jump: its predictor lands ~2 off, the last point ~0.04.
+    CHECK(held >= 1);
+    // The same branch without the fallback (same seed) ran through the turn in more, shorter
+    // steps after failed correctors: measured 373 evaluations against 285.
+    test::SdeEnsembleStepper again(drift, 1e-3, 16, 0.01, 10, Eigen::Vector2d(-1, -1), 9);
+    CoarseMap map_again(again, noisy_map(true, 1e-2), [&again](double lambda) { again.set_parameter(lambda); });
+    cs.fallback_ratio = 1e6;
+    const Branch without = PseudoArclengthContinuation(map_again, cs).run(Eigen::Vector2d(-1, -1), 0.0, +1.0);
+    CHECK(b.evaluations < without.evaluations);
+    WARN("sharp turn: " << b.points.size() << " points, " << held << " from the last point, " << b.evaluations
+                        << " evaluations (without the fallback: " << without.points.size() << " points, "
+                        << without.evaluations << " evaluations); " << b.end_reason);
+}
+
+TEST_CASE("a fallback with its own system: the solve goes on in it from the fallback's kept state", "[unit][steady]") {
+    const NoisyCase c;
+    test::SdeEnsembleStepper toy = c.stepper(5);
+    CoarseMap map(toy, noisy_map(true, 1e-2));
+    FixedPointSystem fixed(map, 3);
+    CallLog first(fixed), second(fixed);
+    FallbackGuess fallback{c.c + Eigen::Vector3d::Constant(0.3), 2.0, &second};
+    const SteadySolveRecord rec =
+        NewtonKrylov{NewtonKrylovSettings{}}.solve(first, c.c + Eigen::Vector3d::Constant(1.0), &fallback);
+    INFO(rec.message);
+    CHECK(rec.from_fallback);
+    CHECK(first.calls == "be");                   // evaluated once, then left
+    CHECK(second.calls.substr(0, 2) == "bj");     // the fallback's state serves the first products
+    CHECK(rec.converged());
+}
+
+TEST_CASE("an arclength corrector never runs the micro model at a parameter outside its bounds", "[unit][steady]") {
+    test::SdeEnsembleStepper toy(fold_drift, 0.0, 1, 0.01, 10, Eigen::Vector2d(-1, -1), 1);
+    double highest = -std::numeric_limits<double>::infinity();
+    CoarseMap map(toy, deterministic_map(), [&](double lambda) {
+        highest = std::max(highest, lambda);
+        toy.set_parameter(lambda);
+    });
+    const Eigen::Vector3d predicted(-1.0, -1.0, -0.5);
+    ArclengthSystem system(map, Eigen::Vector3d(0.0, 0.0, 1.0), predicted, -0.7, -0.3);
+    system.begin(predicted);
+    const long before = map.evaluations();
+    // A Newton step from a noisy tangent asking for lambda = 5: no decrease, and no burst.
+    const SystemEvaluation out = system.trial(Eigen::Vector3d(-1.0, -1.0, 5.0));
+    CHECK(std::isinf(out.g.norm()));
+    CHECK(map.evaluations() == before);
+    CHECK(highest <= -0.3);
+    // Inside the bounds a trial runs as always.
+    const SystemEvaluation in = system.trial(Eigen::Vector3d(-1.0, -1.0, -0.4));
+    CHECK(std::isfinite(in.g.norm()));
+    CHECK(map.evaluations() == before + 1);
+    system.end();
 }

@@ -147,6 +147,9 @@ refused "one realization" "mode" 1 mode=steady
 refused "checkpoints" "checkpoint.interval" 2 mode=steady checkpoint.interval=2
 refused "an Anderson key with Newton" "steady.depth" 2 mode=steady steady.depth=2
 refused "a continuation key in mode = steady" "continuation.end" 2 mode=steady continuation.end=0.5
+refused "the predictor fallback in mode = steady" "continuation.predictor_fallback" 2 mode=steady continuation.predictor_fallback=1
+refused "a negative predictor fallback" "continuation.predictor_fallback" 2 mode=continuation \
+  continuation.parameter=gas_drag.superficial_velocity continuation.end=0.5 continuation.predictor_fallback=-1
 refused "drop on failure" "ensemble.on_failure" 2 mode=steady ensemble.on_failure=drop
 refused "tau off the sampling grid" "steady.tau" 2 mode=steady steady.tau=0.3
 refused "gap coordinates of the compact vector" "steady.coordinates" 2 mode=steady steady.coordinates=gaps cpi.observable=compact
