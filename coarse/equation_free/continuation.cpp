@@ -37,6 +37,7 @@ std::vector<FoldEstimate> Branch::folds() const {
 PseudoArclengthContinuation::PseudoArclengthContinuation(CoarseMap& map, const ContinuationSettings& settings)
     : map_(map), settings_(settings), newton_(settings.corrector) {
     EFDEM_EXPECTS(map_.has_parameter() && !map_.has_base());
+    EFDEM_EXPECTS(settings_.evaluation_min <= settings_.parameter_min && settings_.parameter_max <= settings_.evaluation_max);
     EFDEM_EXPECTS(0.0 < settings_.min_step && settings_.min_step <= settings_.step &&
                   settings_.step <= settings_.max_step && settings_.max_points >= 1 &&
                   settings_.target_iterations >= 1 && settings_.fallback_ratio >= 0.0);
@@ -129,7 +130,8 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
         // No corrector runs the micro model beyond one parameter step outside the range.
         const double margin = settings_.max_parameter_step > 0.0 ? settings_.max_parameter_step
                                                                    : settings_.parameter_max - settings_.parameter_min;
-        const double lambda_lo = settings_.parameter_min - margin, lambda_hi = settings_.parameter_max + margin;
+        const double lambda_lo = std::max(settings_.parameter_min - margin, settings_.evaluation_min);
+        const double lambda_hi = std::min(settings_.parameter_max + margin, settings_.evaluation_max);
         while (static_cast<int>(branch.points.size()) < settings_.max_points) {
             before = map_.micro_time();
             const auto [step, lands] = predictor_step(ds, y[n], t[n]);

@@ -21,6 +21,7 @@
 /// Each point's stability is the leading eigenvalue of dPhi/dX there (coarse_spectrum.hpp).
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,6 +55,11 @@ struct ContinuationSettings {
     /// predictor heading out of the range is shortened to land on its end (the last point).
     double parameter_min = -1e300;
     double parameter_max = 1e300;
+    /// Where the micro model can be run at all (e.g. a gas velocity >= 0): no corrector
+    /// evaluates beyond, nor beyond one max_parameter_step (or the range's width) outside
+    /// [parameter_min, parameter_max].
+    double evaluation_min = -std::numeric_limits<double>::infinity();
+    double evaluation_max = std::numeric_limits<double>::infinity();
     int target_iterations = 3;  ///< Newton steps per corrector the step size aims at
     /// A predicted point with |F| above this multiple of the stopping threshold is compared
     /// with the last point at the predicted parameter (FallbackGuess: one or two extra bursts).

@@ -116,6 +116,10 @@ SteadyRunSettings SteadyRunSettings::from_params(const Params& root, double samp
     b.parameter_min = std::min(s.parameter_start, s.parameter_end) / s.parameter_scale;
     b.parameter_max = std::max(s.parameter_start, s.parameter_end) / s.parameter_scale;
     b.display_scale = s.parameter_scale;
+    // Every parameter continuation.parameter may name is a velocity-like key in [0, 1000] (the
+    // bounds continuation.end is read with): no corrector runs the DEM outside.
+    b.evaluation_min = 0.0;
+    b.evaluation_max = 1e3 / s.parameter_scale;
     b.stability = s.eigenvalues > 0;
     b.spectrum = s.spectrum;
     b.spectrum.eigenvalues = 1;

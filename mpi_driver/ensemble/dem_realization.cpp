@@ -67,6 +67,10 @@ void DemRealization::set_parameter(const std::string& key, double value) {
     EFDEM_EXPECTS(key == "gas_drag.superficial_velocity");
     auto* gas = dynamic_cast<dem::GasDrag*>(system_.find_effect("gas_drag"));
     if (!gas) throw RuntimeFailure(fmt::format("{} cannot be set: the scene does not list gas_drag in its effects", key));
+    // The scene key's own bounds; the coarse solvers keep to them (ContinuationSettings::
+    // evaluation_min/max), so this is the last line against a value no bed can be run at.
+    if (!(value >= 0.0 && value <= 1e3))
+        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: outside [0, 1000]", key, value));
     gas->set_superficial_velocity(value);
 }
 
