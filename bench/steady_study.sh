@@ -21,7 +21,8 @@
 #              up to 5 Newton steps a point: a first try (2026-12-03, warm-up 100, 3 steps) ended
 #              with the first point at |F| = 1.53 against a threshold of 0.63 after 440 units,
 #              the line search taking 1/8, 1/2, 1/4 of noisy GMRES steps; the corrector's
-#              predictor fallback (continuation.predictor_fallback) on;
+#              predictor fallback (continuation.predictor_fallback) on (2026-12-03: four points
+#              in 1,260 units, 25 min; every corrector started from the last point);
 #   anderson.h5  steady.solver = anderson (no derivatives: Anderson-accelerated fixed point on
 #              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 120 of
 #              DEM time: the cheap option against which Newton is compared.
@@ -29,6 +30,8 @@
 # to bench/results/steady_study/ (committed), and a run whose copy is there is not made again (a
 # fresh clone continues). Compare with
 #   /usr/bin/python3 bench/steady_compare.py bench/results/steady_study [--run anderson]
+#   /usr/bin/python3 scripts/plot_steady.py bench/results/steady_study/branch.h5 \
+#       bench/results/steady_study/branch_low.h5 -o docs/steady_branch.png
 #   bash bench/steady_study.sh [OUT_DIR [RUN...]]   (default runs/steady_study, every run; needs build/)
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
