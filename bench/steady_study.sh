@@ -23,6 +23,9 @@
 #              the line search taking 1/8, 1/2, 1/4 of noisy GMRES steps; the corrector's
 #              predictor fallback (continuation.predictor_fallback) on (2026-12-03: four points
 #              in 1,260 units, 25 min; every corrector started from the last point);
+#   stability_020.h5  the low end's last point again, for its stability: mode = steady at U_s = 0.2
+#              with R = 8 and 6 Arnoldi products (the branch's 2 products at R = 4 left the
+#              leading mu at -0.58 with an upper end of 1.33), warm-up 200, tau = 20;
 #   anderson.h5  steady.solver = anderson (no derivatives: Anderson-accelerated fixed point on
 #              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 120 of
 #              DEM time: the cheap option against which Newton is compared.
@@ -52,8 +55,10 @@ run() {  # NAME overrides...
   if ended "$kept/$name.h5"; then echo "skip $name (kept in bench/results/steady_study)"; return; fi
   if ! ended "$out/$name.h5"; then
     echo "run $name: $*"
+    local r=(ensemble.realizations_per_rank=2)  # R = 4 unless the run asks for more
+    [[ " $* " == *" ensemble.realizations_per_rank="* ]] && r=()
     mpirun -n 2 --oversubscribe "$efdem" "$scene" output.directory="$out" output.prefix="$name" output.overwrite=true \
-      ensemble.realizations_per_rank=2 "$@" > "$out/$name.log" 2>&1 || echo "$name exited $?"
+      "${r[@]}" "$@" > "$out/$name.log" 2>&1 || echo "$name exited $?"
   fi
   if ended "$out/$name.h5"; then cp "$out/$name.h5" "$kept/$name.h5.part" && mv "$kept/$name.h5.part" "$kept/$name.h5"; fi
 }
@@ -68,5 +73,8 @@ run branch_low mode=continuation seed=17 run.duration=0 gas_drag.superficial_vel
   continuation.parameter=gas_drag.superficial_velocity continuation.end=0.2 continuation.step=0.0667 \
   continuation.max_points=4 steady.warmup=200 steady.tau=20 steady.difference_step=2 steady.max_krylov=3 \
   steady.max_iterations=5 steady.eigenvalues=1 steady.eigenvalue_products=2
+run stability_020 mode=steady seed=29 run.duration=0 gas_drag.superficial_velocity=0.2 ensemble.realizations_per_rank=4 \
+  steady.warmup=200 steady.tau=20 steady.difference_step=2 steady.max_krylov=3 steady.max_iterations=4 \
+  steady.eigenvalues=2 steady.eigenvalue_products=6
 run anderson mode=steady seed=1 run.duration=120 steady.solver=anderson steady.warmup=60 steady.tau=20 \
   steady.max_iterations=8 steady.eigenvalues=0
