@@ -84,7 +84,10 @@ Eigen::VectorXd CoarseMap::derivative(const Eigen::VectorXd& v, double dparamete
     EFDEM_EXPECTS(has_base_ && v.size() == base_.x.size());
     const double length = std::sqrt(v.squaredNorm() + dparameter * dparameter);
     if (length == 0.0) return Eigen::VectorXd::Zero(v.size());
-    const double h = settings_.difference_step;
+    const double forward = base_.parameter + (settings_.difference_step / length) * dparameter;
+    // Backwards where the forward point's parameter is one the micro model cannot run at.
+    const double h = (forward < parameter_lo_ || forward > parameter_hi_) ? -settings_.difference_step
+                                                                          : settings_.difference_step;
     const MapEvaluation e = evaluate_from_base(base_.x + (h / length) * v, base_.parameter + (h / length) * dparameter);
     derivative_noise_ = 0.0;
     if (base_.members.rows() >= 2 && e.members.rows() == base_.members.rows()) {

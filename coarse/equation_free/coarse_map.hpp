@@ -21,6 +21,7 @@
 /// \endcode
 
 #include <functional>
+#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -92,7 +93,8 @@ class CoarseMap {
     /// Phi at another point from the base's kept micro state (with CRN). \pre a base.
     MapEvaluation evaluate_from_base(const Eigen::VectorXd& x, double parameter);
     /// dPhi(X; lambda) [v; dparameter] at the base by a one-sided difference from the base's
-    /// micro state; the step h is taken along (v, dparameter)/|(v, dparameter)|.
+    /// micro state; the step h is taken along (v, dparameter)/|(v, dparameter)|, backwards when
+    /// the forward point's parameter lies outside set_parameter_bounds().
     /// Zero for a zero direction (no evaluation). \pre a base; dparameter = 0 without a hook.
     Eigen::VectorXd derivative(const Eigen::VectorXd& v, double dparameter = 0.0);
     /// The noise of the last derivative(): |SE| of the mean of the members' own differences
@@ -113,6 +115,11 @@ class CoarseMap {
     /// Solve in other coordinates (see CoarseCoordinates); every x, phi and f of this map is
     /// then in u. \pre both maps set.
     void set_coordinates(CoarseCoordinates coordinates) { coordinates_ = std::move(coordinates); }
+    /// Where differences may take the parameter (default: anywhere); see derivative().
+    void set_parameter_bounds(double lo, double hi) {
+        parameter_lo_ = lo;
+        parameter_hi_ = hi;
+    }
     long repairs() const { return repairs_; }
     /// The largest change a repair made to a lifted point so far [unit of x].
     double largest_repair() const { return largest_repair_; }
@@ -138,6 +145,8 @@ class CoarseMap {
     CoarseCoordinates coordinates_;
     long repairs_ = 0;
     double largest_repair_ = 0;
+    double parameter_lo_ = -std::numeric_limits<double>::infinity();
+    double parameter_hi_ = std::numeric_limits<double>::infinity();
     double derivative_noise_ = 0;
     MapEvaluation base_;
     bool has_base_ = false;

@@ -106,6 +106,13 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
     const double micro0 = map_.micro_time();
     const Eigen::Index n = x0.size();
     Branch branch;
+    // No corrector (nor difference) runs the micro model beyond one parameter step outside the
+    // range, nor where it cannot run at all.
+    const double margin = settings_.max_parameter_step > 0.0 ? settings_.max_parameter_step
+                                                               : settings_.parameter_max - settings_.parameter_min;
+    const double lambda_lo = std::max(settings_.parameter_min - margin, settings_.evaluation_min);
+    const double lambda_hi = std::min(settings_.parameter_max + margin, settings_.evaluation_max);
+    map_.set_parameter_bounds(lambda_lo, lambda_hi);
     double before = map_.micro_time();
     FixedPointSystem first(map_, n, lambda0);
     SteadySolveRecord rec = newton_.solve(first, x0);
@@ -127,11 +134,6 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             ds = std::clamp(settings_.parameter_step / std::max(std::abs(t[n]), 1e-12), settings_.min_step,
                             settings_.max_step);
         branch.end_reason = fmt::format("{} points (the limit)", settings_.max_points);
-        // No corrector runs the micro model beyond one parameter step outside the range.
-        const double margin = settings_.max_parameter_step > 0.0 ? settings_.max_parameter_step
-                                                                   : settings_.parameter_max - settings_.parameter_min;
-        const double lambda_lo = std::max(settings_.parameter_min - margin, settings_.evaluation_min);
-        const double lambda_hi = std::min(settings_.parameter_max + margin, settings_.evaluation_max);
         while (static_cast<int>(branch.points.size()) < settings_.max_points) {
             before = map_.micro_time();
             const auto [step, lands] = predictor_step(ds, y[n], t[n]);

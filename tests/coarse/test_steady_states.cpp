@@ -541,3 +541,27 @@ TEST_CASE("an arclength corrector never runs the micro model at a parameter outs
     CHECK(map.evaluations() == before + 1);
     system.end();
 }
+
+TEST_CASE("a difference whose forward point leaves the parameter bounds is taken backwards", "[unit][steady]") {
+    test::SdeEnsembleStepper toy(fold_drift, 0.0, 1, 0.01, 10, Eigen::Vector2d(-1, -1), 1);
+    double highest = -std::numeric_limits<double>::infinity();
+    CoarseMap map(toy, deterministic_map(), [&](double lambda) {
+        highest = std::max(highest, lambda);
+        toy.set_parameter(lambda);
+    });
+    const Eigen::Vector2d x(-1.0, -1.0);
+    const Eigen::Vector2d v = Eigen::Vector2d::Zero();
+    map.begin(x, -0.5);
+    const Eigen::VectorXd forward = map.derivative(v, 1.0);  // d Phi / d lambda
+    map.end();
+    map.set_parameter_bounds(-0.7, -0.5);  // the base on the upper bound
+    highest = -std::numeric_limits<double>::infinity();
+    map.begin(x, -0.5);
+    const Eigen::VectorXd backward = map.derivative(v, 1.0);
+    map.end();
+    CHECK(highest <= -0.5);
+    // One-sided differences of step h = 1e-6 either way: they differ by h |d2 Phi / d lambda2|,
+    // O(1e-6) for this smooth map (tau = 2), and by round-off eps |Phi| / h ~ 1e-10.
+    CHECK((forward - backward).norm() <= 1e-5 * (1.0 + forward.norm()));
+    CHECK(forward.norm() > 0.1);  // a real derivative, not two zeros
+}
