@@ -519,13 +519,23 @@ TEST_CASE("a fallback with its own system: the solve goes on in it from the fall
     CHECK(rec.converged());
 }
 
-TEST_CASE("an arclength corrector never runs the micro model at a parameter outside its bounds", "[unit][steady]") {
-    test::SdeEnsembleStepper toy(fold_drift, 0.0, 1, 0.01, 10, Eigen::Vector2d(-1, -1), 1);
+namespace {
+/// The deterministic fold toy behind a map whose hook remembers the highest parameter it was
+/// asked to run at.
+struct WatchedFold {
+    test::SdeEnsembleStepper toy{fold_drift, 0.0, 1, 0.01, 10, Eigen::Vector2d(-1, -1), 1};
     double highest = -std::numeric_limits<double>::infinity();
-    CoarseMap map(toy, deterministic_map(), [&](double lambda) {
-        highest = std::max(highest, lambda);
-        toy.set_parameter(lambda);
-    });
+    CoarseMap map{toy, deterministic_map(), [this](double lambda) {
+                      highest = std::max(highest, lambda);
+                      toy.set_parameter(lambda);
+                  }};
+};
+}  // namespace
+
+TEST_CASE("an arclength corrector never runs the micro model at a parameter outside its bounds", "[unit][steady]") {
+    WatchedFold fold;
+    CoarseMap& map = fold.map;
+    double& highest = fold.highest;
     const Eigen::Vector3d predicted(-1.0, -1.0, -0.5);
     ArclengthSystem system(map, Eigen::Vector3d(0.0, 0.0, 1.0), predicted, -0.7, -0.3);
     system.begin(predicted);
@@ -543,12 +553,9 @@ TEST_CASE("an arclength corrector never runs the micro model at a parameter outs
 }
 
 TEST_CASE("a difference whose forward point leaves the parameter bounds is taken backwards", "[unit][steady]") {
-    test::SdeEnsembleStepper toy(fold_drift, 0.0, 1, 0.01, 10, Eigen::Vector2d(-1, -1), 1);
-    double highest = -std::numeric_limits<double>::infinity();
-    CoarseMap map(toy, deterministic_map(), [&](double lambda) {
-        highest = std::max(highest, lambda);
-        toy.set_parameter(lambda);
-    });
+    WatchedFold fold;
+    CoarseMap& map = fold.map;
+    double& highest = fold.highest;
     const Eigen::Vector2d x(-1.0, -1.0);
     const Eigen::Vector2d v = Eigen::Vector2d::Zero();
     map.begin(x, -0.5);
