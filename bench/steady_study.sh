@@ -25,7 +25,9 @@
 #              in 1,260 units, 25 min; every corrector started from the last point);
 #   stability_020.h5  the low end's last point again, for its stability: mode = steady at U_s = 0.2
 #              with R = 8 and 6 Arnoldi products (the branch's 2 products at R = 4 left the
-#              leading mu at -0.58 with an upper end of 1.33), warm-up 200, tau = 20;
+#              leading mu at -0.58 with an upper end of 1.33), warm-up 200, tau = 20
+#              (2026-12-03: Newton's line search failed at its first step; mu_1 = 0.949 +- 0.17:
+#              nearly neutral, 1 - mu below the products' noise; exit 3 is the result);
 #   anderson.h5  steady.solver = anderson (no derivatives: Anderson-accelerated fixed point on
 #              Phi_tau, which contracts the slow mode by mu ~ 0.42 per tau = 20), at most 120 of
 #              DEM time: the cheap option against which Newton is compared.
