@@ -9,6 +9,12 @@
 
 namespace efdem::coarse {
 
+Eigen::MatrixXd CoarseCoordinates::rows_from_state(const Eigen::MatrixXd& rows) const {
+    Eigen::MatrixXd out(rows.rows(), rows.cols());
+    for (Eigen::Index r = 0; r < rows.rows(); ++r) out.row(r) = from_state(rows.row(r).transpose()).transpose();
+    return out;
+}
+
 CoarseMap::CoarseMap(CoarseStepper& stepper, const CoarseMapSettings& settings,
                      std::function<void(double)> set_parameter)
     : stepper_(stepper), settings_(settings), set_parameter_(std::move(set_parameter)) {
@@ -46,12 +52,8 @@ MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
         const Eigen::MatrixXd& m = burst.members.back();
         e.standard_error = ensemble_standard_error(m);  // in X
         state_noise = e.standard_error.norm();
-        e.members = m;
-        if (coordinates_) {
-            for (Eigen::Index r = 0; r < m.rows(); ++r)
-                e.members.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
-            e.standard_error = ensemble_standard_error(e.members);  // in u
-        }
+        e.members = coordinates_ ? coordinates_.rows_from_state(m) : m;
+        if (coordinates_) e.standard_error = ensemble_standard_error(e.members);  // in u
     }
     e.noise_norm = e.standard_error.norm();
     // In X: Phi's restriction against the point the solver asked for (before any repair).

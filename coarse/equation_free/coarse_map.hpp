@@ -57,6 +57,8 @@ struct CoarseCoordinates {
     std::function<Eigen::VectorXd(const Eigen::VectorXd&)> from_state;
     std::string name = "heights";  ///< for the record
     explicit operator bool() const { return static_cast<bool>(to_state); }
+    /// from_state of every row (one member's coarse vector per row).
+    Eigen::MatrixXd rows_from_state(const Eigen::MatrixXd& rows) const;
 };
 
 /// One evaluation of the map.

@@ -80,10 +80,8 @@ double SteadyRun::difference_step(const BurstSamples& warm) {
                   difference_step_);
         return difference_step_;
     }
-    Eigen::MatrixXd m = warm.members.back();
-    if (coordinates_)
-        for (Eigen::Index r = 0; r < m.rows(); ++r) m.row(r) = coordinates_.from_state(m.row(r).transpose()).transpose();
-    const double noise = ensemble_standard_error(m).norm();
+    const Eigen::MatrixXd& last = warm.members.back();
+    const double noise = ensemble_standard_error(coordinates_ ? coordinates_.rows_from_state(last) : last).norm();
     if (!(noise > 0.0)) {
         difference_step_origin_ = "default (the realizations agree exactly: no noise to derive it from)";
         return difference_step_;
