@@ -9,13 +9,11 @@
 
 namespace efdem::coarse {
 
-ArclengthSystem::ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted,
-                                 double lambda_min, double lambda_max)
-    : map_(map), tangent_(std::move(tangent)), predicted_(std::move(predicted)), lambda_min_(lambda_min),
-      lambda_max_(lambda_max) {
+ArclengthSystem::ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted)
+    : map_(map), tangent_(std::move(tangent)), predicted_(std::move(predicted)) {
     EFDEM_EXPECTS(map_.has_parameter() && tangent_.size() == predicted_.size() && tangent_.size() >= 2);
     EFDEM_EXPECTS(std::abs(tangent_.norm() - 1.0) < 1e-12);
-    EFDEM_EXPECTS(lambda_min_ <= predicted_[predicted_.size() - 1] && predicted_[predicted_.size() - 1] <= lambda_max_);
+    EFDEM_EXPECTS(map_.parameter_in_bounds(predicted_[predicted_.size() - 1]));
 }
 
 SystemEvaluation ArclengthSystem::assemble(const MapEvaluation& e, const Eigen::VectorXd& y) const {
@@ -31,7 +29,7 @@ SystemEvaluation ArclengthSystem::assemble(const MapEvaluation& e, const Eigen::
 }
 
 SystemEvaluation ArclengthSystem::begin(const Eigen::VectorXd& y) {
-    EFDEM_EXPECTS(y.size() == dimension() && lambda_min_ <= y[y.size() - 1] && y[y.size() - 1] <= lambda_max_);
+    EFDEM_EXPECTS(y.size() == dimension() && map_.parameter_in_bounds(y[y.size() - 1]));
     const Eigen::Index n = y.size() - 1;
     return assemble(map_.begin(y.head(n), y[n]), y);
 }
@@ -48,9 +46,8 @@ Eigen::VectorXd ArclengthSystem::jacobian_times(const Eigen::VectorXd& v) {
 SystemEvaluation ArclengthSystem::trial(const Eigen::VectorXd& y) {
     EFDEM_EXPECTS(y.size() == dimension());
     const Eigen::Index n = y.size() - 1;
-    if (!(lambda_min_ <= y[n] && y[n] <= lambda_max_)) {  // not run: no decrease
-        log::info("arclength trial at lambda = {:.6g} outside [{:.6g}, {:.6g}]: not evaluated", y[n], lambda_min_,
-                  lambda_max_);
+    if (!map_.parameter_in_bounds(y[n])) {  // not run: no decrease
+        log::info("arclength trial at lambda = {:.6g} outside the parameter bounds: not evaluated", y[n]);
         SystemEvaluation out;
         out.g = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::infinity());
         return out;

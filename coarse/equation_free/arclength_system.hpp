@@ -9,8 +9,6 @@
 /// corrector (NewtonKrylov) goes round the fold. Products by CRN differences along (v, mu) in
 /// one map evaluation (CoarseMap::derivative with a parameter step).
 
-#include <limits>
-
 #include "coarse/equation_free/coarse_map.hpp"
 #include "coarse/equation_free/newton_system.hpp"
 
@@ -19,14 +17,11 @@ namespace efdem::coarse {
 class ArclengthSystem final : public NewtonSystem {
   public:
     /// \pre map has a parameter hook; tangent and predicted have size n + 1; |tangent| = 1;
-    /// lambda_min <= predicted lambda <= lambda_max.
-    /// The micro model is never run at a lambda outside [lambda_min, lambda_max]: a line-search
-    /// trial there counts as no decrease (|G| = inf) without a burst. A Newton step from a noisy
-    /// tangent can ask for an unphysical parameter (on the DEM: a gas velocity that blows the bed
-    /// into the lid).
-    ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted,
-                    double lambda_min = -std::numeric_limits<double>::infinity(),
-                    double lambda_max = std::numeric_limits<double>::infinity());
+    /// the predicted lambda within the map's parameter bounds (CoarseMap::set_parameter_bounds).
+    /// The micro model is never run at a lambda outside them: a line-search trial there counts
+    /// as no decrease (|G| = inf) without a burst. A Newton step from a noisy tangent can ask for
+    /// an unphysical parameter (on the DEM, e.g. a gas velocity that blows the bed into the lid).
+    ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted);
 
     Eigen::Index dimension() const override { return tangent_.size(); }
     SystemEvaluation begin(const Eigen::VectorXd& y) override;
@@ -41,7 +36,6 @@ class ArclengthSystem final : public NewtonSystem {
 
     CoarseMap& map_;
     Eigen::VectorXd tangent_, predicted_;
-    double lambda_min_, lambda_max_;
 };
 
 }  // namespace efdem::coarse

@@ -88,8 +88,7 @@ Eigen::VectorXd CoarseMap::derivative(const Eigen::VectorXd& v, double dparamete
     if (length == 0.0) return Eigen::VectorXd::Zero(v.size());
     const double forward = base_.parameter + (settings_.difference_step / length) * dparameter;
     // Backwards where the forward point's parameter is one the micro model cannot run at.
-    const double h = (forward < parameter_lo_ || forward > parameter_hi_) ? -settings_.difference_step
-                                                                          : settings_.difference_step;
+    const double h = parameter_in_bounds(forward) ? settings_.difference_step : -settings_.difference_step;
     const MapEvaluation e = evaluate_from_base(base_.x + (h / length) * v, base_.parameter + (h / length) * dparameter);
     derivative_noise_ = 0.0;
     if (base_.members.rows() >= 2 && e.members.rows() == base_.members.rows()) {

@@ -117,11 +117,13 @@ class CoarseMap {
     /// Solve in other coordinates (see CoarseCoordinates); every x, phi and f of this map is
     /// then in u. \pre both maps set.
     void set_coordinates(CoarseCoordinates coordinates) { coordinates_ = std::move(coordinates); }
-    /// Where differences may take the parameter (default: anywhere); see derivative().
+    /// Where the micro model may be run (default: anywhere): a difference is taken backwards
+    /// rather than leave it (derivative()); callers ask parameter_in_bounds() before a point.
     void set_parameter_bounds(double lo, double hi) {
         parameter_lo_ = lo;
         parameter_hi_ = hi;
     }
+    bool parameter_in_bounds(double p) const { return parameter_lo_ <= p && p <= parameter_hi_; }
     long repairs() const { return repairs_; }
     /// The largest change a repair made to a lifted point so far [unit of x].
     double largest_repair() const { return largest_repair_; }

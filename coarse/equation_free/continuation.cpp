@@ -110,9 +110,8 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
     // range, nor where it cannot run at all.
     const double margin = settings_.max_parameter_step > 0.0 ? settings_.max_parameter_step
                                                                : settings_.parameter_max - settings_.parameter_min;
-    const double lambda_lo = std::max(settings_.parameter_min - margin, settings_.evaluation_min);
-    const double lambda_hi = std::min(settings_.parameter_max + margin, settings_.evaluation_max);
-    map_.set_parameter_bounds(lambda_lo, lambda_hi);
+    map_.set_parameter_bounds(std::max(settings_.parameter_min - margin, settings_.evaluation_min),
+                              std::min(settings_.parameter_max + margin, settings_.evaluation_max));
     double before = map_.micro_time();
     FixedPointSystem first(map_, n, lambda0);
     SteadySolveRecord rec = newton_.solve(first, x0);
@@ -145,13 +144,13 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             // The last point is solved at the end of the range itself: its constraint row is
             // lambda = end instead of the arclength (regular unless a fold sits exactly there).
             const Eigen::VectorXd hold_lambda = Eigen::VectorXd::Unit(n + 1, n);
-            ArclengthSystem system(map_, lands ? hold_lambda : t, predicted, lambda_lo, lambda_hi);
+            ArclengthSystem system(map_, lands ? hold_lambda : t, predicted);
             // The fallback: the last point at the predicted parameter, corrected with lambda held
             // there (its constraint row is 0 at the start; in the arclength row of a noisy
             // tangent it would be -ds |t_X|^2, which the line search would trade against |F|).
             FallbackGuess held{y, settings_.fallback_ratio, nullptr};
             held.y[n] = predicted[n];
-            ArclengthSystem natural(map_, hold_lambda, held.y, lambda_lo, lambda_hi);
+            ArclengthSystem natural(map_, hold_lambda, held.y);
             held.system = &natural;
             rec = newton_.solve(system, predicted, &held);
             if (rec.reason == SteadyStopReason::stopped) {

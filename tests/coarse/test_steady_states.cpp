@@ -537,7 +537,8 @@ TEST_CASE("an arclength corrector never runs the micro model at a parameter outs
     CoarseMap& map = fold.map;
     double& highest = fold.highest;
     const Eigen::Vector3d predicted(-1.0, -1.0, -0.5);
-    ArclengthSystem system(map, Eigen::Vector3d(0.0, 0.0, 1.0), predicted, -0.7, -0.3);
+    map.set_parameter_bounds(-0.7, -0.3);
+    ArclengthSystem system(map, Eigen::Vector3d(0.0, 0.0, 1.0), predicted);
     system.begin(predicted);
     const long before = map.evaluations();
     // A Newton step from a noisy tangent asking for lambda = 5: no decrease, and no burst.
