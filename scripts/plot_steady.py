@@ -60,6 +60,7 @@ def plot_branch(runs, out):
     """runs: (file, name) of one or more continuation runs in the same parameter, on one diagram."""
     fig, (ax_m, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
     reasons = []
+    held_labelled = False  # one legend entry for the crosses, whichever run has them
     for k, (f, name) in enumerate(runs):
         b = f["branch"]
         if "parameter" not in b or len(b["parameter"]) == 0:
@@ -77,7 +78,8 @@ def plot_branch(runs, out):
             held = b["from_last_point"][:] == 1
             if held.any():
                 ax_m.plot(lam[held], b["mean_height"][:][held], "x", ms=10, color="k",
-                          label="corrector started from the last point" if k == len(runs) - 1 else None)
+                          label=None if held_labelled else "corrector started from the last point")
+                held_labelled = True
         rate = b["leading_rate"][:]
         mu = np.hypot(b["leading_real"][:], b["leading_imag"][:])
         stable = mu < 1

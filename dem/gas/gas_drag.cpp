@@ -29,7 +29,7 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     if (!s.law)
         p.fail("law", "names an unknown drag law '" + law + "'",
                fmt::format("known drag laws: {}", fmt::join(drag_law_names(), ", ")));
-    s.superficial_velocity = p.get<double>("superficial_velocity", Bounds::closed(0.0, 1e3));
+    s.superficial_velocity = p.get<double>("superficial_velocity", Bounds::closed(0.0, kMaxSuperficialVelocity));
     s.phi_cap = p.get_or<double>("phi_cap", 0.70, Bounds::open(0.0, 1.0));
     s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::at_least(0.1));
 

@@ -64,6 +64,9 @@ struct GasDragSpec {
     static GasDragSpec from_params(const Params& scope);
 };
 
+/// The largest gas_drag.superficial_velocity a scene (or a continuation) may set [sqrt(g d_p)].
+inline constexpr double kMaxSuperficialVelocity = 1e3;
+
 class GasDrag final : public Effect {
   public:
     explicit GasDrag(const EffectSetup& setup);

@@ -69,8 +69,9 @@ void DemRealization::set_parameter(const std::string& key, double value) {
     if (!gas) throw RuntimeFailure(fmt::format("{} cannot be set: the scene does not list gas_drag in its effects", key));
     // The scene key's own bounds; the coarse solvers keep to them (ContinuationSettings::
     // evaluation_min/max), so this is the last line against a value no bed can be run at.
-    if (!(value >= 0.0 && value <= 1e3))
-        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: outside [0, 1000]", key, value));
+    if (!(value >= 0.0 && value <= dem::kMaxSuperficialVelocity))
+        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: outside [0, {:g}]", key, value,
+                                         dem::kMaxSuperficialVelocity));
     gas->set_superficial_velocity(value);
 }
 
