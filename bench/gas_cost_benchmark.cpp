@@ -20,8 +20,8 @@
 #include "core/param_table.hpp"
 #include "core/version.hpp"
 #include "dem/gas/gas_drag.hpp"
-#include "dem/realization_builder.hpp"
 #include "dem/gas/slab_fields.hpp"
+#include "dem/realization_builder.hpp"
 
 using namespace efdem;
 

@@ -60,8 +60,8 @@ int main(int argc, char** argv) {
         const EnsembleLayout layout(world, k);
         std::vector<std::unique_ptr<Realization>> local;
         for (int j = 0; j < k; ++j)
-            local.push_back(std::make_unique<DemRealization>(static_bed(n, layout.first_index() + j), 0, 1,
-                                                             RealizationOutput{}));
+            local.push_back(std::make_unique<DemRealization>(
+                static_bed(n, layout.first_index() + j), 0, 1, RealizationOutput{}));
         StepperSettings ss;
         ss.sample_interval = 1e-4;
         ss.steps_per_sample = 1;
@@ -88,8 +88,8 @@ int main(int argc, char** argv) {
             }
         }
         if (world.is_root())
-            std::printf("R=%d N=%ld ranks=%d restrict_seconds=%.6f lift_seconds=%.6f\n", layout.size(), n,
-                        world.size(), median(restrict_s), median(lift_s));
+            std::printf("R=%d N=%ld ranks=%d restrict_seconds=%.6f lift_seconds=%.6f\n",
+                        layout.size(), n, world.size(), median(restrict_s), median(lift_s));
     }
     MPI_Finalize();
     return 0;

@@ -1,7 +1,7 @@
 #include "core/bounds.hpp"
 
-#include <cmath>
 #include <fmt/format.h>
+#include <cmath>
 
 namespace efdem {
 

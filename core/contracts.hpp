@@ -14,10 +14,10 @@ namespace efdem::detail {
 
 #if !defined(NDEBUG) || defined(EFDEM_ENFORCE_CONTRACTS)
 #define EFDEM_CONTRACTS_ACTIVE 1
-#define EFDEM_CONTRACT_CHECK_(kind, ...)                                                      \
-    do {                                                                                       \
-        if (!(__VA_ARGS__))                                                                    \
-            ::efdem::detail::contract_violation(kind, #__VA_ARGS__, __FILE__, __LINE__);      \
+#define EFDEM_CONTRACT_CHECK_(kind, ...)                                                 \
+    do {                                                                                 \
+        if (!(__VA_ARGS__))                                                              \
+            ::efdem::detail::contract_violation(kind, #__VA_ARGS__, __FILE__, __LINE__); \
     } while (false)
 #else
 #define EFDEM_CONTRACTS_ACTIVE 0

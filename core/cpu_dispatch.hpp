@@ -27,7 +27,9 @@ inline bool cpu_has_avx2() {
 #else
 #define EFDEM_AVX2_DISPATCH 0
 #define EFDEM_TARGET_AVX2
-inline bool cpu_has_avx2() { return false; }
+inline bool cpu_has_avx2() {
+    return false;
+}
 #endif
 
 }  // namespace efdem

@@ -51,7 +51,7 @@ struct SourceLocation {
  * \endcode
  */
 class InputError : public std::runtime_error {
-public:
+  public:
     InputError(SourceLocation where, std::string key, std::string value, std::string problem,
                std::string allowed = {});
     /// An input error that is not about a single key (a missing file, a syntax error).
@@ -63,7 +63,7 @@ public:
     const std::string& problem() const { return problem_; }
     const std::string& allowed() const { return allowed_; }
 
-private:
+  private:
     SourceLocation where_;
     std::string key_, value_, problem_, allowed_;
 };
@@ -74,12 +74,12 @@ private:
  * Carries the realization index when one is known (-1 otherwise); the driver adds the rank.
  */
 class RuntimeFailure : public std::runtime_error {
-public:
+  public:
     explicit RuntimeFailure(const std::string& message, long realization = -1)
         : std::runtime_error(message), realization_(realization) {}
     long realization() const { return realization_; }
 
-private:
+  private:
     long realization_;
 };
 

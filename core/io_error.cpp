@@ -10,7 +10,8 @@
 
 namespace efdem {
 
-std::string io_failure_message(const std::filesystem::path& path, const std::string& what, int error_number) {
+std::string io_failure_message(const std::filesystem::path& path, const std::string& what,
+                               int error_number) {
     const bool full = error_number == ENOSPC || error_number == EDQUOT;
     return fmt::format("cannot write {} {}: {}{}", what, path.string(),
                        error_number != 0 ? std::strerror(error_number) : "write failed",
@@ -26,12 +27,14 @@ void flush_or_fail(std::FILE* f, const std::filesystem::path& path, const std::s
     }
 }
 
-void write_whole_file(const std::filesystem::path& file, std::string_view bytes, const std::string& what) {
+void write_whole_file(const std::filesystem::path& file, std::string_view bytes,
+                      const std::string& what) {
     const std::filesystem::path tmp = file.string() + ".tmp";
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
     int err = f ? 0 : errno;
     if (f) {
-        if (std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fflush(f) != 0) err = errno ? errno : EIO;
+        if (std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fflush(f) != 0)
+            err = errno ? errno : EIO;
         if (std::fclose(f) != 0 && err == 0) err = errno ? errno : EIO;
     }
     std::error_code ec;

@@ -9,7 +9,9 @@ int g_rank = 0;
 int g_n_ranks = 1;
 Level g_level = Level::info;
 
-std::string rank_prefix() { return g_n_ranks > 1 ? fmt::format("[rank {}] ", g_rank) : ""; }
+std::string rank_prefix() {
+    return g_n_ranks > 1 ? fmt::format("[rank {}] ", g_rank) : "";
+}
 }  // namespace
 
 void configure(int rank, int n_ranks, Level lvl) {
@@ -17,8 +19,12 @@ void configure(int rank, int n_ranks, Level lvl) {
     g_n_ranks = n_ranks;
     g_level = lvl;
 }
-Level level() { return g_level; }
-int rank() { return g_rank; }
+Level level() {
+    return g_level;
+}
+int rank() {
+    return g_rank;
+}
 
 void write_info(const std::string& message) {
     std::fprintf(stdout, "%s\n", message.c_str());

@@ -57,8 +57,7 @@ ParamTable ParamTable::from_text(std::string_view text, std::string file,
 
 std::string ParamTable::read_text_file(const std::filesystem::path& path) {
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec))
-        throw InputError({path.string(), 0}, "file not found");
+    if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0}, "file not found");
     if (std::filesystem::is_directory(path, ec))
         throw InputError({path.string(), 0}, "is a directory, not a file");
     std::ifstream in(path, std::ios::binary);
@@ -85,10 +84,16 @@ void ParamTable::add_override(std::string_view assignment) {
     }
 }
 
-Params ParamTable::root() { return Params(this, ""); }
-Params ParamTable::scope(std::string_view prefix) { return Params(this, std::string(prefix) + "."); }
+Params ParamTable::root() {
+    return Params(this, "");
+}
+Params ParamTable::scope(std::string_view prefix) {
+    return Params(this, std::string(prefix) + ".");
+}
 
-bool ParamTable::contains(std::string_view key) const { return index_.find(key) != index_.end(); }
+bool ParamTable::contains(std::string_view key) const {
+    return index_.find(key) != index_.end();
+}
 
 const ParamEntry* ParamTable::find(std::string_view key) const {
     const auto it = index_.find(key);
@@ -127,10 +132,13 @@ std::string ParamTable::closest_key(std::string_view key, bool among_queried) co
     return best;
 }
 
-void ParamTable::declare(const std::string& key, const std::string& expected, const std::string* fallback) const {
-    auto it = std::find_if(declarations_.begin(), declarations_.end(), [&](const KeyDeclaration& d) { return d.key == key; });
+void ParamTable::declare(const std::string& key, const std::string& expected,
+                         const std::string* fallback) const {
+    auto it = std::find_if(declarations_.begin(), declarations_.end(),
+                           [&](const KeyDeclaration& d) { return d.key == key; });
     if (it == declarations_.end()) {
-        declarations_.push_back({key, expected, fallback ? *fallback : std::string(), fallback == nullptr});
+        declarations_.push_back(
+            {key, expected, fallback ? *fallback : std::string(), fallback == nullptr});
         return;
     }
     if (!expected.empty()) it->expected = expected;
@@ -173,13 +181,17 @@ void ParamTable::check_all_used(const UnusedKeyHint& hint) const {
 // ---------------------------------------------------------------------------------------------
 // Params
 
-std::string Params::full_key(std::string_view key) const { return prefix_ + std::string(key); }
+std::string Params::full_key(std::string_view key) const {
+    return prefix_ + std::string(key);
+}
 
 Params Params::scope(std::string_view sub) const {
     return Params(table_, prefix_ + std::string(sub) + ".");
 }
 
-bool Params::contains(std::string_view key) const { return table_->contains(full_key(key)); }
+bool Params::contains(std::string_view key) const {
+    return table_->contains(full_key(key));
+}
 
 const ParamEntry* Params::lookup(std::string_view key) const {
     const std::string full = full_key(key);
@@ -244,7 +256,8 @@ T Params::get_or(std::string_view key, const T& fallback, const Bounds& bounds) 
 EFDEM_PARAM_VALUE_TYPES(EFDEM_PARAMS_INSTANTIATE)
 #undef EFDEM_PARAMS_INSTANTIATE
 
-std::string Params::get_choice(std::string_view key, const std::vector<std::string>& allowed) const {
+std::string Params::get_choice(std::string_view key,
+                               const std::vector<std::string>& allowed) const {
     const std::string word = get<std::string>(key);
     table_->declare(full_key(key), "one of: " + comma_list(allowed), nullptr);
     if (std::find(allowed.begin(), allowed.end(), word) == allowed.end())
@@ -254,9 +267,12 @@ std::string Params::get_choice(std::string_view key, const std::vector<std::stri
 
 std::string Params::get_or_choice(std::string_view key, const std::string& fallback,
                                   const std::vector<std::string>& allowed) const {
-    table_->declare(full_key(key), "", &fallback);  // the default, whether or not the scene sets the key
-    const std::string word = contains(key) ? get_choice(key, allowed) : get_or<std::string>(key, fallback);
-    table_->declare(full_key(key), "one of: " + comma_list(allowed), nullptr);  // after get_or's "one word"
+    table_->declare(full_key(key), "",
+                    &fallback);  // the default, whether or not the scene sets the key
+    const std::string word =
+        contains(key) ? get_choice(key, allowed) : get_or<std::string>(key, fallback);
+    table_->declare(full_key(key), "one of: " + comma_list(allowed),
+                    nullptr);  // after get_or's "one word"
     return word;
 }
 

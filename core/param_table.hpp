@@ -63,7 +63,7 @@ struct KeyDeclaration {
 using UnusedKeyHint = std::function<std::string(const ParamEntry&)>;
 
 class ParamTable {
-public:
+  public:
     /// Parses scene text. `file` names the text in messages; relative paths in the scene resolve
     /// against `base_dir`. Throws InputError on a syntax error or a duplicated key.
     static ParamTable from_text(std::string_view text, std::string file,
@@ -100,13 +100,14 @@ public:
     /// All entries in file order (overrides last).
     const std::vector<ParamEntry>& entries() const { return entries_; }
 
-private:
+  private:
     friend class Params;
     ParamTable() = default;
     void record(const std::string& key, const std::string& value, const std::string& origin);
     void note_query(const std::string& key) const { queried_.emplace(key, true); }
     /// Records what `key` accepts; a later call refines it (a choice list, a default).
-    void declare(const std::string& key, const std::string& expected, const std::string* fallback) const;
+    void declare(const std::string& key, const std::string& expected,
+                 const std::string* fallback) const;
     std::string closest_key(std::string_view key, bool among_queried) const;
 
     std::string text_;
@@ -133,7 +134,7 @@ private:
  * \endcode
  */
 class Params {
-public:
+  public:
     Params(ParamTable* table, std::string prefix) : table_(table), prefix_(std::move(prefix)) {}
 
     template <class T>
@@ -161,7 +162,7 @@ public:
                            const std::string& allowed = {}) const;
     ParamTable& table() const { return *table_; }
 
-private:
+  private:
     const ParamEntry* lookup(std::string_view key) const;
     [[noreturn]] void fail_missing(const std::string& full, const std::string& expected) const;
 

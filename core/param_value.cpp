@@ -203,7 +203,9 @@ struct ValueTraits<std::vector<std::string>> {
 
 template <>
 struct ValueTraits<Vec3> {
-    static std::string expected(const Bounds& b) { return with_bounds("three finite real numbers", b); }
+    static std::string expected(const Bounds& b) {
+        return with_bounds("three finite real numbers", b);
+    }
     static std::optional<Vec3> parse(const std::vector<std::string>& toks, const Bounds& b,
                                      std::string& problem) {
         if (!has_count(toks, 3, "3 values", problem)) return std::nullopt;
@@ -232,10 +234,10 @@ std::string show_param_value(const T& value) {
     return ValueTraits<T>::show(value);
 }
 
-#define EFDEM_PARAM_VALUE_INSTANTIATE(T)                                                      \
-    template std::optional<T> parse_param_value<T>(const std::vector<std::string>&,           \
-                                                   const Bounds&, std::string&);              \
-    template std::string param_value_expected<T>(const Bounds&);                              \
+#define EFDEM_PARAM_VALUE_INSTANTIATE(T)                                                           \
+    template std::optional<T> parse_param_value<T>(const std::vector<std::string>&, const Bounds&, \
+                                                   std::string&);                                  \
+    template std::string param_value_expected<T>(const Bounds&);                                   \
     template std::string show_param_value<T>(const T&);
 EFDEM_PARAM_VALUE_TYPES(EFDEM_PARAM_VALUE_INSTANTIATE)
 #undef EFDEM_PARAM_VALUE_INSTANTIATE

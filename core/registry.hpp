@@ -28,7 +28,7 @@ namespace efdem {
  */
 template <class Product, class... Args>
 class Registry {
-public:
+  public:
     using Factory = std::unique_ptr<Product> (*)(Args...);
     struct Entry {
         std::string_view name;
@@ -60,7 +60,7 @@ public:
     }
     std::span<const Entry> entries() const { return entries_; }
 
-private:
+  private:
     std::span<const Entry> entries_;
 };
 

@@ -41,7 +41,7 @@ constexpr std::uint64_t purpose_hash(std::string_view purpose) {
  * \endcode
  */
 class RandomStream {
-public:
+  public:
     using State = std::array<std::uint64_t, 4>;
 
     RandomStream(std::uint64_t master_seed, std::uint64_t realization, std::string_view purpose);
@@ -83,7 +83,7 @@ public:
     const State& state() const { return s_; }
     void set_state(const State& s) { s_ = s; }
 
-private:
+  private:
     static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
     State s_{};
 };

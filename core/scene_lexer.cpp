@@ -21,7 +21,8 @@ std::string_view trim(std::string_view s) {
 
 bool valid_key(std::string_view key) {
     if (key.empty() || key.front() == '.' || key.back() == '.') return false;
-    if (!(std::isalpha(static_cast<unsigned char>(key.front())) || key.front() == '_')) return false;
+    if (!(std::isalpha(static_cast<unsigned char>(key.front())) || key.front() == '_'))
+        return false;
     char prev = 0;
     for (char c : key) {
         const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.';
@@ -43,15 +44,14 @@ std::string_view strip_comment(std::string_view line) {
 
 }  // namespace
 
-SceneAssignment parse_assignment(std::string_view text, SourceLocation where,
-                                 AssignmentForm form) {
+SceneAssignment parse_assignment(std::string_view text, SourceLocation where, AssignmentForm form) {
     const auto eq = text.find('=');
     if (eq == std::string_view::npos)
-        throw InputError(std::move(where),
-                         fmt::format("expected {}, got '{}'",
-                                     form == AssignmentForm::scene_line ? "'key = value'"
-                                                                        : "key=value",
-                                     quote_for_message(text)));
+        throw InputError(
+            std::move(where),
+            fmt::format("expected {}, got '{}'",
+                        form == AssignmentForm::scene_line ? "'key = value'" : "key=value",
+                        quote_for_message(text)));
     std::string key(trim(text.substr(0, eq)));
     std::string value(trim(text.substr(eq + 1)));
     if (!valid_key(key))
@@ -76,7 +76,8 @@ std::vector<SceneAssignment> lex_scene(std::string_view text, const std::string&
         ++line_no;
         SourceLocation where{file, line_no};
         if (raw.find('\0') != std::string::npos)
-            throw InputError(std::move(where), "the line contains a NUL byte; is this a text file?");
+            throw InputError(std::move(where),
+                             "the line contains a NUL byte; is this a text file?");
         const std::string_view line = trim(strip_comment(raw));
         if (line.empty()) continue;
         SceneAssignment a = parse_assignment(line, std::move(where), AssignmentForm::scene_line);

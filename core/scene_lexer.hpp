@@ -33,8 +33,7 @@ enum class AssignmentForm { scene_line, command_line };
 /// as written (for a scene line: comment already cut off, trimmed). Throws InputError at `where`
 /// if there is no '=', the key is not a valid key name, the value is empty or has an
 /// unterminated quote.
-SceneAssignment parse_assignment(std::string_view text, SourceLocation where,
-                                 AssignmentForm form);
+SceneAssignment parse_assignment(std::string_view text, SourceLocation where, AssignmentForm form);
 
 /// Lexes a whole scene: one assignment per non-blank line, in file order, each located at
 /// `file`:line. Throws InputError on the first bad line (a NUL byte, a syntax error as in

@@ -21,7 +21,9 @@ inline long whole_multiple(const Params& scope, const char* key, double duration
                            const std::string& dt_name) {
     const double n = std::round(duration / dt);
     if (duration > 0 && n < 1)
-        scope.fail(key, fmt::format("is shorter than {} = {:g}: it would be taken as no {} at all", dt_name, dt, dt_name),
+        scope.fail(key,
+                   fmt::format("is shorter than {} = {:g}: it would be taken as no {} at all",
+                               dt_name, dt, dt_name),
                    fmt::format("0 or a multiple of {:g}, e.g. {:g}", dt, dt));
     if (std::abs(n * dt - duration) > 1e-9 * std::max(duration, dt))
         scope.fail(key, fmt::format("is not a whole multiple of {} = {:g}", dt_name, dt),

@@ -23,8 +23,8 @@ namespace efdem::dem {
 inline constexpr double kMaxDomainLength = 1e6;
 
 struct Domain {
-    double lx = 1.0;  ///< periodic length in x [d_p]
-    double ly = 1.0;  ///< periodic length in y [d_p]
+    double lx = 1.0;                                              ///< periodic length in x [d_p]
+    double ly = 1.0;                                              ///< periodic length in y [d_p]
     double lid_height = std::numeric_limits<double>::infinity();  ///< z of the lid, or +inf
 
     bool has_lid() const { return std::isfinite(lid_height); }

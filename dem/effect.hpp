@@ -50,9 +50,9 @@ struct ForceContext {
 
 /// Numbers an effect adds to a thermo line (contacts, overlaps).
 struct ThermoStats {
-    long contacts = 0;          ///< touching particle pairs
-    long wall_contacts = 0;     ///< particles touching a wall
-    double max_overlap = 0.0;   ///< largest overlap / diameter of the pair
+    long contacts = 0;             ///< touching particle pairs
+    long wall_contacts = 0;        ///< particles touching a wall
+    double max_overlap = 0.0;      ///< largest overlap / diameter of the pair
     Tag max_overlap_tag = -1;      ///< a particle of that contact (-1: none)
     Tag max_overlap_partner = -1;  ///< the other particle, or -1 for a wall
 };
@@ -60,13 +60,15 @@ struct ThermoStats {
 /// Derived parameters an effect reports for `efdem --check` and the run log.
 struct EffectReport {
     std::vector<std::pair<std::string, std::string>> lines;
-    void add(std::string key, std::string value) { lines.emplace_back(std::move(key), std::move(value)); }
+    void add(std::string key, std::string value) {
+        lines.emplace_back(std::move(key), std::move(value));
+    }
 };
 
 /// What a factory in the effect table receives.
 struct EffectSetup {
-    Params scope;                          ///< the effect's own keys: `<name>.`
-    Params root;                           ///< the whole scene (for documented fallbacks)
+    Params scope;  ///< the effect's own keys: `<name>.`
+    Params root;   ///< the whole scene (for documented fallbacks)
     const SpeciesTable& species;
     const Domain& domain;
     const std::vector<std::string>& effect_names;  ///< the scene's `effects` list
@@ -78,7 +80,7 @@ struct EffectSetup {
 };
 
 class Effect {
-public:
+  public:
     virtual ~Effect() = default;
     virtual std::string_view name() const = 0;
     virtual Needs needs() const { return {}; }

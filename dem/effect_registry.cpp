@@ -1,10 +1,10 @@
 #include "dem/effect_registry.hpp"
 
-#include "dem/gas/gas_drag.hpp"
-#include "dem/effects/gravity.hpp"
 #include "dem/contact/pair_contact.hpp"
-#include "dem/effects/viscous_damping.hpp"
 #include "dem/contact/wall_contact.hpp"
+#include "dem/effects/gravity.hpp"
+#include "dem/effects/viscous_damping.hpp"
+#include "dem/gas/gas_drag.hpp"
 
 namespace efdem::dem {
 

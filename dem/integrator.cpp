@@ -22,8 +22,12 @@ void kick(Particles& p, double h, double dt) {
 }
 }  // namespace
 
-void VelocityVerlet::first_half(Particles& p) const { kick<true>(p, 0.5 * dt_, dt_); }
+void VelocityVerlet::first_half(Particles& p) const {
+    kick<true>(p, 0.5 * dt_, dt_);
+}
 
-void VelocityVerlet::second_half(Particles& p) const { kick<false>(p, 0.5 * dt_, dt_); }
+void VelocityVerlet::second_half(Particles& p) const {
+    kick<false>(p, 0.5 * dt_, dt_);
+}
 
 }  // namespace efdem::dem

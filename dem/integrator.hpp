@@ -14,13 +14,13 @@
 namespace efdem::dem {
 
 class VelocityVerlet {
-public:
+  public:
     explicit VelocityVerlet(double dt) : dt_(dt) {}
     double dt() const { return dt_; }
     void first_half(Particles& p) const;
     void second_half(Particles& p) const;
 
-private:
+  private:
     double dt_;
 };
 

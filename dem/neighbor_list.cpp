@@ -125,7 +125,8 @@ void NeighborList::build_pairs(const Particles& p, const Domain& domain, std::sp
         offsets_[i] = static_cast<std::uint32_t>(entries_.size());
         const std::uint32_t c = cell_of_[i];
         const int cx = static_cast<int>(c % static_cast<std::uint32_t>(nx_));
-        const int cy = static_cast<int>((c / static_cast<std::uint32_t>(nx_)) % static_cast<std::uint32_t>(ny_));
+        const int cy = static_cast<int>((c / static_cast<std::uint32_t>(nx_)) %
+                                        static_cast<std::uint32_t>(ny_));
         const int cz = static_cast<int>(c / static_cast<std::uint32_t>(nx_ * ny_));
         // Unique neighbour cells (periodic in x and y; fewer than 3 cells means duplicates).
         int ns = 0;
@@ -137,7 +138,8 @@ void NeighborList::build_pairs(const Particles& p, const Domain& domain, std::sp
                 for (int dx = -1; dx <= 1; ++dx) {
                     const int xx = (cx + dx + nx_) % nx_;
                     const int cell = (zz * ny_ + yy) * nx_ + xx;
-                    if (std::find(stencil, stencil + ns, cell) == stencil + ns) stencil[ns++] = cell;
+                    if (std::find(stencil, stencil + ns, cell) == stencil + ns)
+                        stencil[ns++] = cell;
                 }
             }
         }
@@ -151,10 +153,14 @@ void NeighborList::build_pairs(const Particles& p, const Domain& domain, std::sp
                 if (j <= i) continue;
                 Vec3 d = xi - x[j];
                 int sx = 0, sy = 0;
-                if (d.x > half_lx) sx = 1;
-                else if (d.x < -half_lx) sx = -1;
-                if (d.y > half_ly) sy = 1;
-                else if (d.y < -half_ly) sy = -1;
+                if (d.x > half_lx)
+                    sx = 1;
+                else if (d.x < -half_lx)
+                    sx = -1;
+                if (d.y > half_ly)
+                    sy = 1;
+                else if (d.y < -half_ly)
+                    sy = -1;
                 d.x -= sx * domain.lx;
                 d.y -= sy * domain.ly;
                 const double reach = ri + radius[j] + skin_;

@@ -22,7 +22,7 @@
 namespace efdem::dem {
 
 class NeighborList {
-public:
+  public:
     using Entry = std::uint32_t;
     static constexpr int kCodeBits = 4;
     static constexpr Entry kCodeMask = (1u << kCodeBits) - 1;
@@ -62,7 +62,7 @@ public:
     long builds() const { return builds_; }
     std::size_t bytes() const;
 
-private:
+  private:
     void bin(const Particles& p, const Domain& domain, std::span<const Vec3> x);
     void build_pairs(const Particles& p, const Domain& domain, std::span<const Vec3> x);
 
@@ -78,8 +78,9 @@ private:
     // Cell grid of the last binning.
     int nx_ = 1, ny_ = 1, nz_ = 1;
     double cell_x_ = 1, cell_y_ = 1, cell_z_ = 1, z_lo_ = 0;
-    std::vector<std::uint32_t> cell_of_;     ///< cell of each particle
-    std::vector<std::uint32_t> cell_start_;  ///< first particle of each cell (sorted order), size ncell + 1
+    std::vector<std::uint32_t> cell_of_;  ///< cell of each particle
+    std::vector<std::uint32_t>
+        cell_start_;  ///< first particle of each cell (sorted order), size ncell + 1
 };
 
 }  // namespace efdem::dem

@@ -28,7 +28,7 @@ using Index = std::uint32_t;  ///< particle index in the arrays (not stable; see
 using Tag = std::int64_t;     ///< permanent particle id
 
 class Particles {
-public:
+  public:
     std::size_t size() const { return x_.size(); }
     bool empty() const { return x_.empty(); }
     void reserve(std::size_t n);
@@ -77,14 +77,14 @@ public:
         const SpeciesId* species;
     };
     KernelView kernel_view() {
-        return {size(),      x_.data(),      v_.data(),      omega_.data(),
-                f_.data(),   torque_.data(), radius_.data(), species_.data()};
+        return {size(),    x_.data(),      v_.data(),      omega_.data(),
+                f_.data(), torque_.data(), radius_.data(), species_.data()};
     }
 
     /// Bytes held by the arrays (for memory-per-particle reports).
     std::size_t bytes() const;
 
-private:
+  private:
     std::vector<Vec3> x_, v_, omega_, f_, torque_;
     std::vector<double> radius_, mass_, inv_mass_, inertia_, inv_inertia_;
     std::vector<SpeciesId> species_;

@@ -18,13 +18,15 @@ Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& roo
     Particles p;
     if (bed.source == BedSpec::Source::lattice) {
         p = lattice_bed(bed, scene, spec);
-        if (bed.settle && !spec.skip_settling) p = settle_bed(std::move(p), bed, scene, root, spec, settling);
+        if (bed.settle && !spec.skip_settling)
+            p = settle_bed(std::move(p), bed, scene, root, spec, settling);
     } else {
         p = read_lammps_data(bed.file, scene.species, scene.domain);
     }
     if (bed.permute_species) {
         // A separate stream, so that permuting never shifts the lattice's packing draws.
-        RandomStream rng(spec.seed, static_cast<std::uint64_t>(spec.realization), "species_permutation");
+        RandomStream rng(spec.seed, static_cast<std::uint64_t>(spec.realization),
+                         "species_permutation");
         permute_species(p, scene.species, rng);
     }
     return p;
@@ -53,7 +55,8 @@ void check_initial_state(const System& sys, const BedSpec& bed, const Params& be
 }
 }  // namespace
 
-System build_system(const Params& root, const RealizationSpec& spec, const SettlingReport& settling) {
+System build_system(const Params& root, const RealizationSpec& spec,
+                    const SettlingReport& settling) {
     DemScene scene = DemScene::from_params(root);
     auto effects = make_effects(scene, root);
     const std::string warning = check_time_step(scene, root, effects);
@@ -66,8 +69,10 @@ System build_system(const Params& root, const RealizationSpec& spec, const Settl
     options.realization = spec.realization;
     // The numerical watchdog (System::health_problem): how often, and the largest overlap.
     const Params watchdog = root.scope("watchdog");
-    options.health_check_every = watchdog.get_or<long>("check_every", 1000, Bounds::closed(0, 1000000000));
-    options.max_overlap_fraction = watchdog.get_or<double>("max_overlap", 0.1, Bounds::open_closed(0.0, 1.0));
+    options.health_check_every =
+        watchdog.get_or<long>("check_every", 1000, Bounds::closed(0, 1000000000));
+    options.max_overlap_fraction =
+        watchdog.get_or<double>("max_overlap", 0.1, Bounds::open_closed(0.0, 1.0));
     System sys(scene.species, scene.domain, std::move(particles), std::move(effects), options);
     check_initial_state(sys, bed, root.scope("bed"), options);
     return sys;

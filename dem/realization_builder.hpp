@@ -19,12 +19,14 @@ namespace efdem::dem {
 
 /// The initial particles of one realization according to `bed`: the lattice, settled unless
 /// bed.settle = false or spec.skip_settling, or the LAMMPS data file; then the species
-/// permutation when bed.permute_species is set. `settling`: told how the settling goes (if it runs).
+/// permutation when bed.permute_species is set. `settling`: told how the settling goes (if it
+/// runs).
 Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& root,
                     const RealizationSpec& spec, const SettlingReport& settling = {});
 
 /// Builds one realization: effects, initial bed (build_bed), System. InputError for bad input;
 /// the same keys are read for every realization. `settling`: as in build_bed.
-System build_system(const Params& root, const RealizationSpec& spec, const SettlingReport& settling = {});
+System build_system(const Params& root, const RealizationSpec& spec,
+                    const SettlingReport& settling = {});
 
 }  // namespace efdem::dem

@@ -17,12 +17,16 @@ DemScene DemScene::from_params(const Params& root) {
     s.skin = root.scope("neighbor").get_or<double>("skin", 0.1, Bounds::open_closed(0.0, 10.0));
     const double cutoff = s.species.max_diameter() + s.skin;
     if (s.domain.lx < 2 * cutoff)
-        root.scope("domain").fail("lx", fmt::format("is narrower than twice the neighbour cutoff "
-                                                    "(largest diameter + skin = {:g})", cutoff),
+        root.scope("domain").fail("lx",
+                                  fmt::format("is narrower than twice the neighbour cutoff "
+                                              "(largest diameter + skin = {:g})",
+                                              cutoff),
                                   fmt::format(">= {:g}", 2 * cutoff));
     if (s.domain.ly < 2 * cutoff)
-        root.scope("domain").fail("ly", fmt::format("is narrower than twice the neighbour cutoff "
-                                                    "(largest diameter + skin = {:g})", cutoff),
+        root.scope("domain").fail("ly",
+                                  fmt::format("is narrower than twice the neighbour cutoff "
+                                              "(largest diameter + skin = {:g})",
+                                              cutoff),
                                   fmt::format(">= {:g}", 2 * cutoff));
     return s;
 }
@@ -54,19 +58,21 @@ std::string check_time_step(const DemScene& scene, const Params& root,
         if (!limiting || e->time_scale() < limiting->time_scale()) limiting = e.get();
     if (!limiting || !std::isfinite(limiting->time_scale())) return {};
     const double tc = limiting->time_scale();
-    const std::string who = fmt::format("{} {} contacts", limiting->name(), limiting->time_scale_label());
+    const std::string who =
+        fmt::format("{} {} contacts", limiting->name(), limiting->time_scale_label());
     if (scene.dt > kRefuseDtFraction * tc)
         root.fail("dt",
                   fmt::format("exceeds t_c/5 = {:.4g} for the {} (contact time t_c = {:.4g}); "
                               "the contacts would not be resolved",
                               kRefuseDtFraction * tc, who, tc),
-                  fmt::format("dt <= {:.4g}; recommended dt <= t_c/20 = {:.4g}", kRefuseDtFraction * tc,
-                              kWarnDtFraction * tc));
+                  fmt::format("dt <= {:.4g}; recommended dt <= t_c/20 = {:.4g}",
+                              kRefuseDtFraction * tc, kWarnDtFraction * tc));
     if (scene.dt > kWarnDtFraction * tc)
-        return fmt::format("dt = {:g} is t_c/{:.1f} for the {} (t_c = {:.4g}); contacts are resolved "
-                           "with fewer than 20 steps, so restitution and overlaps lose accuracy "
-                           "(recommended dt <= {:.4g})",
-                           scene.dt, tc / scene.dt, who, tc, kWarnDtFraction * tc);
+        return fmt::format(
+            "dt = {:g} is t_c/{:.1f} for the {} (t_c = {:.4g}); contacts are resolved "
+            "with fewer than 20 steps, so restitution and overlaps lose accuracy "
+            "(recommended dt <= {:.4g})",
+            scene.dt, tc / scene.dt, who, tc, kWarnDtFraction * tc);
     return {};
 }
 

@@ -21,8 +21,8 @@
 namespace efdem::dem {
 
 /// Time-step limits relative to the shortest contact duration t_c (issue: stiff contacts).
-inline constexpr double kRefuseDtFraction = 1.0 / 5.0;   ///< dt > t_c/5 is refused
-inline constexpr double kWarnDtFraction = 1.0 / 20.0;    ///< t_c/20 < dt <= t_c/5 warns
+inline constexpr double kRefuseDtFraction = 1.0 / 5.0;  ///< dt > t_c/5 is refused
+inline constexpr double kWarnDtFraction = 1.0 / 20.0;   ///< t_c/20 < dt <= t_c/5 warns
 
 struct DemScene {
     double dt = 0;
@@ -49,9 +49,10 @@ std::string unused_key_hint(const ParamEntry& entry, const std::vector<std::stri
 
 /// Everything needed to build one realization (dem/realization_builder.hpp).
 struct RealizationSpec {
-    std::uint64_t seed = 1;       ///< master seed
-    long realization = 0;         ///< global realization index
-    bool skip_settling = false;   ///< read every key but do not run the settling (efdem --check, a restart)
+    std::uint64_t seed = 1;  ///< master seed
+    long realization = 0;    ///< global realization index
+    bool skip_settling =
+        false;  ///< read every key but do not run the settling (efdem --check, a restart)
 };
 
 }  // namespace efdem::dem

@@ -38,13 +38,16 @@ SpeciesTable SpeciesTable::from_params(const Params& p) {
                        "distinct names");
     const std::string count = std::to_string(names.size());
     if (density.size() != names.size())
-        p.fail("density", "has " + std::to_string(density.size()) + " values for " + count +
-                              " species", "one density per name in species.names");
+        p.fail("density",
+               "has " + std::to_string(density.size()) + " values for " + count + " species",
+               "one density per name in species.names");
     if (diameter.size() != names.size())
-        p.fail("diameter", "has " + std::to_string(diameter.size()) + " values for " + count +
-                               " species", "one diameter per name in species.names");
+        p.fail("diameter",
+               "has " + std::to_string(diameter.size()) + " values for " + count + " species",
+               "one diameter per name in species.names");
     std::vector<Species> out;
-    for (std::size_t i = 0; i < names.size(); ++i) out.push_back({names[i], density[i], diameter[i]});
+    for (std::size_t i = 0; i < names.size(); ++i)
+        out.push_back({names[i], density[i], diameter[i]});
     return SpeciesTable(std::move(out));
 }
 
@@ -67,7 +70,8 @@ double SpeciesTable::max_diameter() const {
 
 double SpeciesTable::min_mass() const {
     double m = mass(0);
-    for (std::size_t s = 1; s < species_.size(); ++s) m = std::min(m, mass(static_cast<SpeciesId>(s)));
+    for (std::size_t s = 1; s < species_.size(); ++s)
+        m = std::min(m, mass(static_cast<SpeciesId>(s)));
     return m;
 }
 

@@ -46,7 +46,7 @@ struct Species {
  * \endcode
  */
 class SpeciesTable {
-public:
+  public:
     SpeciesTable() = default;
     explicit SpeciesTable(std::vector<Species> species);
     static SpeciesTable from_params(const Params& scope);
@@ -58,11 +58,13 @@ public:
 
     double radius(SpeciesId s) const { return 0.5 * species_[s].diameter; }
     double mass(SpeciesId s) const;
-    double inertia(SpeciesId s) const { return 0.1 * mass(s) * species_[s].diameter * species_[s].diameter; }
+    double inertia(SpeciesId s) const {
+        return 0.1 * mass(s) * species_[s].diameter * species_[s].diameter;
+    }
     double max_diameter() const;
     double min_mass() const;
 
-private:
+  private:
     std::vector<Species> species_;
 };
 

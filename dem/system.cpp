@@ -58,7 +58,7 @@ Effect* System::find_effect(std::string_view name) {
 }
 
 ForceContext System::context() {
-    return ForceContext{particles_,    domain_,         species_, neighbor_list(),
+    return ForceContext{particles_,        domain_,       species_, neighbor_list(),
                         contact_history(), slab_fields(), dt(),     time_};
 }
 
@@ -189,7 +189,8 @@ std::optional<std::string> System::health_problem() const {
     const auto x = particles_.x();
     const auto v = particles_.v();
     const auto tag = particles_.tag();
-    const double z_max = domain_.has_lid() ? domain_.lid_height : std::numeric_limits<double>::max();
+    const double z_max =
+        domain_.has_lid() ? domain_.lid_height : std::numeric_limits<double>::max();
     for (std::size_t i = 0; i < x.size(); ++i) {
         if (!all_finite(x[i]) || !all_finite(v[i]))
             return fmt::format("particle {} has a non-finite position or velocity", tag[i]);
@@ -198,12 +199,13 @@ std::optional<std::string> System::health_problem() const {
     }
     const ThermoStats s = thermo_stats();
     if (s.max_overlap > options_.max_overlap_fraction)
-        return fmt::format("an overlap of {:.3g} diameters exceeds the limit {:.3g} (watchdog.max_overlap), "
-                           "particle {} with {}: contacts are too soft for the impact speeds or the "
-                           "time step is too large",
-                           s.max_overlap, options_.max_overlap_fraction, s.max_overlap_tag,
-                           s.max_overlap_partner < 0 ? std::string("a wall")
-                                                     : fmt::format("particle {}", s.max_overlap_partner));
+        return fmt::format(
+            "an overlap of {:.3g} diameters exceeds the limit {:.3g} (watchdog.max_overlap), "
+            "particle {} with {}: contacts are too soft for the impact speeds or the "
+            "time step is too large",
+            s.max_overlap, options_.max_overlap_fraction, s.max_overlap_tag,
+            s.max_overlap_partner < 0 ? std::string("a wall")
+                                      : fmt::format("particle {}", s.max_overlap_partner));
     return std::nullopt;
 }
 

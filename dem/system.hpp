@@ -18,19 +18,19 @@
 #include "dem/contact/contact_history.hpp"
 #include "dem/domain.hpp"
 #include "dem/effect.hpp"
+#include "dem/gas/slab_fields.hpp"
 #include "dem/integrator.hpp"
 #include "dem/neighbor_list.hpp"
 #include "dem/particles.hpp"
-#include "dem/gas/slab_fields.hpp"
 #include "dem/species.hpp"
 
 namespace efdem::dem {
 
 struct SystemOptions {
-    double dt = 1e-4;          ///< time step [sqrt(d_p/g)]
-    double skin = 0.1;         ///< neighbour-list skin [d_p]
-    double start_time = 0.0;   ///< simulated time of the initial state
-    long realization = -1;     ///< global realization index (for messages), -1 if none
+    double dt = 1e-4;         ///< time step [sqrt(d_p/g)]
+    double skin = 0.1;        ///< neighbour-list skin [d_p]
+    double start_time = 0.0;  ///< simulated time of the initial state
+    long realization = -1;    ///< global realization index (for messages), -1 if none
     /// Steps between health checks (non-finite state, particles leaving the domain); 0 = never.
     long health_check_every = 1000;
     /// Largest overlap / diameter accepted by the health check (beyond it the run stops).
@@ -38,7 +38,7 @@ struct SystemOptions {
 };
 
 class System {
-public:
+  public:
     System(SpeciesTable species, Domain domain, Particles particles,
            std::vector<std::unique_ptr<Effect>> effects, const SystemOptions& options);
     ~System();
@@ -81,7 +81,9 @@ public:
 
     double translational_kinetic_energy() const;
     double rotational_kinetic_energy() const;
-    double kinetic_energy() const { return translational_kinetic_energy() + rotational_kinetic_energy(); }
+    double kinetic_energy() const {
+        return translational_kinetic_energy() + rotational_kinetic_energy();
+    }
     /// Sum of the effects' potential energies (elastic contacts, gravity).
     double potential_energy() const;
     ThermoStats thermo_stats() const;
@@ -101,7 +103,7 @@ public:
                            std::span<const PairHistoryRecord> pair_history);
     void set_step_count(long s) { step_ = s; }
 
-private:
+  private:
     ForceContext context();
     ForceContext context() const;
     void compute_forces();

@@ -19,30 +19,30 @@
 #include "dem/beds/bed_observation.hpp"
 #include "dem/effect_registry.hpp"
 #include "dem/realization_builder.hpp"
-#include "mpi_driver/run/check_report.hpp"
-#include "mpi_driver/output/csv_recorder.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
-#include "mpi_driver/run/driver.hpp"
-#include "mpi_driver/run/steady_driver.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/output/csv_recorder.hpp"
+#include "mpi_driver/run/check_report.hpp"
+#include "mpi_driver/run/driver.hpp"
+#include "mpi_driver/run/steady_driver.hpp"
 #if EFDEM_HAVE_HDF5
 #include "mpi_driver/checkpoint/checkpoint_reader.hpp"
 #include "mpi_driver/checkpoint/checkpoint_writer.hpp"
 #include "mpi_driver/output/hdf5_recorder.hpp"
 #endif
-#include "mpi_driver/ensemble/mpi_broadcast.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
-#include "mpi_driver/output/recorder_list.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/checkpoint/restart_loader.hpp"
-#include "mpi_driver/run/output_guard.hpp"
-#include "mpi_driver/run/run_options.hpp"
-#include "mpi_driver/run/run_observables.hpp"
-#include "mpi_driver/run/run_settings.hpp"
-#include "mpi_driver/run/settling_progress.hpp"
+#include "mpi_driver/ensemble/mpi_broadcast.hpp"
+#include "mpi_driver/ensemble/mpi_session.hpp"
 #include "mpi_driver/ensemble/scene_input.hpp"
 #include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/output/recorder_list.hpp"
+#include "mpi_driver/run/output_guard.hpp"
+#include "mpi_driver/run/run_observables.hpp"
+#include "mpi_driver/run/run_options.hpp"
+#include "mpi_driver/run/run_settings.hpp"
+#include "mpi_driver/run/settling_progress.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;
@@ -50,13 +50,15 @@ using namespace efdem::mpi_driver;
 namespace {
 /// observe.bed: how every realization measures the bed (the same on every rank: the profile's
 /// default top depends only on the particle count and sizes, which every realization shares).
-std::optional<dem::BedObservationSettings> bed_settings(const RunSettings& s, const dem::System& any) {
+std::optional<dem::BedObservationSettings> bed_settings(const RunSettings& s,
+                                                        const dem::System& any) {
     if (!s.observe.bed) return std::nullopt;
     dem::BedObservationSettings b;
     b.profile_dz = s.observe.profile_dz;
-    b.profile_slabs = s.observe.profile_height > 0
-                          ? static_cast<std::size_t>(std::ceil(s.observe.profile_height / b.profile_dz - 1e-9))
-                          : dem::default_profile_slabs(any, b.profile_dz);
+    b.profile_slabs =
+        s.observe.profile_height > 0
+            ? static_cast<std::size_t>(std::ceil(s.observe.profile_height / b.profile_dz - 1e-9))
+            : dem::default_profile_slabs(any, b.profile_dz);
     b.mixing_layer = s.observe.mixing_layer;
     b.mixing_species = s.observe.species;
     b.species = any.species().size();
@@ -65,7 +67,9 @@ std::optional<dem::BedObservationSettings> bed_settings(const RunSettings& s, co
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double seconds_since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 /// The root's wall clock outside the run loop: since start-up, and the set-up's settling.
 struct SetupWall {
@@ -80,12 +84,14 @@ struct SetupWall {
 
 /// `bed`: the run's bed_settings (the axes of /bed), if it records them.
 RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
-                         const dem::System& any, const std::optional<dem::BedObservationSettings>& bed) {
+                         const dem::System& any,
+                         const std::optional<dem::BedObservationSettings>& bed) {
     RunProvenance p;
     p.scene_file = table.file();
     p.scene_text = table.text();
     p.overrides = fmt::format("{}", fmt::join(table.overrides(), " "));
-    for (const auto& r : table.resolved()) p.parameters += fmt::format("{} = {}   [{}]\n", r.key, r.value, r.origin);
+    for (const auto& r : table.resolved())
+        p.parameters += fmt::format("{} = {}   [{}]\n", r.key, r.value, r.origin);
     p.mode = s.mode_name();
     p.ranks = mpi.size();
     p.realizations_per_rank = s.realizations_per_rank;
@@ -94,7 +100,8 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
     p.p_grid = coarse::ProbabilityGrid(s.observe.quantiles).values();
     p.observed_species = any.species()[s.observe.species].name;
     if (bed) {
-        for (std::size_t k = 0; k < bed->species; ++k) p.species_names.push_back(any.species()[static_cast<dem::SpeciesId>(k)].name);
+        for (std::size_t k = 0; k < bed->species; ++k)
+            p.species_names.push_back(any.species()[static_cast<dem::SpeciesId>(k)].name);
         p.profile_dz = bed->profile_dz;
         p.profile_slabs = static_cast<long>(bed->profile_slabs);
         p.mixing_layer = bed->mixing_layer;
@@ -120,19 +127,22 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
             if (resume) restore_outputs(restart->header, s.output.directory, s.output.prefix);
             std::vector<std::unique_ptr<RunRecorder>> owned;
 #if EFDEM_HAVE_HDF5
-            owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory, s.output.prefix, prov,
-                                                           observables.primary->dimension(), resume));
+            owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory, s.output.prefix,
+                                                           prov, observables.primary->dimension(),
+                                                           resume));
 #endif
-            owned.push_back(std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov, resume));
+            owned.push_back(
+                std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov, resume));
             recorders = std::make_unique<RecorderList>(std::move(owned));
         }
-        RealizationOutput out{s.output.directory, s.output.prefix,
-                              std::lround(s.output.vtk_interval / s.observe.interval),
-                              std::lround(s.output.thermo_interval / s.observe.interval),
-                              resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
+        RealizationOutput out{
+            s.output.directory, s.output.prefix,
+            std::lround(s.output.vtk_interval / s.observe.interval),
+            std::lround(s.output.thermo_interval / s.observe.interval),
+            resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
         for (auto& sys : systems)
-            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species, s.observe.other, out,
-                                                             resume, bed));
+            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species,
+                                                             s.observe.other, out, resume, bed));
     } catch (const std::exception& e) {
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
@@ -150,7 +160,8 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
             }
         } catch (const std::exception& e) {
             code = kExitInputError;
-            message = fmt::format("{}: checkpoint does not fit the scene: {}", restart->path.string(), e.what());
+            message = fmt::format("{}: checkpoint does not fit the scene: {}",
+                                  restart->path.string(), e.what());
         }
         const Agreement agreed = agree_on_failure(mpi.comm(), code, message);
         if (agreed.exit_code != kExitOk) {
@@ -159,9 +170,11 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         }
         log::info("restarted from {} at t = {:.6g}", restart->path.string(), local.front()->time());
     }
-    log::info("efdem {}: {} run of {} on {} ranks x {} = {} realizations ({} particles each), output {}/{}.*",
-              version(), prov.mode, table.file(), mpi.size(), s.realizations_per_rank, prov.realizations,
-              local.front()->particles(), s.output.directory.string(), s.output.prefix);
+    log::info(
+        "efdem {}: {} run of {} on {} ranks x {} = {} realizations ({} particles each), output "
+        "{}/{}.*",
+        version(), prov.mode, table.file(), mpi.size(), s.realizations_per_rank, prov.realizations,
+        local.front()->particles(), s.output.directory.string(), s.output.prefix);
 
     StepperSettings ss;
     ss.sample_interval = s.observe.interval;
@@ -175,12 +188,13 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     ss.parameter = s.steady.parameter;
     ss.lift_members = s.lift_members && s.is_cpi();
     // The run's start (progress counts from there; on the non-root ranks it is not used).
-    const double t0 = resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
+    const double t0 =
+        resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
     const ColourLifter lifter;
     // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).
-    EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter, recorders.get(),
-                            mpi.is_root() && !s.is_steady() ? &progress : nullptr);
+    EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter,
+                            recorders.get(), mpi.is_root() && !s.is_steady() ? &progress : nullptr);
     RunControl control;
     if (resume) {
         stepper.restore_state(restart->header.stepper);
@@ -196,8 +210,9 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         identity.scene_text = table.text();
         identity.parameters = parameter_lines(table);
         // The recorders (root only) name the files they write; the checkpoint stores them whole.
-        writer = std::make_unique<CheckpointWriter>(layout, s.checkpoint, s.output.prefix, std::move(identity),
-                                                    recorders ? recorders->files() : std::vector<std::filesystem::path>{});
+        writer = std::make_unique<CheckpointWriter>(
+            layout, s.checkpoint, s.output.prefix, std::move(identity),
+            recorders ? recorders->files() : std::vector<std::filesystem::path>{});
         stepper.set_checkpoint_writer(writer.get(), s.checkpoint.enabled());
         control.checkpoint_interval = s.checkpoint.interval;
     }
@@ -213,7 +228,8 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
     RunSummary summary;
     try {
         summary = s.is_steady() ? run_steady(stepper, s, recorders.get(), progress)
-                  : s.is_cpi()  ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(), progress, control)
+                  : s.is_cpi()  ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(),
+                                          progress, control)
                                 : run_direct(stepper, s, progress, control);
         wall.fill(summary);
         recorders->finish(summary);
@@ -229,7 +245,8 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         } catch (const std::exception& again) {
             log::error("the run file could not be marked failed: {}", again.what());
         }
-        log::error("the run failed; its files in {} are marked 'failed'", s.output.directory.string());
+        log::error("the run failed; its files in {} are marked 'failed'",
+                   s.output.directory.string());
         return kExitRuntimeFailure;
     } catch (const std::exception& e) {
         // A failure on the root (e.g. its run file on a full disk): mark the run file if it can
@@ -242,26 +259,32 @@ int run(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
         }
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
-    log::info("{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall ({} settling the beds, {} the run), "
-              "{:.3e} particle-steps",
-              summary.end_status, summary.simulated_time, summary.dem_time, format_duration(summary.total_wall_seconds),
-              format_duration(summary.settling_wall_seconds), format_duration(summary.wall_seconds),
-              summary.particle_steps);
+    log::info(
+        "{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall ({} settling the beds, {} "
+        "the run), "
+        "{:.3e} particle-steps",
+        summary.end_status, summary.simulated_time, summary.dem_time,
+        format_duration(summary.total_wall_seconds), format_duration(summary.settling_wall_seconds),
+        format_duration(summary.wall_seconds), summary.particle_steps);
     if (summary.stop_signal != 0) {
         if (s.is_steady()) {
-            std::fprintf(stderr, "efdem: stopped by %s; the iterates so far and the best one are in %s/%s.h5 (mode = "
-                                 "%s cannot be continued from a checkpoint)\n",
-                         signal_name(summary.stop_signal).c_str(), s.output.directory.c_str(), s.output.prefix.c_str(),
-                         s.mode_name());
+            std::fprintf(stderr,
+                         "efdem: stopped by %s; the iterates so far and the best one are in "
+                         "%s/%s.h5 (mode = "
+                         "%s cannot be continued from a checkpoint)\n",
+                         signal_name(summary.stop_signal).c_str(), s.output.directory.c_str(),
+                         s.output.prefix.c_str(), s.mode_name());
         } else if (summary.checkpoint.empty()) {
             std::fprintf(stderr, "efdem: stopped by %s; nothing could be saved (no HDF5)\n",
                          signal_name(summary.stop_signal).c_str());
         } else {
             std::string command = fmt::format("mpirun -n {} efdem {}", mpi.size(), table.file());
             for (const auto& o : table.overrides()) command += " " + o;
-            std::fprintf(stderr, "efdem: stopped by %s: checkpoint %s (t = %.6g); continue with: %s restart=%s\n",
-                         signal_name(summary.stop_signal).c_str(), summary.checkpoint.c_str(),
-                         summary.checkpoint_time, command.c_str(), summary.checkpoint.c_str());
+            std::fprintf(
+                stderr,
+                "efdem: stopped by %s: checkpoint %s (t = %.6g); continue with: %s restart=%s\n",
+                signal_name(summary.stop_signal).c_str(), summary.checkpoint.c_str(),
+                summary.checkpoint_time, command.c_str(), summary.checkpoint.c_str());
         }
         std::fflush(stderr);
         return kExitInterrupted;
@@ -304,7 +327,8 @@ int main(int argc, char** argv) {
         case RunOptions::Action::list_effects:
             if (mpi.is_root()) print_effects();
             return kExitOk;
-        default: break;
+        default:
+            break;
     }
     if (const std::string mismatch = mpi.launcher_mismatch(); !mismatch.empty()) {
         log::error("{}", mismatch);
@@ -332,20 +356,23 @@ int main(int argc, char** argv) {
         // Settling a paper-size bed takes minutes: the root says how its own realizations go
         // (the other ranks settle theirs at the same time).
         SettlingProgressLine settling_line(5.0);
-        const dem::SettlingReport settling = mpi.is_root() ? settling_line.report() : dem::SettlingReport{};
+        const dem::SettlingReport settling =
+            mpi.is_root() ? settling_line.report() : dem::SettlingReport{};
         // A restart replaces every particle state by the checkpoint's (positions, velocities,
         // species, neighbours, contact history, clock, random streams; a dropped realization is
         // never advanced again), so its beds are built but not settled: settling them would only
         // cost minutes on a paper-size bed and be thrown away.
         if (settings->is_steady() && !options.restart.empty())
             throw InputError(SourceLocation{"<command line>", 0},
-                             fmt::format("restart = '{}': mode = {} cannot be continued from a checkpoint (a solve keeps "
+                             fmt::format("restart = '{}': mode = {} cannot be continued from a "
+                                         "checkpoint (a solve keeps "
                                          "micro states in memory that a checkpoint does not hold)",
                                          options.restart, settings->mode_name()));
         const bool skip_settling = check || !options.restart.empty();
         for (int j = 0; j < k; ++j) {
             const long realization = check ? 0 : static_cast<long>(mpi.rank()) * k + j;
-            systems.push_back(dem::build_system(root, {settings->seed, realization, skip_settling}, settling));
+            systems.push_back(
+                dem::build_system(root, {settings->seed, realization, skip_settling}, settling));
         }
         table->check_all_used(
             [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
@@ -354,18 +381,21 @@ int main(int argc, char** argv) {
             check_output_is_free(root, *settings, !options.restart.empty());
 #if EFDEM_HAVE_HDF5
             if (check && !options.restart.empty())
-                check_restart(options.restart, read_checkpoint_header(options.restart), parameter_lines(*table),
-                              mpi.size() * settings->realizations_per_rank, settings->checkpoint.allow_physics_change);
+                check_restart(options.restart, read_checkpoint_header(options.restart),
+                              parameter_lines(*table), mpi.size() * settings->realizations_per_rank,
+                              settings->checkpoint.allow_physics_change);
 #endif
         }
         if (!check) {
             std::filesystem::create_directories(settings->output.directory);
-            std::filesystem::create_directories(settings->checkpoint.directory);  // a stop signal checkpoints
+            std::filesystem::create_directories(
+                settings->checkpoint.directory);  // a stop signal checkpoints
         }
 #if !EFDEM_HAVE_HDF5
         if (settings->checkpoint.enabled() || !options.restart.empty())
             throw InputError(SourceLocation{"<command line>", 0},
-                             "checkpoints need HDF5, and this efdem was built without it (EFDEM_ENABLE_HDF5=OFF)");
+                             "checkpoints need HDF5, and this efdem was built without it "
+                             "(EFDEM_ENABLE_HDF5=OFF)");
 #endif
     } catch (const InputError& e) {
         code = kExitInputError;
@@ -375,15 +405,17 @@ int main(int argc, char** argv) {
         message = e.what();
     } catch (const std::filesystem::filesystem_error& e) {
         code = kExitInputError;
-        message = fmt::format("{} = '{}' cannot be created: {}",
-                              e.path1() == settings->output.directory ? "output.directory" : "checkpoint.directory",
-                              quote_for_message(e.path1().string()), e.code().message());
+        message = fmt::format(
+            "{} = '{}' cannot be created: {}",
+            e.path1() == settings->output.directory ? "output.directory" : "checkpoint.directory",
+            quote_for_message(e.path1().string()), e.code().message());
     } catch (const std::exception& e) {
         code = kExitRuntimeFailure;
         message = std::string("unexpected failure during set-up: ") + e.what();
     }
     const Agreement agreed = agree_on_failure(mpi.comm(), code, message);
-    // Every rank has built (and settled) its realizations: the set-up's wall time, almost all settling.
+    // Every rank has built (and settled) its realizations: the set-up's wall time, almost all
+    // settling.
     wall.settling_seconds = seconds_since(settling_start);
     if (agreed.exit_code != kExitOk) {
         if (mpi.is_root()) log::error("{}", agreed.message);
@@ -397,8 +429,10 @@ int main(int argc, char** argv) {
             try {
                 const auto removed = remove_earlier_run(*settings);
                 if (!removed.empty())
-                    log::info("output.overwrite = true: deleted the {} file(s) of the earlier run {}/{}", removed.size(),
-                              settings->output.directory.string(), settings->output.prefix);
+                    log::info(
+                        "output.overwrite = true: deleted the {} file(s) of the earlier run {}/{}",
+                        removed.size(), settings->output.directory.string(),
+                        settings->output.prefix);
             } catch (const RuntimeFailure& e) {
                 removal = kExitRuntimeFailure;
                 why = e.what();
@@ -414,7 +448,8 @@ int main(int argc, char** argv) {
     if (check) {
         if (mpi.is_root() && list_keys) {
             for (const auto& d : table->declarations())
-                std::printf("%s\t%s\t%s\n", d.key.c_str(), d.expected.c_str(), d.required ? "required" : d.fallback.c_str());
+                std::printf("%s\t%s\t%s\n", d.key.c_str(), d.expected.c_str(),
+                            d.required ? "required" : d.fallback.c_str());
         } else if (mpi.is_root()) {
             std::printf("%s", check_report(*table, *settings, systems.front(), ranks).c_str());
         }

@@ -22,15 +22,17 @@
 namespace efdem::coarse {
 
 class CompactObservable final : public EnsembleObservable {
-public:
+  public:
     explicit CompactObservable(ProbabilityGrid grid, CompactFitSettings settings = {})
         : grid_(grid), settings_(settings) {}
     std::string_view name() const override { return "compact"; }
     std::string_view label() const override { return "compact (A,B,C,D)"; }
     Eigen::Index dimension() const override { return 4; }
     bool needs_top_half() const override { return true; }
-    Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) override;
-    Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const override;
+    Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf,
+                                      const Eigen::MatrixXd& top) override;
+    Eigen::VectorXd lift_target(const Eigen::VectorXd& x,
+                                const Eigen::VectorXd& top) const override;
     int status() const override { return static_cast<int>(last_.status); }
     std::string status_message() const override { return last_.message; }
     std::string failure_message() const override { return last_failure_; }
@@ -39,7 +41,7 @@ public:
     std::vector<double> saved_state() const override;
     void restore_state(const std::vector<double>& state) override;
 
-private:
+  private:
     ProbabilityGrid grid_;
     CompactFitSettings settings_;
     std::optional<CompactParameters> previous_;

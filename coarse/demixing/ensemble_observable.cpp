@@ -13,17 +13,20 @@ std::string EnsembleObservable::failure_reason() const {
     return why.empty() ? std::string("the restriction is not usable") : why;
 }
 
-Eigen::VectorXd IcdfObservable::restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd&) {
+Eigen::VectorXd IcdfObservable::restrict_ensemble(const Eigen::MatrixXd& icdf,
+                                                  const Eigen::MatrixXd&) {
     EFDEM_EXPECTS(icdf.cols() == m_);
     return ensemble_mean(icdf);
 }
 
-Eigen::MatrixXd IcdfObservable::restrict_members(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd&) const {
+Eigen::MatrixXd IcdfObservable::restrict_members(const Eigen::MatrixXd& icdf,
+                                                 const Eigen::MatrixXd&) const {
     EFDEM_EXPECTS(icdf.cols() == m_);
     return icdf;
 }
 
-Eigen::VectorXd IcdfObservable::lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd&) const {
+Eigen::VectorXd IcdfObservable::lift_target(const Eigen::VectorXd& x,
+                                            const Eigen::VectorXd&) const {
     EFDEM_EXPECTS(x.size() == m_);
     return x;
 }

@@ -22,7 +22,7 @@
 namespace efdem::coarse {
 
 class EnsembleObservable {
-public:
+  public:
     virtual ~EnsembleObservable() = default;
     /// The name a scene gives it (cpi.observable), e.g. "icdf".
     virtual std::string_view name() const = 0;
@@ -33,20 +33,23 @@ public:
     /// X of one sample. May carry state (e.g. a warm start); call once per sample, in time order.
     /// Returns a vector of NaN when X cannot be formed (the integrator then rejects the burst);
     /// status() says why.
-    virtual Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) = 0;
+    virtual Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf,
+                                              const Eigen::MatrixXd& top) = 0;
     /// Whether restrict_members() forms each realization's own X (default: no).
     virtual bool restricts_members() const { return false; }
     /// Each realization's own X (R x dimension(), row r = realization r), whose column means
     /// are restrict_ensemble()'s X: what the statistical error of the slope is measured from.
     /// Empty when !restricts_members(). Keeps no state (a warm start belongs to the mean).
-    virtual Eigen::MatrixXd restrict_members(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) const {
+    virtual Eigen::MatrixXd restrict_members(const Eigen::MatrixXd& icdf,
+                                             const Eigen::MatrixXd& top) const {
         (void)icdf;
         (void)top;
         return {};
     }
     /// The observed-species ICDF target for one realization, from the projected X and that
     /// realization's own top-half ICDF (ignored when !needs_top_half()).
-    virtual Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const = 0;
+    virtual Eigen::VectorXd lift_target(const Eigen::VectorXd& x,
+                                        const Eigen::VectorXd& top) const = 0;
     /// 0 when the last restrict_ensemble() succeeded; a message otherwise.
     virtual int status() const { return 0; }
     virtual std::string status_message() const { return {}; }
@@ -73,22 +76,25 @@ public:
 /// X = the ensemble-mean ICDF of the observed species (m nodes); every realization is lifted to
 /// X itself (physics.md §9).
 class IcdfObservable final : public EnsembleObservable {
-public:
+  public:
     explicit IcdfObservable(Eigen::Index m) : m_(m) {}
     std::string_view name() const override { return "icdf"; }
     std::string_view label() const override { return "full ICDF"; }
     Eigen::Index dimension() const override { return m_; }
     bool needs_top_half() const override { return false; }
-    Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) override;
-    Eigen::VectorXd lift_target(const Eigen::VectorXd& x, const Eigen::VectorXd& top) const override;
+    Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf,
+                                      const Eigen::MatrixXd& top) override;
+    Eigen::VectorXd lift_target(const Eigen::VectorXd& x,
+                                const Eigen::VectorXd& top) const override;
     /// Each realization's X is its own ICDF: the rows of `icdf` themselves.
     bool restricts_members() const override { return true; }
-    Eigen::MatrixXd restrict_members(const Eigen::MatrixXd& icdf, const Eigen::MatrixXd& top) const override;
+    Eigen::MatrixXd restrict_members(const Eigen::MatrixXd& icdf,
+                                     const Eigen::MatrixXd& top) const override;
     /// Projected ICDFs are made non-decreasing and clipped into the feasible range before
     /// lifting (physics.md §9 step 1; coarse/demixing/monotone_repair.hpp).
     RepairHook repair_hook(FeasibleRange range) const override;
 
-private:
+  private:
     Eigen::Index m_;
 };
 

@@ -13,12 +13,14 @@ CoarseCoordinates icdf_gap_coordinates(double floor) {
     c.name = "gaps";
     c.to_state = [](const Eigen::VectorXd& u) {
         Eigen::VectorXd x(u.size());
-        for (Eigen::Index i = 0; i < u.size(); ++i) x[i] = i == 0 ? u[0] : x[i - 1] + std::exp(u[i]);
+        for (Eigen::Index i = 0; i < u.size(); ++i)
+            x[i] = i == 0 ? u[0] : x[i - 1] + std::exp(u[i]);
         return x;
     };
     c.from_state = [floor](const Eigen::VectorXd& x) {
         Eigen::VectorXd u(x.size());
-        for (Eigen::Index i = 0; i < x.size(); ++i) u[i] = i == 0 ? x[0] : std::log(std::max(x[i] - x[i - 1], floor));
+        for (Eigen::Index i = 0; i < x.size(); ++i)
+            u[i] = i == 0 ? x[0] : std::log(std::max(x[i] - x[i - 1], floor));
         return u;
     };
     return c;

@@ -19,11 +19,14 @@ std::unique_ptr<EnsembleObservable> make_compact(const ProbabilityGrid& grid) {
 constexpr ObservableTable::Entry kObservables[] = {
     {"icdf", &make_icdf, "the ensemble-mean ICDF of the observed species on the p-grid (m nodes)"},
     {"compact", &make_compact,
-     "(A, B, C, D) of y = Q_top - Q_L ~ max[A p + B + C e^(D p), 0] (paper Eq. 3), fitted per sample"},
+     "(A, B, C, D) of y = Q_top - Q_L ~ max[A p + B + C e^(D p), 0] (paper Eq. 3), fitted per "
+     "sample"},
 };
 constexpr ObservableTable kTable{kObservables};
 }  // namespace
 
-const ObservableTable& observable_table() { return kTable; }
+const ObservableTable& observable_table() {
+    return kTable;
+}
 
 }  // namespace efdem::coarse

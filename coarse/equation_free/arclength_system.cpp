@@ -11,7 +11,8 @@ namespace efdem::coarse {
 
 ArclengthSystem::ArclengthSystem(CoarseMap& map, Eigen::VectorXd tangent, Eigen::VectorXd predicted)
     : map_(map), tangent_(std::move(tangent)), predicted_(std::move(predicted)) {
-    EFDEM_EXPECTS(map_.has_parameter() && tangent_.size() == predicted_.size() && tangent_.size() >= 2);
+    EFDEM_EXPECTS(map_.has_parameter() && tangent_.size() == predicted_.size() &&
+                  tangent_.size() >= 2);
     EFDEM_EXPECTS(std::abs(tangent_.norm() - 1.0) < 1e-12);
     EFDEM_EXPECTS(map_.parameter_in_bounds(predicted_[predicted_.size() - 1]));
 }
@@ -47,7 +48,8 @@ SystemEvaluation ArclengthSystem::trial(const Eigen::VectorXd& y) {
     EFDEM_EXPECTS(y.size() == dimension());
     const Eigen::Index n = y.size() - 1;
     if (!map_.parameter_in_bounds(y[n])) {  // not run: no decrease
-        log::info("arclength trial at lambda = {:.6g} outside the parameter bounds: not evaluated", y[n]);
+        log::info("arclength trial at lambda = {:.6g} outside the parameter bounds: not evaluated",
+                  y[n]);
         SystemEvaluation out;
         out.g = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::infinity());
         return out;

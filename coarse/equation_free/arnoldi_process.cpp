@@ -39,8 +39,12 @@ bool ArnoldiProcess::extend() {
     return true;
 }
 
-Eigen::MatrixXd ArnoldiProcess::basis() const { return v_.leftCols(invariant_ ? k_ : k_ + 1); }
+Eigen::MatrixXd ArnoldiProcess::basis() const {
+    return v_.leftCols(invariant_ ? k_ : k_ + 1);
+}
 
-Eigen::MatrixXd ArnoldiProcess::hessenberg() const { return h_.topLeftCorner(invariant_ ? k_ : k_ + 1, k_); }
+Eigen::MatrixXd ArnoldiProcess::hessenberg() const {
+    return h_.topLeftCorner(invariant_ ? k_ : k_ + 1, k_);
+}
 
 }  // namespace efdem::coarse

@@ -11,7 +11,8 @@ namespace efdem::coarse {
 
 Eigen::MatrixXd CoarseCoordinates::rows_from_state(const Eigen::MatrixXd& rows) const {
     Eigen::MatrixXd out(rows.rows(), rows.cols());
-    for (Eigen::Index r = 0; r < rows.rows(); ++r) out.row(r) = from_state(rows.row(r).transpose()).transpose();
+    for (Eigen::Index r = 0; r < rows.rows(); ++r)
+        out.row(r) = from_state(rows.row(r).transpose()).transpose();
     return out;
 }
 
@@ -57,7 +58,8 @@ MapEvaluation CoarseMap::run_once(const Eigen::VectorXd& x, double parameter) {
     }
     e.noise_norm = e.standard_error.norm();
     // In X: Phi's restriction against the point the solver asked for (before any repair).
-    e.state_residual_norm = coordinates_ ? (burst.x.back() - coordinates_.to_state(x)).norm() : e.f.norm();
+    e.state_residual_norm =
+        coordinates_ ? (burst.x.back() - coordinates_.to_state(x)).norm() : e.f.norm();
     e.state_noise_norm = coordinates_ ? state_noise : e.noise_norm;
     return e;
 }
@@ -88,8 +90,10 @@ Eigen::VectorXd CoarseMap::derivative(const Eigen::VectorXd& v, double dparamete
     if (length == 0.0) return Eigen::VectorXd::Zero(v.size());
     const double forward = base_.parameter + (settings_.difference_step / length) * dparameter;
     // Backwards where the forward point's parameter is one the micro model cannot run at.
-    const double h = parameter_in_bounds(forward) ? settings_.difference_step : -settings_.difference_step;
-    const MapEvaluation e = evaluate_from_base(base_.x + (h / length) * v, base_.parameter + (h / length) * dparameter);
+    const double h =
+        parameter_in_bounds(forward) ? settings_.difference_step : -settings_.difference_step;
+    const MapEvaluation e =
+        evaluate_from_base(base_.x + (h / length) * v, base_.parameter + (h / length) * dparameter);
     derivative_noise_ = 0.0;
     if (base_.members.rows() >= 2 && e.members.rows() == base_.members.rows()) {
         const Eigen::MatrixXd d = (e.members - base_.members) * (length / h);

@@ -63,10 +63,10 @@ struct CoarseCoordinates {
 
 /// One evaluation of the map.
 struct MapEvaluation {
-    Eigen::VectorXd x;    ///< the lifted point
+    Eigen::VectorXd x;     ///< the lifted point
     double parameter = 0;  ///< the parameter it was evaluated at (0 without a parameter hook)
-    Eigen::VectorXd phi;  ///< Phi_tau(x): the restricted sample at the end of the burst
-    Eigen::VectorXd f;    ///< F = phi - x
+    Eigen::VectorXd phi;   ///< Phi_tau(x): the restricted sample at the end of the burst
+    Eigen::VectorXd f;     ///< F = phi - x
     /// Standard error of each component of phi from the members' spread at the last sample
     /// (sqrt(var/R)); zeros when the stepper reports no members or only one.
     Eigen::VectorXd standard_error;

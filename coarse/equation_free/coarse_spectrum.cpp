@@ -28,7 +28,9 @@ std::vector<CoarseEigenvalue> ritz_values(const ArnoldiProcess& arnoldi, double 
         e.residual = arnoldi.next_coupling() * std::abs(y[k - 1]);
     }
     std::stable_sort(out.begin(), out.end(),
-                     [](const CoarseEigenvalue& a, const CoarseEigenvalue& b) { return std::abs(a.mu) > std::abs(b.mu); });
+                     [](const CoarseEigenvalue& a, const CoarseEigenvalue& b) {
+                         return std::abs(a.mu) > std::abs(b.mu);
+                     });
     return out;
 }
 
@@ -37,8 +39,9 @@ std::vector<CoarseEigenvalue> ritz_values(const ArnoldiProcess& arnoldi, double 
 CoarseSpectrum leading_eigenvalues(const LinearOperator& jacobian, Eigen::Index n, double tau,
                                    const SpectrumSettings& settings) {
     EFDEM_EXPECTS(n >= 1 && tau > 0.0 && settings.eigenvalues >= 1);
-    const int limit = settings.max_products > 0 ? std::min<int>(settings.max_products, static_cast<int>(n))
-                                                : static_cast<int>(n);
+    const int limit = settings.max_products > 0
+                          ? std::min<int>(settings.max_products, static_cast<int>(n))
+                          : static_cast<int>(n);
     std::mt19937_64 rng(settings.seed);
     std::uniform_real_distribution<double> uniform(0.5, 1.5);  // every mode present in the start
     Eigen::VectorXd start(n);
@@ -50,8 +53,9 @@ CoarseSpectrum leading_eigenvalues(const LinearOperator& jacobian, Eigen::Index 
         out.leading = ritz_values(arnoldi, tau);
         if (arnoldi.invariant()) break;
         if (out.leading.size() < wanted) continue;
-        const bool settled = std::all_of(out.leading.begin(), out.leading.begin() + static_cast<long>(wanted),
-                                         [&](const CoarseEigenvalue& e) { return e.residual <= settings.tolerance; });
+        const bool settled = std::all_of(
+            out.leading.begin(), out.leading.begin() + static_cast<long>(wanted),
+            [&](const CoarseEigenvalue& e) { return e.residual <= settings.tolerance; });
         if (settled) break;
     }
     out.products = arnoldi.steps();
@@ -60,14 +64,15 @@ CoarseSpectrum leading_eigenvalues(const LinearOperator& jacobian, Eigen::Index 
     return out;
 }
 
-CoarseSpectrum coarse_spectrum(CoarseMap& map, const Eigen::VectorXd& x, const SpectrumSettings& settings,
-                               double parameter) {
+CoarseSpectrum coarse_spectrum(CoarseMap& map, const Eigen::VectorXd& x,
+                               const SpectrumSettings& settings, double parameter) {
     map.begin(x, parameter);
     double noise2 = 0.0;  // Arnoldi's basis vectors are unit vectors: |e_j| is the product's noise
     CoarseSpectrum out = leading_eigenvalues(
         [&map, &noise2](const Eigen::VectorXd& v) {
             Eigen::VectorXd jv = map.derivative(v);
-            noise2 += map.derivative_noise() * map.derivative_noise() / std::max(v.squaredNorm(), 1e-300);
+            noise2 +=
+                map.derivative_noise() * map.derivative_noise() / std::max(v.squaredNorm(), 1e-300);
             return jv;
         },
         x.size(), map.settings().tau, settings);

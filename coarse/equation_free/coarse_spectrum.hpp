@@ -53,7 +53,7 @@ struct CoarseEigenvalue {
 struct CoarseSpectrum {
     std::vector<CoarseEigenvalue> leading;  ///< by |mu|, largest first
     int products = 0;                       ///< directional derivatives spent
-    bool whole_space = false;  ///< the Krylov space became invariant (or all of R^n)
+    bool whole_space = false;               ///< the Krylov space became invariant (or all of R^n)
 };
 
 /// Leading eigenvalues of the operator `jacobian` (dimension n) over a time tau.
@@ -63,7 +63,7 @@ CoarseSpectrum leading_eigenvalues(const LinearOperator& jacobian, Eigen::Index 
 
 /// The same at the steady state x (parameter: for a map with a parameter hook): begins a base
 /// at x on `map`, takes the derivatives from it, and ends it. \pre no base on `map`.
-CoarseSpectrum coarse_spectrum(CoarseMap& map, const Eigen::VectorXd& x, const SpectrumSettings& settings,
-                               double parameter = 0.0);
+CoarseSpectrum coarse_spectrum(CoarseMap& map, const Eigen::VectorXd& x,
+                               const SpectrumSettings& settings, double parameter = 0.0);
 
 }  // namespace efdem::coarse

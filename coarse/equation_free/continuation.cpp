@@ -22,29 +22,34 @@ std::vector<FoldEstimate> Branch::folds() const {
         const auto chord = [this](std::size_t a) {
             const BranchPoint& p = points[a];
             const BranchPoint& q = points[a + 1];
-            return std::sqrt((q.x - p.x).squaredNorm() + (q.parameter - p.parameter) * (q.parameter - p.parameter));
+            return std::sqrt((q.x - p.x).squaredNorm() +
+                             (q.parameter - p.parameter) * (q.parameter - p.parameter));
         };
         // Parabola through (0, l0), (s1, l1), (s2, l2) in Newton form; its vertex.
         const double s1 = chord(k - 1), s2 = s1 + chord(k);
-        const double l0 = points[k - 1].parameter, l1 = points[k].parameter, l2 = points[k + 1].parameter;
-        const double a1 = (l1 - l0) / s1, a2 = ((l2 - l1) / (s2 - s1) - a1) / s2;  // l = l0 + a1 s + a2 s (s - s1)
+        const double l0 = points[k - 1].parameter, l1 = points[k].parameter,
+                     l2 = points[k + 1].parameter;
+        const double a1 = (l1 - l0) / s1,
+                     a2 = ((l2 - l1) / (s2 - s1) - a1) / s2;  // l = l0 + a1 s + a2 s (s - s1)
         const double s_vertex = (a2 * s1 - a1) / (2 * a2);
         out.push_back({k, l0 + a1 * s_vertex + a2 * s_vertex * (s_vertex - s1)});
     }
     return out;
 }
 
-PseudoArclengthContinuation::PseudoArclengthContinuation(CoarseMap& map, const ContinuationSettings& settings)
+PseudoArclengthContinuation::PseudoArclengthContinuation(CoarseMap& map,
+                                                         const ContinuationSettings& settings)
     : map_(map), settings_(settings), newton_(settings.corrector) {
     EFDEM_EXPECTS(map_.has_parameter() && !map_.has_base());
-    EFDEM_EXPECTS(settings_.evaluation_min <= settings_.parameter_min && settings_.parameter_max <= settings_.evaluation_max);
+    EFDEM_EXPECTS(settings_.evaluation_min <= settings_.parameter_min &&
+                  settings_.parameter_max <= settings_.evaluation_max);
     EFDEM_EXPECTS(0.0 < settings_.min_step && settings_.min_step <= settings_.step &&
                   settings_.step <= settings_.max_step && settings_.max_points >= 1 &&
                   settings_.target_iterations >= 1 && settings_.fallback_ratio >= 0.0);
 }
 
-BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec, Eigen::Index n, double step,
-                                                    double micro_before) {
+BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec, Eigen::Index n,
+                                                    double step, double micro_before) {
     BranchPoint p;
     p.x = rec.x.head(n);
     p.parameter = rec.x.size() > n ? rec.x[n] : 0.0;
@@ -59,11 +64,15 @@ BranchPoint PseudoArclengthContinuation::make_point(const SteadySolveRecord& rec
         if (p.has_leading) p.leading = s.leading.front();
     }
     p.micro_time = map_.micro_time() - micro_before;
-    log::info("branch point: parameter = {:.6g}, |F| = {:.3e}, {} Newton step(s){}{}", p.parameter * settings_.display_scale, p.residual,
-              p.newton_iterations, p.from_fallback ? " from the last point" : "",
-              p.has_leading ? fmt::format(", leading mu = {:.6g}{:+.3g}i (residual {:.2g}, products' noise {:.2g})",
-                                          p.leading.mu.real(), p.leading.mu.imag(), p.leading.residual, p.leading.noise)
-                            : std::string{});
+    log::info(
+        "branch point: parameter = {:.6g}, |F| = {:.3e}, {} Newton step(s){}{}",
+        p.parameter * settings_.display_scale, p.residual, p.newton_iterations,
+        p.from_fallback ? " from the last point" : "",
+        p.has_leading
+            ? fmt::format(", leading mu = {:.6g}{:+.3g}i (residual {:.2g}, products' noise {:.2g})",
+                          p.leading.mu.real(), p.leading.mu.imag(), p.leading.residual,
+                          p.leading.noise)
+            : std::string{});
     return p;
 }
 
@@ -75,7 +84,9 @@ Eigen::VectorXd PseudoArclengthContinuation::first_tangent(const Eigen::VectorXd
     GmresSettings gs;
     gs.max_iterations = settings_.corrector.max_krylov;
     gs.relative_tolerance = settings_.corrector.forcing;
-    const GmresResult z = gmres([this](const Eigen::VectorXd& v) -> Eigen::VectorXd { return map_.derivative(v) - v; }, -f_lambda, gs);
+    const GmresResult z = gmres(
+        [this](const Eigen::VectorXd& v) -> Eigen::VectorXd { return map_.derivative(v) - v; },
+        -f_lambda, gs);
     map_.end();
     Eigen::VectorXd t(n + 1);
     t.head(n) = z.x;
@@ -84,7 +95,7 @@ Eigen::VectorXd PseudoArclengthContinuation::first_tangent(const Eigen::VectorXd
 }
 
 std::pair<double, bool> PseudoArclengthContinuation::predictor_step(double ds, double lambda,
-                                                                     double t_lambda) const {
+                                                                    double t_lambda) const {
     const double speed = std::abs(t_lambda);
     if (settings_.max_parameter_step > 0.0 && ds * speed > settings_.max_parameter_step)
         ds = settings_.max_parameter_step / speed;
@@ -97,19 +108,21 @@ std::pair<double, bool> PseudoArclengthContinuation::predictor_step(double ds, d
 
 std::string PseudoArclengthContinuation::range_end(const char* what, double lambda) const {
     const double k = settings_.display_scale;
-    return fmt::format("{} the parameter range [{:.6g}, {:.6g}] at {:.6g}", what, settings_.parameter_min * k,
-                       settings_.parameter_max * k, lambda * k);
+    return fmt::format("{} the parameter range [{:.6g}, {:.6g}] at {:.6g}", what,
+                       settings_.parameter_min * k, settings_.parameter_max * k, lambda * k);
 }
 
-Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda0, double direction) {
+Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda0,
+                                        double direction) {
     const long evaluations0 = map_.evaluations();
     const double micro0 = map_.micro_time();
     const Eigen::Index n = x0.size();
     Branch branch;
     // No corrector (nor difference) runs the micro model beyond one parameter step outside the
     // range, nor where it cannot run at all.
-    const double margin = settings_.max_parameter_step > 0.0 ? settings_.max_parameter_step
-                                                               : settings_.parameter_max - settings_.parameter_min;
+    const double margin = settings_.max_parameter_step > 0.0
+                              ? settings_.max_parameter_step
+                              : settings_.parameter_max - settings_.parameter_min;
     map_.set_parameter_bounds(std::max(settings_.parameter_min - margin, settings_.evaluation_min),
                               std::min(settings_.parameter_max + margin, settings_.evaluation_max));
     double before = map_.micro_time();
@@ -117,8 +130,9 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
     SteadySolveRecord rec = newton_.solve(first, x0);
     branch.first_solve = rec;
     if (!rec.converged()) {
-        branch.end_reason = fmt::format("the first point at parameter = {:.6g} did not converge: {}",
-                                        lambda0 * settings_.display_scale, rec.message);
+        branch.end_reason =
+            fmt::format("the first point at parameter = {:.6g} did not converge: {}",
+                        lambda0 * settings_.display_scale, rec.message);
     } else {
         SteadySolveRecord with_lambda = rec;
         with_lambda.x.conservativeResize(n + 1);
@@ -130,8 +144,8 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
         Eigen::VectorXd t = first_tangent(branch.points.back().x, lambda0, direction);
         double ds = settings_.step;
         if (settings_.parameter_step > 0.0)
-            ds = std::clamp(settings_.parameter_step / std::max(std::abs(t[n]), 1e-12), settings_.min_step,
-                            settings_.max_step);
+            ds = std::clamp(settings_.parameter_step / std::max(std::abs(t[n]), 1e-12),
+                            settings_.min_step, settings_.max_step);
         branch.end_reason = fmt::format("{} points (the limit)", settings_.max_points);
         while (static_cast<int>(branch.points.size()) < settings_.max_points) {
             before = map_.micro_time();
@@ -154,14 +168,16 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
             held.system = &natural;
             rec = newton_.solve(system, predicted, &held);
             if (rec.reason == SteadyStopReason::stopped) {
-                branch.end_reason = fmt::format("stopped after parameter = {:.6g}: {}", y[n] * settings_.display_scale, rec.message);
+                branch.end_reason = fmt::format("stopped after parameter = {:.6g}: {}",
+                                                y[n] * settings_.display_scale, rec.message);
                 break;
             }
             if (!rec.converged()) {
                 ds = step * 0.5;
                 if (ds < settings_.min_step) {
-                    branch.end_reason = fmt::format("the step fell below {:.3g} after parameter = {:.6g}: {}",
-                                                    settings_.min_step, y[n] * settings_.display_scale, rec.message);
+                    branch.end_reason = fmt::format(
+                        "the step fell below {:.3g} after parameter = {:.6g}: {}",
+                        settings_.min_step, y[n] * settings_.display_scale, rec.message);
                     break;
                 }
                 continue;
@@ -178,8 +194,9 @@ Branch PseudoArclengthContinuation::run(const Eigen::VectorXd& x0, double lambda
                 branch.end_reason = range_end("reached the end of", y[n]);
                 break;
             }
-            const double factor = std::clamp(static_cast<double>(settings_.target_iterations) /
-                                                 std::max(1, rec.iterations), 0.5, 2.0);
+            const double factor = std::clamp(
+                static_cast<double>(settings_.target_iterations) / std::max(1, rec.iterations), 0.5,
+                2.0);
             ds = std::clamp(step * factor, settings_.min_step, settings_.max_step);
         }
     }

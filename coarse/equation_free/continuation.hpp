@@ -64,9 +64,9 @@ struct ContinuationSettings {
     /// A predicted point with |F| above this multiple of the stopping threshold is compared
     /// with the last point at the predicted parameter (FallbackGuess: one or two extra bursts).
     double fallback_ratio = 2.0;
-    bool stability = true;      ///< the leading eigenvalue at each point
+    bool stability = true;                            ///< the leading eigenvalue at each point
     SpectrumSettings spectrum = SpectrumSettings{1};  // the leading eigenvalue only
-    BranchObserver on_point;  ///< may be empty
+    BranchObserver on_point;                          ///< may be empty
     /// lambda x display_scale is what the log and the end reason show (the scene's units when
     /// the caller continues in a scaled parameter).
     double display_scale = 1.0;
@@ -115,7 +115,8 @@ class PseudoArclengthContinuation {
 
   private:
     /// Stability and bookkeeping of a corrected point.
-    BranchPoint make_point(const SteadySolveRecord& rec, Eigen::Index n, double step, double micro_before);
+    BranchPoint make_point(const SteadySolveRecord& rec, Eigen::Index n, double step,
+                           double micro_before);
     /// The unit tangent at (x, lambda) from F_X z = -F_lambda.
     Eigen::VectorXd first_tangent(const Eigen::VectorXd& x, double lambda, double direction);
     /// The predictor's arclength step from the planned ds: at most max_parameter_step in lambda,

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <deque>
 
-#include <Eigen/QR>
 #include <fmt/format.h>
+#include <Eigen/QR>
 
 #include "core/contracts.hpp"
 #include "core/log.hpp"
@@ -12,11 +12,12 @@
 namespace efdem::coarse {
 
 FixedPointIteration::FixedPointIteration(const FixedPointSettings& settings) : settings_(settings) {
-    EFDEM_EXPECTS(settings_.max_iterations >= 0 && settings_.damping > 0.0 && settings_.damping <= 1.0 &&
-                  settings_.depth >= 0);
+    EFDEM_EXPECTS(settings_.max_iterations >= 0 && settings_.damping > 0.0 &&
+                  settings_.damping <= 1.0 && settings_.depth >= 0);
 }
 
-SteadySolveRecord FixedPointIteration::solve(CoarseMap& map, const Eigen::VectorXd& x0, double parameter) const {
+SteadySolveRecord FixedPointIteration::solve(CoarseMap& map, const Eigen::VectorXd& x0,
+                                             double parameter) const {
     EFDEM_EXPECTS(!map.has_base());
     const long evaluations0 = map.evaluations();
     const double micro0 = map.micro_time();
@@ -29,26 +30,30 @@ SteadySolveRecord FixedPointIteration::solve(CoarseMap& map, const Eigen::Vector
         const double r = e.f.norm();
         const bool growing = r > rec.best_residual;
         rec.add_iterate(x, r, e.noise_norm, e.state_residual_norm, e.state_noise_norm);
-        log::info("fixed point {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r, e.noise_norm);
+        log::info("fixed point {:3d}: |F| = {:.4e} (noise {:.3e})", rec.iterations, r,
+                  e.noise_norm);
         // The observer sees every iterate (the last one too); a stop it asks for comes after
         // the stopping rule, so a converged solve is never reported as stopped.
         const std::string stop_asked = settings_.observer ? settings_.observer(rec) : std::string{};
         if (settings_.stop.reached(r, e.noise_norm, rec.reason)) {
-            rec.message = fmt::format("{} after {} fixed-point iteration(s): |F| = {:.4e} <= {:.4e}",
-                                      to_string(rec.reason), rec.iterations, r,
-                                      settings_.stop.threshold(e.noise_norm));
+            rec.message = fmt::format(
+                "{} after {} fixed-point iteration(s): |F| = {:.4e} <= {:.4e}",
+                to_string(rec.reason), rec.iterations, r, settings_.stop.threshold(e.noise_norm));
             break;
         }
         if (!stop_asked.empty()) {
             rec.reason = SteadyStopReason::stopped;
-            rec.message = fmt::format("stopped after {} fixed-point iteration(s) with |F| = {:.4e}: {}", rec.iterations, r, stop_asked);
+            rec.message =
+                fmt::format("stopped after {} fixed-point iteration(s) with |F| = {:.4e}: {}",
+                            rec.iterations, r, stop_asked);
             break;
         }
         if (rec.iterations >= settings_.max_iterations) {
             rec.reason = SteadyStopReason::max_iterations;
-            rec.message = fmt::format("{} fixed-point iterations done with |F| = {:.4e} above {:.4e} (noise "
-                                      "{:.3e}); the slowest coarse mode may be close to 1: try Newton-Krylov",
-                                      rec.iterations, r, settings_.stop.threshold(e.noise_norm), e.noise_norm);
+            rec.message = fmt::format(
+                "{} fixed-point iterations done with |F| = {:.4e} above {:.4e} (noise "
+                "{:.3e}); the slowest coarse mode may be close to 1: try Newton-Krylov",
+                rec.iterations, r, settings_.stop.threshold(e.noise_norm), e.noise_norm);
             break;
         }
         if (growing) {

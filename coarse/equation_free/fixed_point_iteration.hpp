@@ -7,7 +7,8 @@
 ///   f_k = Phi(x_k) - x_k;
 ///   depth 0 (damped):  x_{k+1} = x_k + beta f_k;
 ///   depth m (Anderson): gamma = argmin |f_k - dF gamma| over the last m differences
-///       dF = [f_{j+1} - f_j], dX = [x_{j+1} - x_j];  x_{k+1} = x_k + beta f_k - (dX + beta dF) gamma.
+///       dF = [f_{j+1} - f_j], dX = [x_{j+1} - x_j];  x_{k+1} = x_k + beta f_k - (dX + beta dF)
+///       gamma.
 ///
 /// The history is dropped when |f| grows past the best seen (the extrapolation went wrong, or
 /// noise dominates the differences). Same stopping rule and record as NewtonKrylov. Plain
@@ -33,7 +34,8 @@ class FixedPointIteration {
   public:
     explicit FixedPointIteration(const FixedPointSettings& settings);
     /// Iterates on `map` (no base on it) from x0 at `parameter`.
-    SteadySolveRecord solve(CoarseMap& map, const Eigen::VectorXd& x0, double parameter = 0.0) const;
+    SteadySolveRecord solve(CoarseMap& map, const Eigen::VectorXd& x0,
+                            double parameter = 0.0) const;
 
   private:
     FixedPointSettings settings_;

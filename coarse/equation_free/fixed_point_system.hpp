@@ -16,7 +16,9 @@ class FixedPointSystem final : public NewtonSystem {
 
     Eigen::Index dimension() const override { return n_; }
     SystemEvaluation begin(const Eigen::VectorXd& y) override;
-    Eigen::VectorXd jacobian_times(const Eigen::VectorXd& v) override { return map_.derivative(v) - v; }
+    Eigen::VectorXd jacobian_times(const Eigen::VectorXd& v) override {
+        return map_.derivative(v) - v;
+    }
     SystemEvaluation trial(const Eigen::VectorXd& y) override;
     void end() override { map_.end(); }
     long evaluations() const override { return map_.evaluations(); }

@@ -8,7 +8,8 @@
 
 namespace efdem::coarse {
 
-GmresResult gmres(const LinearOperator& a, const Eigen::VectorXd& b, const GmresSettings& settings) {
+GmresResult gmres(const LinearOperator& a, const Eigen::VectorXd& b,
+                  const GmresSettings& settings) {
     EFDEM_EXPECTS(settings.max_iterations >= 1 && b.allFinite());
     GmresResult out;
     out.x = Eigen::VectorXd::Zero(b.size());
@@ -19,7 +20,8 @@ GmresResult gmres(const LinearOperator& a, const Eigen::VectorXd& b, const Gmres
         out.converged = true;
         return out;
     }
-    ArnoldiProcess arnoldi(a, b, std::min<int>(settings.max_iterations, static_cast<int>(b.size())));
+    ArnoldiProcess arnoldi(a, b,
+                           std::min<int>(settings.max_iterations, static_cast<int>(b.size())));
     Eigen::VectorXd y;
     while (arnoldi.extend()) {
         const Eigen::MatrixXd h = arnoldi.hessenberg();

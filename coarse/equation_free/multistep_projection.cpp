@@ -38,14 +38,16 @@ std::vector<double> projection_weights(std::span<const SlopeNode> nodes, double 
     return w;
 }
 
-Eigen::VectorXd projected_increment(std::span<const SlopeNode> nodes, std::span<const double> weights) {
+Eigen::VectorXd projected_increment(std::span<const SlopeNode> nodes,
+                                    std::span<const double> weights) {
     EFDEM_EXPECTS(weights.size() == nodes.size() && !nodes.empty());
     Eigen::VectorXd inc = weights[0] * nodes[0].slope;
     for (std::size_t k = 1; k < nodes.size(); ++k) inc += weights[k] * nodes[k].slope;
     return inc;
 }
 
-Eigen::VectorXd statistical_error(std::span<const SlopeNode> nodes, std::span<const double> weights) {
+Eigen::VectorXd statistical_error(std::span<const SlopeNode> nodes,
+                                  std::span<const double> weights) {
     EFDEM_EXPECTS(weights.size() == nodes.size() && !nodes.empty());
     Eigen::VectorXd var = Eigen::VectorXd::Zero(nodes[0].slope.size());
     for (std::size_t k = 0; k < nodes.size(); ++k) {

@@ -32,9 +32,9 @@ namespace efdem::coarse {
 
 /// One measured slope: where it belongs in time, its value and its standard error.
 struct SlopeNode {
-    double tau = 0.0;        ///< centre of the estimation window
-    Eigen::VectorXd slope;   ///< s [unit of X per sqrt(d_p/g)]
-    Eigen::VectorXd se;      ///< standard error of s per component (same unit)
+    double tau = 0.0;       ///< centre of the estimation window
+    Eigen::VectorXd slope;  ///< s [unit of X per sqrt(d_p/g)]
+    Eigen::VectorXd se;     ///< standard error of s per component (same unit)
 };
 
 /**
@@ -46,10 +46,12 @@ struct SlopeNode {
 std::vector<double> projection_weights(std::span<const SlopeNode> nodes, double t0, double dt);
 
 /// sum_k W_k s_k: the increment of X over the jump. \pre weights.size() == nodes.size().
-Eigen::VectorXd projected_increment(std::span<const SlopeNode> nodes, std::span<const double> weights);
+Eigen::VectorXd projected_increment(std::span<const SlopeNode> nodes,
+                                    std::span<const double> weights);
 
 /// Per component sqrt(sum_k W_k^2 se_k^2): the projection noise of the jump.
-Eigen::VectorXd statistical_error(std::span<const SlopeNode> nodes, std::span<const double> weights);
+Eigen::VectorXd statistical_error(std::span<const SlopeNode> nodes,
+                                  std::span<const double> weights);
 
 /// | integral_{t0}^{t0+dt} prod_k (t - tau_k) dt | over the method's nodes.
 double omega_integral(std::span<const SlopeNode> nodes, double t0, double dt);

@@ -29,7 +29,8 @@ WindowFit fit_window(const BurstSamples& b, double t_a, std::size_t n) {
     WindowFit f;
     f.slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
     if (f.slope.ok && b.members.size() == b.t.size())
-        f.se = member_slope_standard_error(t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
+        f.se = member_slope_standard_error(t, std::span<const Eigen::MatrixXd>(b.members.data(), n),
+                                           t_a);
     return f;
 }
 
@@ -37,8 +38,8 @@ WindowFit fit_window(const BurstSamples& b, double t_a, std::size_t n) {
 /// samples or no members.
 bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
     const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
-    const auto n = static_cast<std::size_t>(
-        std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) - b.t.begin());  // samples before t_b
+    const auto n = static_cast<std::size_t>(std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) -
+                                            b.t.begin());  // samples before t_b
     WindowFit f = fit_window(b, t_a, n);
     if (!f.slope.ok || f.se.size() != f.slope.slope.size()) return false;
     out = SlopeNode{f.slope.t_mean, std::move(f.slope.slope), std::move(f.se)};
@@ -47,7 +48,8 @@ bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) 
 
 }  // namespace
 
-MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSettings& settings, RepairHook repair)
+MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSettings& settings,
+                                                             RepairHook repair)
     : settings_(settings), repair_(std::move(repair)) {
     EFDEM_EXPECTS(std::isfinite(settings.healing) && settings.healing >= 0.0);
     EFDEM_EXPECTS(std::isfinite(settings.window) && settings.window > 0.0);
@@ -63,12 +65,13 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
 }
 
 std::string_view MultistepProjectiveIntegrator::name() const {
-    if (settings_.steps == 2) return settings_.adaptive ? "adaptive_adams_bashforth2" : "projective_adams_bashforth2";
+    if (settings_.steps == 2)
+        return settings_.adaptive ? "adaptive_adams_bashforth2" : "projective_adams_bashforth2";
     return settings_.adaptive ? "adaptive_forward_euler" : "projective_forward_euler_multistep";
 }
 
-bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
-                                                  double length) const {
+bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec,
+                                                  Measured& out, double length) const {
     const double t_start = stepper.time();
     const double burst = settings_.healing + settings_.window;
     if (!(length > 0.0)) length = burst;
@@ -97,11 +100,13 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     if (out.node.se.size() != slope.slope.size()) {
         if (settings_.adaptive) {
             rec.status = StepStatus::invalid_burst;
-            append_message(rec, "the error controller needs every realization's own slope (at least two "
-                                "realizations, an observable with members)");
+            append_message(rec,
+                           "the error controller needs every realization's own slope (at least two "
+                           "realizations, an observable with members)");
             return false;
         }
-        out.node.se = Eigen::VectorXd::Zero(slope.slope.size());  // fixed DT: estimates without noise
+        out.node.se =
+            Eigen::VectorXd::Zero(slope.slope.size());  // fixed DT: estimates without noise
     }
     out.node.tau = slope.t_mean;
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
@@ -113,11 +118,13 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         if (d.drifting) {
             out.hold_kind = "fast transient";
             out.hold = "still in a fast transient (" + d.message + ")";
-        } else if (w.in_phase && settings_.window < 2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
+        } else if (w.in_phase &&
+                   settings_.window < 2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
             out.hold_kind = "in-phase wave";
-            out.hold = fmt::format("{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
-                                    "by the common wave beyond its standard error; use cpi.window >= {:.3g}",
-                                    w.message, settings_.window, 2.0 * w.period);
+            out.hold = fmt::format(
+                "{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
+                "by the common wave beyond its standard error; use cpi.window >= {:.3g}",
+                w.message, settings_.window, 2.0 * w.period);
         }
     }
     rec.window = slope.t_last - slope.t_first;
@@ -146,7 +153,8 @@ std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
 double MultistepProjectiveIntegrator::prior_curvature() const {
     const std::size_t q = method_nodes().size();
     if (history_.size() < q + 1) return std::numeric_limits<double>::quiet_NaN();
-    const std::vector<SlopeNode> nodes(history_.end() - static_cast<std::ptrdiff_t>(q + 1), history_.end());
+    const std::vector<SlopeNode> nodes(history_.end() - static_cast<std::ptrdiff_t>(q + 1),
+                                       history_.end());
     return slope_divided_difference(nodes).norm;
 }
 
@@ -167,7 +175,8 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         return std::min(settings_.dt, end_limit(settings_.dt));
     }
     const StepSizeSettings& s = settings_.control;
-    if (!hold_.empty()) {  // the slope is a fast transient's or a common wave's, not the slow dynamics'
+    if (!hold_.empty()) {  // the slope is a fast transient's or a common wave's, not the slow
+                           // dynamics'
         append_message(rec, hold_ + ": one burst of direct simulation");
         c.limited_by = hold_kind_;
         return 0.0;
@@ -202,13 +211,18 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
         return 0.0;
     }
     if (dt < s.dt_min * (1.0 - 1e-12)) {
-        const std::string why =
-            c.limited_by == "rejection"
-                ? fmt::format("the curvature the rejected jump showed allows no DT >= cpi.dt_min = {:.3g} within the "
-                              "tolerance", s.dt_min)
-                : fmt::format("the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = {:.3g} (statistical error of "
-                              "one DT_min jump {:.3g})", s.tolerance, c.dt_tolerance, s.dt_min,
-                              jump_error(model, s.dt_min).statistical);
+        const std::string why = c.limited_by == "rejection"
+                                    ? fmt::format(
+                                          "the curvature the rejected jump showed allows no DT >= "
+                                          "cpi.dt_min = {:.3g} within the "
+                                          "tolerance",
+                                          s.dt_min)
+                                    : fmt::format(
+                                          "the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = "
+                                          "{:.3g} (statistical error of "
+                                          "one DT_min jump {:.3g})",
+                                          s.tolerance, c.dt_tolerance, s.dt_min,
+                                          jump_error(model, s.dt_min).statistical);
         append_message(rec, why + ": one burst of direct simulation instead");
         c.limited_by = "tolerance below dt_min";
         return 0.0;
@@ -224,7 +238,8 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
     }
     // Never a jump the measured transient would be amplified by: shorten until stable.
     // The record keeps the assessment of the DT taken (or of the last one refused).
-    CpiCycle cycle{SlopeEstimator::least_squares, burst, settings_.window, dt, static_cast<int>(model.nodes.size())};
+    CpiCycle cycle{SlopeEstimator::least_squares, burst, settings_.window, dt,
+                   static_cast<int>(model.nodes.size())};
     for (int i = 0; i < 20 && dt > 0.0; ++i) {
         cycle.dt = dt;
         const StabilityAssessment a = assess_stability(decay_, cycle);
@@ -278,8 +293,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     const std::vector<SlopeNode> nodes = method_nodes();
     c.steps = static_cast<int>(nodes.size());
     const long attempt = totals_.attempts + totals_.direct + 1;
-    const bool forced_shrink = settings_.force.kind == ForcedDecision::Kind::shrink && settings_.force.attempt == attempt;
-    const bool forced_reject = settings_.force.kind == ForcedDecision::Kind::reject && settings_.force.attempt == attempt;
+    const bool forced_shrink =
+        settings_.force.kind == ForcedDecision::Kind::shrink && settings_.force.attempt == attempt;
+    const bool forced_reject =
+        settings_.force.kind == ForcedDecision::Kind::reject && settings_.force.attempt == attempt;
 
     rec.dt_requested = plan_dt(rec);
     if (forced_shrink) {  // as if a jump of the planned DT had been rejected (tests)
@@ -345,9 +362,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         if (settings_.adaptive) {
             stepper.confirm_kept_state();
             if (!within)
-                append_message(rec, fmt::format("error {:.3g} = {:.2f} x tolerance kept: {}", c.error(),
-                                                c.error() / s.tolerance,
-                                                at_floor ? "DT is at cpi.dt_min" : "too many rejections in a row"));
+                append_message(rec, fmt::format("error {:.3g} = {:.2f} x tolerance kept: {}",
+                                                c.error(), c.error() / s.tolerance,
+                                                at_floor ? "DT is at cpi.dt_min"
+                                                         : "too many rejections in a row"));
         }
         c.accepted = true;
         accept_burst(m);
@@ -373,43 +391,51 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     const double redo = largest_dt_within(posterior, s.safety * s.tolerance, rec.dt);
     // A redo that the curvature seen would not allow even at dt_min is not tried: the next step
     // runs one burst directly (cap 0) instead of a jump known to exceed the tolerance.
-    dt_cap_ = forced_reject        ? 0.5 * rec.dt
-              : redo < s.dt_min    ? 0.0
-                                   : std::max(s.dt_min, std::min(redo, 0.5 * rec.dt));
+    dt_cap_ = forced_reject     ? 0.5 * rec.dt
+              : redo < s.dt_min ? 0.0
+                                : std::max(s.dt_min, std::min(redo, 0.5 * rec.dt));
     ++consecutive_rejections_;
     ++totals_.rejected;
     rec.status = StepStatus::rejected;
-    append_message(rec, fmt::format("step rejected{}: error {:.3g} = {:.2f} x tolerance (statistical {:.3g}, "
-                                    "truncation {:.3g}); back to t = {:.6g}, next DT <= {:.4g}",
-                                    forced_reject ? " (forced)" : "", c.error(), c.error() / s.tolerance,
-                                    c.statistical, c.truncation, t_end_, dt_cap_));
+    append_message(
+        rec, fmt::format("step rejected{}: error {:.3g} = {:.2f} x tolerance (statistical {:.3g}, "
+                         "truncation {:.3g}); back to t = {:.6g}, next DT <= {:.4g}",
+                         forced_reject ? " (forced)" : "", c.error(), c.error() / s.tolerance,
+                         c.statistical, c.truncation, t_end_, dt_cap_));
     return rec;
 }
 
 std::string MultistepProjectiveIntegrator::summary(int realizations) const {
     const Totals& t = totals_;
-    std::string s = fmt::format("{}: {} jumps kept, {} rejected, {} bursts run directly (tolerance allowed DT < "
-                                "cpi.dt_min)", name(), t.accepted, t.rejected, t.direct);
+    std::string s = fmt::format(
+        "{}: {} jumps kept, {} rejected, {} bursts run directly (tolerance allowed DT < "
+        "cpi.dt_min)",
+        name(), t.accepted, t.rejected, t.direct);
     if (t.accepted == 0) return s;
     const double n = static_cast<double>(t.accepted);
     const double err = t.statistical + t.truncation;
-    s += fmt::format("\nmean DT kept {:.4g}; mean error per jump {:.3g} (statistical {:.3g}, truncation {:.3g}): "
-                     "the statistical part is {:.0f}% of the error budget",
-                     t.dt_taken / n, err / n, t.statistical / n, t.truncation / n,
-                     err > 0 ? 100.0 * t.statistical / err : 0.0);
+    s += fmt::format(
+        "\nmean DT kept {:.4g}; mean error per jump {:.3g} (statistical {:.3g}, truncation "
+        "{:.3g}): "
+        "the statistical part is {:.0f}% of the error budget",
+        t.dt_taken / n, err / n, t.statistical / n, t.truncation / n,
+        err > 0 ? 100.0 * t.statistical / err : 0.0);
     if (settings_.adaptive)
-        s += fmt::format("\nmean DT the tolerance allows: {:.4g} with R = {}, {:.4g} with R = {}, {:.4g} with R = {} "
-                         "(before the growth and dt_max limits)",
-                         t.dt_tolerance / n, realizations, t.dt_tolerance_2r / n, 2 * realizations,
-                         t.dt_tolerance_4r / n, 4 * realizations);
+        s += fmt::format(
+            "\nmean DT the tolerance allows: {:.4g} with R = {}, {:.4g} with R = {}, {:.4g} with R "
+            "= {} "
+            "(before the growth and dt_max limits)",
+            t.dt_tolerance / n, realizations, t.dt_tolerance_2r / n, 2 * realizations,
+            t.dt_tolerance_4r / n, 4 * realizations);
     return s;
 }
 
 void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::string& text) const {
     r.clear();
     const Eigen::Index m = x_end_.size();
-    r.insert(r.end(), {3.0 /* layout version */, static_cast<double>(history_.size()), static_cast<double>(m), t_end_,
-                       dt_last_, dt_cap_, static_cast<double>(consecutive_rejections_), decay_.ok ? 1.0 : 0.0,
+    r.insert(r.end(), {3.0 /* layout version */, static_cast<double>(history_.size()),
+                       static_cast<double>(m), t_end_, dt_last_, dt_cap_,
+                       static_cast<double>(consecutive_rejections_), decay_.ok ? 1.0 : 0.0,
                        decay_.rate, decay_.ratio, decay_.delay});
     r.insert(r.end(), x_end_.data(), x_end_.data() + m);
     for (const auto& n : history_) {
@@ -418,23 +444,27 @@ void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::stri
         r.insert(r.end(), n.se.data(), n.se.data() + m);
     }
     const Totals& t = totals_;
-    r.insert(r.end(), {static_cast<double>(t.attempts), static_cast<double>(t.accepted), static_cast<double>(t.rejected),
-                       static_cast<double>(t.direct), t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r,
-                       t.dt_tolerance_4r, t.statistical, t.truncation});
+    r.insert(r.end(),
+             {static_cast<double>(t.attempts), static_cast<double>(t.accepted),
+              static_cast<double>(t.rejected), static_cast<double>(t.direct), t.dt_taken,
+              t.dt_tolerance, t.dt_tolerance_2r, t.dt_tolerance_4r, t.statistical, t.truncation});
     r.push_back(curvature_only_front_ ? 1.0 : 0.0);  // layout 3
     text = decay_.message + '\n' + hold_kind_ + '\n' + hold_;
 }
 
-void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r, const std::string& text) {
+void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r,
+                                                  const std::string& text) {
     history_.clear();
     curvature_only_front_ = false;
     if (r.empty()) return;  // saved before the first burst
-    // Layout 2 (checkpoint format 2 of earlier versions) lacks the last value: no curvature-only node.
+    // Layout 2 (checkpoint format 2 of earlier versions) lacks the last value: no curvature-only
+    // node.
     EFDEM_EXPECTS(r.size() >= 11 && (r[0] == 2.0 || r[0] == 3.0));
     const auto n = static_cast<std::size_t>(r[1]);
     const auto m = static_cast<Eigen::Index>(r[2]);
     const std::size_t layout_extra = r[0] == 3.0 ? 1 : 0;
-    EFDEM_EXPECTS(r.size() == 11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10 + layout_extra);
+    EFDEM_EXPECTS(r.size() ==
+                  11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10 + layout_extra);
     t_end_ = r[3];
     dt_last_ = r[4];
     dt_cap_ = r[5];

@@ -8,8 +8,8 @@
 ///   1. plan DT: the largest DT whose predicted error (statistical + truncation, from the
 ///      slopes measured so far) is at most safety x tolerance, then the limits: growth over the
 ///      last DT, dt_max, the first jump at most one burst if no curvature is known yet (see
-///      below), the end of the run, the stability monitor; below dt_min no jump is worth its error: run one
-///      burst directly instead (status burst_only, the record says why);
+///      below), the end of the run, the stability monitor; below dt_min no jump is worth its error:
+///      run one burst directly instead (status burst_only, the record says why);
 ///   2. keep the micro state, project X_n + sum_k W_k s_k, repair, lift;
 ///   3. run the next burst (provisional samples) and measure its slope;
 ///   4. judge the jump a posteriori with the curvature that slope shows: accept (samples
@@ -86,7 +86,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
   public:
     /// \pre healing >= 0, window > 0, steps in {1, 2}; adaptive: 0 < dt_min <= dt_max finite,
     ///      tolerance > 0, safety in (0, 1], growth > 1, max_rejections >= 0; else dt >= 0.
-    explicit MultistepProjectiveIntegrator(const MultistepSettings& settings, RepairHook repair = {});
+    explicit MultistepProjectiveIntegrator(const MultistepSettings& settings,
+                                           RepairHook repair = {});
 
     std::string_view name() const override;
     /// Adaptive: needs stepper.can_keep_state() and a stepper with members (slope standard
@@ -98,11 +99,12 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     const MultistepSettings& settings() const { return settings_; }
     /// Totals since the start of the run (saved with the state).
     struct Totals {
-        long attempts = 0;   ///< jumps tried
-        long accepted = 0;   ///< jumps kept
-        long rejected = 0;   ///< jumps redone
-        long direct = 0;     ///< bursts run without a jump because the tolerance allowed < dt_min
-        double dt_taken = 0, dt_tolerance = 0, dt_tolerance_2r = 0, dt_tolerance_4r = 0;  ///< sums over kept jumps
+        long attempts = 0;  ///< jumps tried
+        long accepted = 0;  ///< jumps kept
+        long rejected = 0;  ///< jumps redone
+        long direct = 0;    ///< bursts run without a jump because the tolerance allowed < dt_min
+        double dt_taken = 0, dt_tolerance = 0, dt_tolerance_2r = 0,
+               dt_tolerance_4r = 0;              ///< sums over kept jumps
         double statistical = 0, truncation = 0;  ///< sums over kept jumps
     };
     const Totals& totals() const { return totals_; }
@@ -123,7 +125,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         std::string hold, hold_kind;
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
-    bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out, double length = 0.0) const;
+    bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
+                       double length = 0.0) const;
     /// The length of a burst of direct simulation starting now: one burst, or the rest of the
     /// run when one burst would leave less than one more (the run then ends at its end time).
     double direct_burst_length(const CoarseStepper& stepper) const;
@@ -138,13 +141,13 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     std::deque<SlopeNode> history_;  ///< accepted slopes, oldest first (at most steps + 1)
     /// history_.front() is the first burst's earlier window: for the curvature, not projected from.
     bool curvature_only_front_ = false;
-    double t_end_ = 0.0;             ///< end of the last accepted burst
-    Eigen::VectorXd x_end_;          ///< X there
-    DecayRateEstimate decay_;        ///< from the last accepted burst
-    std::string hold_;               ///< why no jump may start from it (empty: one may)
-    std::string hold_kind_;          ///< "fast transient" or "in-phase wave"
-    double dt_last_ = std::numeric_limits<double>::quiet_NaN();   ///< last kept DT
-    double dt_cap_ = std::numeric_limits<double>::infinity();     ///< set by a rejection
+    double t_end_ = 0.0;       ///< end of the last accepted burst
+    Eigen::VectorXd x_end_;    ///< X there
+    DecayRateEstimate decay_;  ///< from the last accepted burst
+    std::string hold_;         ///< why no jump may start from it (empty: one may)
+    std::string hold_kind_;    ///< "fast transient" or "in-phase wave"
+    double dt_last_ = std::numeric_limits<double>::quiet_NaN();  ///< last kept DT
+    double dt_cap_ = std::numeric_limits<double>::infinity();    ///< set by a rejection
     long consecutive_rejections_ = 0;
     Totals totals_;
 };

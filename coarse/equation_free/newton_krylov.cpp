@@ -20,12 +20,14 @@ constexpr double kKrylovFloor = 0.5;
 }  // namespace
 
 NewtonKrylov::NewtonKrylov(const NewtonKrylovSettings& settings) : settings_(settings) {
-    EFDEM_EXPECTS(settings_.max_iterations >= 0 && settings_.max_krylov >= 1 && settings_.forcing > 0.0 &&
-                  settings_.forcing < 1.0 && settings_.max_backtracks >= 0);
+    EFDEM_EXPECTS(settings_.max_iterations >= 0 && settings_.max_krylov >= 1 &&
+                  settings_.forcing > 0.0 && settings_.forcing < 1.0 &&
+                  settings_.max_backtracks >= 0);
 }
 
-SystemEvaluation NewtonKrylov::choose_start(NewtonSystem*& system, Eigen::VectorXd& y, SystemEvaluation e,
-                                            const FallbackGuess& fallback, SteadySolveRecord& rec) const {
+SystemEvaluation NewtonKrylov::choose_start(NewtonSystem*& system, Eigen::VectorXd& y,
+                                            SystemEvaluation e, const FallbackGuess& fallback,
+                                            SteadySolveRecord& rec) const {
     NewtonSystem& other = fallback.system != nullptr ? *fallback.system : *system;
     EFDEM_EXPECTS(fallback.y.size() == other.dimension() && fallback.ratio >= 0.0);
     const double r = e.g.norm();
@@ -38,9 +40,11 @@ SystemEvaluation NewtonKrylov::choose_start(NewtonSystem*& system, Eigen::Vector
     SystemEvaluation f = other.begin(fallback.y);
     rec.fallback_residual = f.g.norm();
     rec.from_fallback = rec.fallback_residual < r;
-    log::info("newton   0: |G| = {:.4e} at the first guess ({:.3g} x the stopping threshold), {:.4e} at the "
-              "fallback guess: starting from the {}",
-              r, r / threshold, rec.fallback_residual, rec.from_fallback ? "fallback" : "first guess");
+    log::info(
+        "newton   0: |G| = {:.4e} at the first guess ({:.3g} x the stopping threshold), {:.4e} at "
+        "the "
+        "fallback guess: starting from the {}",
+        r, r / threshold, rec.fallback_residual, rec.from_fallback ? "fallback" : "first guess");
     if (rec.from_fallback) {
         y = fallback.y;
         system = &other;
@@ -60,7 +64,8 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& first_system, const Eigen::V
     Eigen::VectorXd y = y0;
     while (true) {
         SystemEvaluation e = solving->begin(y);
-        if (fallback != nullptr && rec.residuals.empty()) e = choose_start(solving, y, std::move(e), *fallback, rec);
+        if (fallback != nullptr && rec.residuals.empty())
+            e = choose_start(solving, y, std::move(e), *fallback, rec);
         NewtonSystem& system = *solving;
         const double r = e.g.norm();
         rec.add_iterate(y, r, e.noise_norm, e.state_residual, e.state_noise);
@@ -69,25 +74,27 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& first_system, const Eigen::V
         // the stopping rule, so a converged solve is never reported as stopped.
         const std::string stop_asked = settings_.observer ? settings_.observer(rec) : std::string{};
         if (settings_.stop.reached(r, e.noise_norm, rec.reason)) {
-            rec.message = fmt::format("{} after {} Newton step(s): |F| = {:.4e} <= {:.4e} (tolerance {:.3e}, "
-                                      "{} x noise {:.3e})",
-                                      to_string(rec.reason), rec.iterations, r,
-                                      settings_.stop.threshold(e.noise_norm), settings_.stop.tolerance,
-                                      settings_.stop.noise_factor, e.noise_norm);
+            rec.message = fmt::format(
+                "{} after {} Newton step(s): |F| = {:.4e} <= {:.4e} (tolerance {:.3e}, "
+                "{} x noise {:.3e})",
+                to_string(rec.reason), rec.iterations, r, settings_.stop.threshold(e.noise_norm),
+                settings_.stop.tolerance, settings_.stop.noise_factor, e.noise_norm);
             system.end();
             break;
         }
         if (!stop_asked.empty()) {
             rec.reason = SteadyStopReason::stopped;
-            rec.message = fmt::format("stopped after {} Newton step(s) with |F| = {:.4e}: {}", rec.iterations, r, stop_asked);
+            rec.message = fmt::format("stopped after {} Newton step(s) with |F| = {:.4e}: {}",
+                                      rec.iterations, r, stop_asked);
             system.end();
             break;
         }
         if (rec.iterations >= settings_.max_iterations) {
             rec.reason = SteadyStopReason::max_iterations;
-            rec.message = fmt::format("{} Newton steps done with |F| = {:.4e} above {:.4e} (noise {:.3e}); try "
-                                      "more iterations, a longer tau or more realizations",
-                                      rec.iterations, r, settings_.stop.threshold(e.noise_norm), e.noise_norm);
+            rec.message = fmt::format(
+                "{} Newton steps done with |F| = {:.4e} above {:.4e} (noise {:.3e}); try "
+                "more iterations, a longer tau or more realizations",
+                rec.iterations, r, settings_.stop.threshold(e.noise_norm), e.noise_norm);
             system.end();
             break;
         }
@@ -95,8 +102,8 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& first_system, const Eigen::V
         gs.max_iterations = settings_.max_krylov;
         gs.relative_tolerance = settings_.forcing;
         gs.absolute_tolerance = kKrylovFloor * settings_.stop.threshold(e.noise_norm);
-        const GmresResult lin =
-            gmres([&system](const Eigen::VectorXd& v) { return system.jacobian_times(v); }, -e.g, gs);
+        const GmresResult lin = gmres(
+            [&system](const Eigen::VectorXd& v) { return system.jacobian_times(v); }, -e.g, gs);
         rec.krylov_iterations.push_back(lin.iterations);
         rec.gmres_residuals.push_back(lin.residuals);
         double s = 1.0;
@@ -109,17 +116,22 @@ SteadySolveRecord NewtonKrylov::solve(NewtonSystem& first_system, const Eigen::V
                 break;
             }
         }
-        log::info("newton {:3d}: {} GMRES products (linear residual {:.3e}), step {:.4g}, trial |F| = {:.4e}",
-                  rec.iterations, lin.iterations, lin.residuals.back(), accepted ? s : 0.0, r_trial);
+        log::info(
+            "newton {:3d}: {} GMRES products (linear residual {:.3e}), step {:.4g}, trial |F| = "
+            "{:.4e}",
+            rec.iterations, lin.iterations, lin.residuals.back(), accepted ? s : 0.0, r_trial);
         system.end();
         if (!accepted) {
             rec.reason = SteadyStopReason::line_search_failed;
             rec.message = fmt::format(
-                "line search failed at Newton step {}: no step down to {:.3g} of the GMRES step decreased |F| = "
+                "line search failed at Newton step {}: no step down to {:.3g} of the GMRES step "
+                "decreased |F| = "
                 "{:.4e} (noise {:.3e}, {:.3g} x the noise){}",
                 rec.iterations, s, r, e.noise_norm, e.noise_norm > 0 ? r / e.noise_norm : 0.0,
-                lin.converged ? "" : "; GMRES did not converge: the derivatives may be too noisy (try a larger "
-                                     "difference step, more realizations)");
+                lin.converged
+                    ? ""
+                    : "; GMRES did not converge: the derivatives may be too noisy (try a larger "
+                      "difference step, more realizations)");
             break;
         }
         rec.step_lengths.push_back(s);

@@ -12,8 +12,8 @@
 namespace efdem::coarse {
 
 struct SystemEvaluation {
-    Eigen::VectorXd g;       ///< G(y)
-    double noise_norm = 0;   ///< norm of G's standard error from the ensemble (0: none)
+    Eigen::VectorXd g;      ///< G(y)
+    double noise_norm = 0;  ///< norm of G's standard error from the ensemble (0: none)
     /// |F| and its noise norm in the stepper's coordinates (MapEvaluation::state_residual_norm,
     /// state_noise_norm), for the record; NaN: the same as |g| and noise_norm.
     double state_residual = std::numeric_limits<double>::quiet_NaN();

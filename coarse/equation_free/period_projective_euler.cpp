@@ -98,8 +98,8 @@ ProjectiveStepRecord PeriodProjectiveEuler::step(CoarseStepper& stepper) {
         plan.dt_candidates.push_back(k * rec.period);
     plan.dt_candidates.push_back(0.0);
     // A burst is at least healing + window (its extensions are not known in advance).
-    plan.dt_max = jump_limit(rec.t_end, plan.dt_candidates.front(),
-                             settings_.healing + settings_.window);
+    plan.dt_max =
+        jump_limit(rec.t_end, plan.dt_candidates.front(), settings_.healing + settings_.window);
     project_and_lift(rec, stepper, plan, repair_);
     rec.periods_per_step = static_cast<int>(std::lround(rec.dt / rec.period));
     return rec;

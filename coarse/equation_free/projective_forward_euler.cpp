@@ -35,7 +35,8 @@ ProjectiveStepRecord ProjectiveForwardEuler::step(CoarseStepper& stepper) {
         return rec;
     }
     rec.slope = slope.slope;
-    rec.slope_standard_error = member_slope_standard_error(rec.burst.t, rec.burst.members, t_window);
+    rec.slope_standard_error =
+        member_slope_standard_error(rec.burst.t, rec.burst.members, t_window);
     rec.window = slope.t_last - slope.t_first;
 
     JumpPlan plan;

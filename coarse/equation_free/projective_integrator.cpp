@@ -38,16 +38,23 @@ double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, doub
     return std::numeric_limits<double>::infinity();
 }
 
-void CoarseStepper::keep_state() { EFDEM_EXPECTS(can_keep_state()); }
-void CoarseStepper::return_to_kept_state() { EFDEM_EXPECTS(can_keep_state()); }
-void CoarseStepper::confirm_kept_state() { EFDEM_EXPECTS(can_keep_state()); }
+void CoarseStepper::keep_state() {
+    EFDEM_EXPECTS(can_keep_state());
+}
+void CoarseStepper::return_to_kept_state() {
+    EFDEM_EXPECTS(can_keep_state());
+}
+void CoarseStepper::confirm_kept_state() {
+    EFDEM_EXPECTS(can_keep_state());
+}
 
 void ProjectiveIntegrator::save_state(std::vector<double>& reals, std::string& text) const {
     reals.clear();
     text.clear();
 }
 
-void ProjectiveIntegrator::restore_state([[maybe_unused]] const std::vector<double>& reals, const std::string& text) {
+void ProjectiveIntegrator::restore_state([[maybe_unused]] const std::vector<double>& reals,
+                                         const std::string& text) {
     (void)text;
     EFDEM_EXPECTS(reals.empty());
 }

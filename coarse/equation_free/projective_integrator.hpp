@@ -40,11 +40,11 @@ std::string_view to_string(StepStatus status);
 /// the ICDF]; per-component vectors in the same unit.
 struct ControllerRecord {
     static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-    bool active = false;    ///< the step was made by the multistep integrator
-    bool adaptive = false;  ///< DT chosen by the controller (else fixed)
-    int steps = 0;          ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
-    double tolerance = nan; ///< cpi.tolerance (NaN when fixed)
-    bool accepted = false;  ///< the jump was kept
+    bool active = false;                ///< the step was made by the multistep integrator
+    bool adaptive = false;              ///< DT chosen by the controller (else fixed)
+    int steps = 0;                      ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
+    double tolerance = nan;             ///< cpi.tolerance (NaN when fixed)
+    bool accepted = false;              ///< the jump was kept
     double statistical = nan;           ///< projection noise of the jump
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
@@ -73,7 +73,7 @@ struct ProjectiveStepRecord {
     double period = std::numeric_limits<double>::quiet_NaN();
     int periods_per_step = 0;  ///< k taken (DT = k T); 0 for the fixed-DT integrator
 
-    Eigen::VectorXd slope;          ///< coarse slope s [unit of X per sqrt(d_p/g)]
+    Eigen::VectorXd slope;  ///< coarse slope s [unit of X per sqrt(d_p/g)]
     /// Standard error of `slope` per component, from the spread of the members' own slopes
     /// over the same window (slope_standard_error(); same unit as slope); DT times it is the
     /// projection noise. Empty when the burst has no members or fewer than two.
@@ -89,8 +89,9 @@ struct ProjectiveStepRecord {
 
     /// The largest slope_standard_error over the components; NaN when there is none.
     double max_slope_standard_error() const {
-        return slope_standard_error.size() == 0 ? std::numeric_limits<double>::quiet_NaN()
-                                                : slope_standard_error.maxCoeff<Eigen::PropagateNaN>();
+        return slope_standard_error.size() == 0
+                   ? std::numeric_limits<double>::quiet_NaN()
+                   : slope_standard_error.maxCoeff<Eigen::PropagateNaN>();
     }
 
     /// The step ended in a state from which the next step can go on as planned.

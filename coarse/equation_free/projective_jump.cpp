@@ -55,7 +55,9 @@ bool repair_projection(ProjectiveStepRecord& rec, Eigen::VectorXd& x, const Repa
     rec.x_projected = x;  // kept for diagnosis if the jump is refused below
     if (!x.allFinite()) {
         rec.status = StepStatus::infeasible_projection;
-        append_message(rec, fmt::format("projected state X(t_end) + {:.6g} s is not finite; nothing lifted", rec.dt));
+        append_message(
+            rec, fmt::format("projected state X(t_end) + {:.6g} s is not finite; nothing lifted",
+                             rec.dt));
         return false;
     }
     if (repair) {

@@ -13,9 +13,12 @@
 
 namespace efdem::coarse {
 
-ProjectiveRun::ProjectiveRun(const CoarseRunSettings& settings, CoarseStepper& stepper, CoarseVariable primary,
-                             std::optional<CoarseVariable> fallback)
-    : settings_(settings), stepper_(stepper), primary_(std::move(primary)), fallback_(std::move(fallback)) {
+ProjectiveRun::ProjectiveRun(const CoarseRunSettings& settings, CoarseStepper& stepper,
+                             CoarseVariable primary, std::optional<CoarseVariable> fallback)
+    : settings_(settings),
+      stepper_(stepper),
+      primary_(std::move(primary)),
+      fallback_(std::move(fallback)) {
     EFDEM_EXPECTS(settings_.burst() > 0.0);
 }
 
@@ -29,7 +32,8 @@ double ProjectiveRun::planned_micro_time(double dt) const {
     return coarse::planned_micro_time(stepper_.time(), t_end_, settings_.burst(), dt);
 }
 
-ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<ProjectiveRunState>& resume) {
+ProjectiveRunOutcome ProjectiveRun::run(double duration,
+                                        const std::optional<ProjectiveRunState>& resume) {
     if (resume) {
         state_ = *resume;
     } else {
@@ -60,8 +64,10 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
         // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
         // plus one burst (or one whose period bursts were extended) can be left with less.
         if (t_end_ - stepper_.time() < burst - tol) {
-            log::info("stopping at t = {:.6g}: the {:.4g} time units left are less than one "
-                      "burst ({:.4g})", stepper_.time(), t_end_ - stepper_.time(), burst);
+            log::info(
+                "stopping at t = {:.6g}: the {:.4g} time units left are less than one "
+                "burst ({:.4g})",
+                stepper_.time(), t_end_ - stepper_.time(), burst);
             break;
         }
         const ProjectiveStepRecord rec = integrator_->step(stepper_);
@@ -77,16 +83,18 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
             // with the fallback, which is always defined.
             std::string why = primary_.failure ? primary_.failure() : std::string{};
             if (why.empty()) why = "its restriction failed";
-            log::warn("the {} observable failed at t = {:.6g}: {} ({}); continuing with the {} as the "
-                      "coarse variable", primary_.description, stepper_.time(), why, rec.message,
-                      fallback_->description);
+            log::warn(
+                "the {} observable failed at t = {:.6g}: {} ({}); continuing with the {} as the "
+                "coarse variable",
+                primary_.description, stepper_.time(), why, rec.message, fallback_->description);
             state_.fell_back = true;
             use(*fallback_);
             continue;
         }
-        if (rec.status == StepStatus::stopped_unstable || ++state_.without_progress >= kMaxStepsWithoutProgress) {
-            out.end_status = fmt::format("stopped at t = {:.6g}: {} ({})", stepper_.time(), to_string(rec.status),
-                                         rec.message);
+        if (rec.status == StepStatus::stopped_unstable ||
+            ++state_.without_progress >= kMaxStepsWithoutProgress) {
+            out.end_status = fmt::format("stopped at t = {:.6g}: {} ({})", stepper_.time(),
+                                         to_string(rec.status), rec.message);
             log::warn("cpi run {}", out.end_status);
             break;
         }
@@ -101,15 +109,21 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration, const std::optional<Pro
     if (out.jumps == 0 && saw_every_step && out.end_status.rfind("completed", 0) == 0) {
         const std::string why =
             out.coarse_steps == 0
-                ? fmt::format("the {:.4g} time units after the warm-up were less than one burst ({:.4g})",
-                              t_end_ - stepper_.time(), burst)
+                ? fmt::format(
+                      "the {:.4g} time units after the warm-up were less than one burst ({:.4g})",
+                      t_end_ - stepper_.time(), burst)
                 : fmt::format("{} coarse step(s), each a burst only", out.coarse_steps);
-        out.end_status += fmt::format(" (no projective jump: {}; all {:.4g} time units were direct simulation)", why,
-                                      out.simulated_time);
-        log::warn("cpi run made no projective jump: {}; all {:.4g} time units were direct simulation. A cpi run "
-                  "gains only when run.duration leaves room for jumps after cpi.warmup (and a steady warm-up) "
-                  "and the controller takes them (each coarse step's status and message say why it did not jump)",
-                  why, out.simulated_time);
+        out.end_status +=
+            fmt::format(" (no projective jump: {}; all {:.4g} time units were direct simulation)",
+                        why, out.simulated_time);
+        log::warn(
+            "cpi run made no projective jump: {}; all {:.4g} time units were direct simulation. A "
+            "cpi run "
+            "gains only when run.duration leaves room for jumps after cpi.warmup (and a steady "
+            "warm-up) "
+            "and the controller takes them (each coarse step's status and message say why it did "
+            "not jump)",
+            why, out.simulated_time);
     }
     return out;
 }
@@ -121,7 +135,8 @@ void ProjectiveRun::warm_up() {
     BurstSamples w;
     if (!settings_.warmup_until_steady) {
         stepper_.run(std::min(settings_.warmup, t_end_ - t0), w);
-        log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step", settings_.warmup);
+        log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step",
+                  settings_.warmup);
         return;
     }
     const double length = std::min(std::max(settings_.warmup, burst), room);
@@ -133,19 +148,27 @@ void ProjectiveRun::warm_up() {
     while (true) {
         const PhaseDrift d = phase_drift(w, stepper_.time() - burst - tol, settings_.drift_rate);
         if (!d.measured) {
-            log::warn("warm-up: {:.4g} time units; the drift of the phase signal cannot be measured (no "
-                      "per-realization phase signals, or fewer than 2 realizations): warm-up by time only",
-                      stepper_.time() - t0);
+            log::warn(
+                "warm-up: {:.4g} time units; the drift of the phase signal cannot be measured (no "
+                "per-realization phase signals, or fewer than 2 realizations): warm-up by time "
+                "only",
+                stepper_.time() - t0);
             return;
         }
         if (!d.drifting) {
-            log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step, until "
-                      "steady: {}", stepper_.time() - t0, d.message);
+            log::info(
+                "warm-up: {:.4g} time units of direct simulation before the first coarse step, "
+                "until "
+                "steady: {}",
+                stepper_.time() - t0, d.message);
             return;
         }
         if (stepper_.time() + window > t_limit + tol) {
-            log::warn("warm-up: stopped after {:.4g} time units (cpi.warmup + cpi.warmup_max, or the end of the "
-                      "run) while still in a fast transient: {}", stepper_.time() - t0, d.message);
+            log::warn(
+                "warm-up: stopped after {:.4g} time units (cpi.warmup + cpi.warmup_max, or the end "
+                "of the "
+                "run) while still in a fast transient: {}",
+                stepper_.time() - t0, d.message);
             return;
         }
         stepper_.run(window, w);

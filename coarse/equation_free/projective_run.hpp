@@ -52,7 +52,7 @@ inline constexpr int kMaxStepsWithoutProgress = 3;
 /// The loop's state between two coarse steps: all a restart needs besides the stepper's.
 struct ProjectiveRunState {
     double t_origin = std::numeric_limits<double>::quiet_NaN();  ///< time the run started at
-    long coarse_steps = 0;      ///< outer steps done
+    long coarse_steps = 0;                                       ///< outer steps done
     long without_progress = 0;  ///< consecutive steps without a jump
     bool fell_back = false;     ///< the primary coarse variable failed; the fallback is in use
     /// The warm-up is done (false in a state saved before or during it: a run resumed from
@@ -120,7 +120,8 @@ class ProjectiveRun {
     /// Runs until t_origin + duration. A new run (no `resume`) starts at the stepper's time
     /// with the warm-up; a resumed one continues from the saved loop state (the stepper must
     /// be restored to the same point). Never throws for a numerical condition.
-    ProjectiveRunOutcome run(double duration, const std::optional<ProjectiveRunState>& resume = std::nullopt);
+    ProjectiveRunOutcome run(double duration,
+                             const std::optional<ProjectiveRunState>& resume = std::nullopt);
 
     const ProjectiveRunState& state() const { return state_; }
     /// The integrator in use (after run() started).

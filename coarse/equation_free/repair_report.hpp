@@ -29,8 +29,8 @@ struct RepairReport {
 };
 
 /**
- * \brief Called on the projected (or perturbed) vector before lifting; may change it in place and reports
- *        what it did. A report with feasible == false stops the step before the lift.
+ * \brief Called on the projected (or perturbed) vector before lifting; may change it in place and
+ * reports what it did. A report with feasible == false stops the step before the lift.
  *
  * \code
  * RepairHook clip = [&](Eigen::VectorXd& x) { return repair_monotone(x, z_min, z_max); };

@@ -84,8 +84,8 @@ V interval_integral(std::span<const double> t, std::span<const V> x, double a, d
 /// member_least_squares_slopes()); empty if the members are missing or of mixed shape, or the
 /// estimator finds no slope.
 template <class Estimator>
-Eigen::MatrixXd slopes_per_member(std::span<const double> t, std::span<const Eigen::MatrixXd> members,
-                                  Estimator estimate) {
+Eigen::MatrixXd slopes_per_member(std::span<const double> t,
+                                  std::span<const Eigen::MatrixXd> members, Estimator estimate) {
     if (members.empty() || members.size() != t.size()) return {};
     const Eigen::Index n_members = members.front().rows(), dim = members.front().cols();
     for (const Eigen::MatrixXd& m : members)

@@ -15,7 +15,9 @@
 
 namespace efdem::coarse {
 
-double mean_height(const Eigen::VectorXd& x) { return x.size() > 0 ? x.mean() : 0.0; }
+double mean_height(const Eigen::VectorXd& x) {
+    return x.size() > 0 ? x.mean() : 0.0;
+}
 
 double mean_height_error_bound(double noise_norm, Eigen::Index n) {
     return n > 0 ? noise_norm / std::sqrt(static_cast<double>(n)) : 0.0;
@@ -23,7 +25,10 @@ double mean_height_error_bound(double noise_norm, Eigen::Index n) {
 
 SteadyRun::SteadyRun(const SteadyRunSettings& settings, CoarseStepper& stepper, RepairHook repair,
                      std::function<void(double)> set_parameter, CoarseCoordinates coordinates)
-    : coordinates_(std::move(coordinates)), settings_(settings), stepper_(stepper), repair_(std::move(repair)),
+    : coordinates_(std::move(coordinates)),
+      settings_(settings),
+      stepper_(stepper),
+      repair_(std::move(repair)),
       set_parameter_(std::move(set_parameter)) {
     EFDEM_EXPECTS(settings_.warmup > 0.0);
     EFDEM_EXPECTS(!settings_.continuation || set_parameter_);
@@ -74,16 +79,21 @@ double SteadyRun::difference_step(const BurstSamples& warm) {
         return difference_step_;
     }
     if (warm.members.empty() || warm.members.back().rows() < 2) {
-        difference_step_origin_ = "default (fewer than two realizations: no noise to derive it from)";
-        log::info("steady: difference step h = {:g}, the default: with fewer than two realizations there is no "
-                  "noise to derive it from",
-                  difference_step_);
+        difference_step_origin_ =
+            "default (fewer than two realizations: no noise to derive it from)";
+        log::info(
+            "steady: difference step h = {:g}, the default: with fewer than two realizations there "
+            "is no "
+            "noise to derive it from",
+            difference_step_);
         return difference_step_;
     }
     const Eigen::MatrixXd& last = warm.members.back();
-    const double noise = ensemble_standard_error(coordinates_ ? coordinates_.rows_from_state(last) : last).norm();
+    const double noise =
+        ensemble_standard_error(coordinates_ ? coordinates_.rows_from_state(last) : last).norm();
     if (!(noise > 0.0)) {
-        difference_step_origin_ = "default (the realizations agree exactly: no noise to derive it from)";
+        difference_step_origin_ =
+            "default (the realizations agree exactly: no noise to derive it from)";
         return difference_step_;
     }
     // A perturbation of norm 1 in log gaps changes a gap by up to a factor e; in heights a
@@ -92,16 +102,21 @@ double SteadyRun::difference_step(const BurstSamples& warm) {
     const double cap = coordinates_ ? 1.0 : 0.25 * warm.x.back().norm();
     const double wanted = settings_.difference_noise_multiple * noise;
     difference_step_ = std::min(wanted, cap);
-    difference_step_origin_ = fmt::format("{:g} x the noise norm {:.4g} at the end of the warm-up{}",
-                                          settings_.difference_noise_multiple, noise,
-                                          wanted > cap ? fmt::format(", capped at {:.3g}", cap) : std::string{});
-    log::info("steady: difference step h = {:.4g} ({}; set steady.difference_step to choose it)", difference_step_,
-              difference_step_origin_);
+    difference_step_origin_ =
+        fmt::format("{:g} x the noise norm {:.4g} at the end of the warm-up{}",
+                    settings_.difference_noise_multiple, noise,
+                    wanted > cap ? fmt::format(", capped at {:.3g}", cap) : std::string{});
+    log::info("steady: difference step h = {:.4g} ({}; set steady.difference_step to choose it)",
+              difference_step_, difference_step_origin_);
     if (wanted > cap)
-        log::warn("steady: the noise asks for a difference step of {:.3g}, more than the {:.3g} at which the "
-                  "coarse map's response stops being a derivative: J v will be noisy; more realizations lower "
-                  "the noise (as 1/sqrt(R)){}",
-                  wanted, cap, coordinates_ ? ", and steady.coordinates = heights measures it in d_p" : "");
+        log::warn(
+            "steady: the noise asks for a difference step of {:.3g}, more than the {:.3g} at which "
+            "the "
+            "coarse map's response stops being a derivative: J v will be noisy; more realizations "
+            "lower "
+            "the noise (as 1/sqrt(R)){}",
+            wanted, cap,
+            coordinates_ ? ", and steady.coordinates = heights measures it in d_p" : "");
     return difference_step_;
 }
 
@@ -113,8 +128,8 @@ SteadyRunOutcome SteadyRun::run() {
     EFDEM_ASSERT(warm.size() >= 1);
     out.x0 = warm.x.back();
     out.warmup_end = stepper_.time();
-    log::info("steady: warm-up of {:g} done at t = {:.6g}; initial guess: mean height {:.4g}", settings_.warmup,
-              out.warmup_end, mean_height(out.x0));
+    log::info("steady: warm-up of {:g} done at t = {:.6g}; initial guess: mean height {:.4g}",
+              settings_.warmup, out.warmup_end, mean_height(out.x0));
 
     std::function<void(double)> hook;
     if (settings_.continuation) {
@@ -137,11 +152,13 @@ SteadyRunOutcome SteadyRun::run() {
     out.evaluations = map.evaluations();
     out.micro_time = map.micro_time();
     if (out.repairs > 0)
-        log::warn("steady: the repair changed {} of {} lifted points (largest change {:.3g}): a difference it "
-                  "touched is biased. steady.coordinates = gaps keeps every lift monotone; a smaller "
-                  "steady.difference_step (h = {:.3g} now) does too, but only while the products' noise, "
-                  "~1.4 x the noise of F / h, stays well below |J v|",
-                  out.repairs, out.evaluations, out.largest_repair, out.difference_step);
+        log::warn(
+            "steady: the repair changed {} of {} lifted points (largest change {:.3g}): a "
+            "difference it "
+            "touched is biased. steady.coordinates = gaps keeps every lift monotone; a smaller "
+            "steady.difference_step (h = {:.3g} now) does too, but only while the products' noise, "
+            "~1.4 x the noise of F / h, stays well below |J v|",
+            out.repairs, out.evaluations, out.largest_repair, out.difference_step);
     return out;
 }
 
@@ -160,25 +177,30 @@ void SteadyRun::solve_steady(CoarseMap& map, SteadyRunOutcome& out) {
     // The spectrum at the answer, and at the best iterate of a solve that ran out of iterations
     // or line search (what the user gets, and the eigenvalues say why it was hard); not after
     // a stop the caller asked for (a budget spent, a signal).
-    const bool spectrum = settings_.eigenvalues > 0 && out.solve.reason != SteadyStopReason::stopped;
+    const bool spectrum =
+        settings_.eigenvalues > 0 && out.solve.reason != SteadyStopReason::stopped;
     if (spectrum) {
         SpectrumSettings ss = settings_.spectrum;
         ss.eigenvalues = settings_.eigenvalues;
-        out.spectrum = coarse_spectrum(map, out.converged ? out.solve.x : out.solve.best, ss);  // in u: same eigenvalues
+        out.spectrum = coarse_spectrum(map, out.converged ? out.solve.x : out.solve.best,
+                                       ss);  // in u: same eigenvalues
         for (const CoarseEigenvalue& e : out.spectrum.leading)
-            log::info("steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual {:.2g}, products' "
-                      "noise {:.2g})",
-                      e.mu.real(), e.mu.imag(), e.rate, e.residual, e.noise);
+            log::info(
+                "steady: eigenvalue mu = {:.5g}{:+.3g}i, rate log|mu|/tau = {:.4g} (residual "
+                "{:.2g}, products' "
+                "noise {:.2g})",
+                e.mu.real(), e.mu.imag(), e.rate, e.residual, e.noise);
     }
     // Report in the coarse vector.
     const Eigen::Index n = out.x0.size();
     out.solve.x = state(out.solve.x, n);
     if (out.solve.best.size() > 0) out.solve.best = state(out.solve.best, n);
-    out.end_status = out.converged
-                         ? fmt::format("completed: {}", out.solve.message)
-                         : fmt::format("not converged: {}; best |F| = {:.4e} (noise {:.3e} at the start)",
-                                       out.solve.message, out.solve.best_state_residual(),
-                                       out.solve.state_noise.empty() ? 0.0 : out.solve.state_noise.front());
+    out.end_status =
+        out.converged
+            ? fmt::format("completed: {}", out.solve.message)
+            : fmt::format("not converged: {}; best |F| = {:.4e} (noise {:.3e} at the start)",
+                          out.solve.message, out.solve.best_state_residual(),
+                          out.solve.state_noise.empty() ? 0.0 : out.solve.state_noise.front());
 }
 
 Branch SteadyRun::unscaled(const Branch& branch) const {
@@ -196,18 +218,21 @@ void SteadyRun::continue_branch(CoarseMap& map, SteadyRunOutcome& out) {
     if (point_observer_) cs.on_point = [this](const Branch& b) { point_observer_(unscaled(b)); };
     PseudoArclengthContinuation continuation(map, cs);
     const double direction = settings_.parameter_end >= settings_.parameter_start ? 1.0 : -1.0;
-    out.branch = unscaled(continuation.run(solver_point(out.x0), settings_.parameter_start / settings_.parameter_scale, direction));
+    out.branch = unscaled(continuation.run(
+        solver_point(out.x0), settings_.parameter_start / settings_.parameter_scale, direction));
     out.converged = !out.branch.points.empty();
     if (!out.converged) {  // the first point's residual history and best iterate, in X
         out.solve = out.branch.first_solve;
         out.solve.x = state(out.solve.x, out.solve.x.size());
-        if (out.solve.best.size() > 0) out.solve.best = state(out.solve.best, out.solve.best.size());
+        if (out.solve.best.size() > 0)
+            out.solve.best = state(out.solve.best, out.solve.best.size());
     }
     const std::size_t n = out.branch.points.size();
-    out.end_status = out.converged ? fmt::format("completed: {} branch point(s) from {} = {:.4g} to {:.4g}; {}", n,
-                                                 out.parameter, out.branch.points.front().parameter,
-                                                 out.branch.points.back().parameter, out.branch.end_reason)
-                                   : fmt::format("not converged: {}", out.branch.end_reason);
+    out.end_status =
+        out.converged ? fmt::format("completed: {} branch point(s) from {} = {:.4g} to {:.4g}; {}",
+                                    n, out.parameter, out.branch.points.front().parameter,
+                                    out.branch.points.back().parameter, out.branch.end_reason)
+                      : fmt::format("not converged: {}", out.branch.end_reason);
 }
 
 }  // namespace efdem::coarse

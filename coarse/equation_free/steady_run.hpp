@@ -31,9 +31,9 @@ namespace efdem::coarse {
 /// What a steady or continuation run found.
 struct SteadyRunOutcome {
     bool continuation = false;
-    std::string solver;     ///< "newton" or "anderson"
+    std::string solver;                   ///< "newton" or "anderson"
     std::string coordinates = "heights";  ///< what the solver worked in (CoarseCoordinates::name)
-    double tau = 0;         ///< micro time of one evaluation
+    double tau = 0;                       ///< micro time of one evaluation
     /// h of the CRN differences, in the solver's coordinates, and where it came from (the scene
     /// key, or the noise measured at the end of the warm-up).
     double difference_step = 0;
@@ -47,12 +47,12 @@ struct SteadyRunOutcome {
     Branch branch;
     std::string parameter;
     double parameter_scale = 1;
-    long repairs = 0;            ///< evaluations whose lifted point the repair changed
-    double largest_repair = 0;   ///< the largest change it made
-    long evaluations = 0;        ///< of Phi_tau, each tau of micro time per member
-    double micro_time = 0;       ///< spent after the warm-up (evaluations x tau)
-    bool converged = false;      ///< steady: the solve stopped at its rule; continuation: >= 1 point
-    std::string end_status;      ///< "completed: ..." or "not converged: ..." (the run file's)
+    long repairs = 0;           ///< evaluations whose lifted point the repair changed
+    double largest_repair = 0;  ///< the largest change it made
+    long evaluations = 0;       ///< of Phi_tau, each tau of micro time per member
+    double micro_time = 0;      ///< spent after the warm-up (evaluations x tau)
+    bool converged = false;     ///< steady: the solve stopped at its rule; continuation: >= 1 point
+    std::string end_status;     ///< "completed: ..." or "not converged: ..." (the run file's)
 };
 
 class SteadyRun {

@@ -7,20 +7,28 @@ namespace efdem::coarse {
 
 std::string to_string(SteadyStopReason reason) {
     switch (reason) {
-        case SteadyStopReason::converged: return "converged";
-        case SteadyStopReason::noise_level: return "stopped at the noise level";
-        case SteadyStopReason::line_search_failed: return "line search failed";
-        case SteadyStopReason::max_iterations: return "iteration limit";
-        case SteadyStopReason::stopped: return "stopped";
+        case SteadyStopReason::converged:
+            return "converged";
+        case SteadyStopReason::noise_level:
+            return "stopped at the noise level";
+        case SteadyStopReason::line_search_failed:
+            return "line search failed";
+        case SteadyStopReason::max_iterations:
+            return "iteration limit";
+        case SteadyStopReason::stopped:
+            return "stopped";
     }
     return "?";
 }
 
-double SteadyStopRule::threshold(double noise) const { return std::max(tolerance, noise_factor * noise); }
+double SteadyStopRule::threshold(double noise) const {
+    return std::max(tolerance, noise_factor * noise);
+}
 
 bool SteadyStopRule::reached(double r, double noise, SteadyStopReason& reason) const {
     if (r > threshold(noise)) return false;
-    reason = noise_factor * noise > tolerance ? SteadyStopReason::noise_level : SteadyStopReason::converged;
+    reason = noise_factor * noise > tolerance ? SteadyStopReason::noise_level
+                                              : SteadyStopReason::converged;
     return true;
 }
 

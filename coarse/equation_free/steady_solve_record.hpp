@@ -46,8 +46,8 @@ struct SteadyStopRule {
 
 struct SteadySolveRecord {
     SteadyStopReason reason = SteadyStopReason::max_iterations;
-    std::string message;  ///< why it stopped, with the numbers
-    Eigen::VectorXd x;    ///< the last iterate
+    std::string message;   ///< why it stopped, with the numbers
+    Eigen::VectorXd x;     ///< the last iterate
     Eigen::VectorXd best;  ///< the iterate with the smallest |F| seen
     double best_residual = std::numeric_limits<double>::infinity();
     std::vector<double> residuals;  ///< |F| at each iterate, the first included
@@ -60,16 +60,16 @@ struct SteadySolveRecord {
     /// Per Newton step, the GMRES residual |G + G' d_j| before the first product and after each
     /// product j (krylov_iterations[k] + 1 values; empty: fixed point).
     std::vector<std::vector<double>> gmres_residuals;
-    std::vector<double> step_lengths;    ///< line-search / damping factor per step
+    std::vector<double> step_lengths;  ///< line-search / damping factor per step
     /// With a fallback guess (NewtonKrylov::solve): |G| at the first guess and at the fallback,
     /// each in its own system (NaN: not evaluated, the first guess was close enough or the map
     /// noise-free), and which the solve started from.
     double first_guess_residual = std::numeric_limits<double>::quiet_NaN();
     double fallback_residual = std::numeric_limits<double>::quiet_NaN();
     bool from_fallback = false;
-    int iterations = 0;       ///< steps taken
-    long evaluations = 0;     ///< evaluations of the coarse map (each one burst of tau)
-    double micro_time = 0;    ///< micro time of those evaluations [sqrt(d_p/g)]
+    int iterations = 0;     ///< steps taken
+    long evaluations = 0;   ///< evaluations of the coarse map (each one burst of tau)
+    double micro_time = 0;  ///< micro time of those evaluations [sqrt(d_p/g)]
 
     /// state_residuals at the best iterate (the one with the smallest solver |F|): what the
     /// record reports as the best |F|, in X; best_residual when nothing was recorded.
@@ -80,8 +80,8 @@ struct SteadySolveRecord {
     }
     /// Adds an iterate and its residual, updating the best; `state` is the evaluation's |F| and
     /// noise in X (NaN in it: the same as residual and noise_norm).
-    void add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm, double residual_in_state,
-                     double noise_in_state);
+    void add_iterate(const Eigen::VectorXd& y, double residual, double noise_norm,
+                     double residual_in_state, double noise_in_state);
 };
 
 }  // namespace efdem::coarse

@@ -11,7 +11,8 @@ JumpError jump_error(const JumpErrorModel& model, double dt) {
     const std::vector<double> w = projection_weights(model.nodes, model.t0, dt);
     JumpError e;
     e.statistical = model.se_scale * rms(statistical_error(model.nodes, w));
-    if (std::isfinite(model.curvature)) e.truncation = model.curvature * omega_integral(model.nodes, model.t0, dt);
+    if (std::isfinite(model.curvature))
+        e.truncation = model.curvature * omega_integral(model.nodes, model.t0, dt);
     return e;
 }
 

@@ -31,7 +31,8 @@ LatticeGeometry lattice_geometry(const BedSpec& bed, const DemScene& scene) {
 double lattice_top(const BedSpec& bed, const DemScene& scene) {
     const LatticeGeometry g = lattice_geometry(bed, scene);
     const long layers = (g.n + g.nx * g.ny - 1) / (g.nx * g.ny);
-    return g.z0 + static_cast<double>(layers - 1) * g.az + bed.jitter + 0.5 * scene.species.max_diameter();
+    return g.z0 + static_cast<double>(layers - 1) * g.az + bed.jitter +
+           0.5 * scene.species.max_diameter();
 }
 }  // namespace
 
@@ -89,14 +90,16 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
                    fmt::format("< (spacing - diameter)/2 = {:g}", 0.5 * (b.spacing - d_max)));
         b.velocity_rms =
             p.get_or<double>("velocity_rms", 0.2, Bounds::closed(0.0, kMaxDomainLength));
-        const std::string layering = p.get_or_choice("layering", "mixed", {"mixed", "light_on_top", "heavy_on_top"});
+        const std::string layering =
+            p.get_or_choice("layering", "mixed", {"mixed", "light_on_top", "heavy_on_top"});
         b.layering = layering == "light_on_top"   ? Layering::light_on_top
                      : layering == "heavy_on_top" ? Layering::heavy_on_top
                                                   : Layering::mixed;
         const double top = lattice_top(b, scene);
         if (scene.domain.has_lid() && top >= scene.domain.lid_height)
-            p.fail("count", fmt::format("needs a lattice {:.4g} high, above the lid at domain.lid = {:g}",
-                                        top, scene.domain.lid_height),
+            p.fail("count",
+                   fmt::format("needs a lattice {:.4g} high, above the lid at domain.lid = {:g}",
+                               top, scene.domain.lid_height),
                    "fewer particles, a wider box or a higher domain.lid");
         if (top > kMaxDomainLength)
             p.fail("count", fmt::format("needs a lattice {:.4g} high", top),
@@ -109,11 +112,14 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
         // a scene can be run unsettled with one override, without editing out its settle block.
         const Params s = p.scope("settle");
         b.settle_damping = s.get_or<double>("damping", 1.0, Bounds::closed(0.0, 1e6));
-        b.settle_damped_time = s.get_or<double>("damped_time", 7.2, Bounds::non_negative());  // steps bounded below
+        b.settle_damped_time =
+            s.get_or<double>("damped_time", 7.2, Bounds::non_negative());  // steps bounded below
         // Kinetic energy per particle in m g d_p: a bed at rest is far below 1e-2; above 1,
         // settling would stop before it started.
-        b.settle_ke_threshold = s.get_or<double>("ke_threshold", 1e-6, Bounds::open_closed(0.0, 1.0));
-        b.settle_max_time = s.get_or<double>("max_time", 100.0, Bounds::positive());  // steps bounded below
+        b.settle_ke_threshold =
+            s.get_or<double>("ke_threshold", 1e-6, Bounds::open_closed(0.0, 1.0));
+        b.settle_max_time =
+            s.get_or<double>("max_time", 100.0, Bounds::positive());  // steps bounded below
         if (b.settle) {
             // Each settling stage is a bounded number of steps, checked here so that
             // `efdem --check` reports it without settling.
@@ -149,18 +155,24 @@ Particles lattice_bed(const BedSpec& bed, const DemScene& scene, const Realizati
     }
     std::vector<SpeciesId> labels;
     labels.reserve(static_cast<std::size_t>(n));
-    for (SpeciesId s : order) labels.insert(labels.end(), static_cast<std::size_t>(bed.count[s]), s);
+    for (SpeciesId s : order)
+        labels.insert(labels.end(), static_cast<std::size_t>(bed.count[s]), s);
     if (bed.layering == BedSpec::Layering::mixed) packing.shuffle(labels.begin(), labels.end());
     const double sigma = bed.velocity_rms / std::sqrt(3.0);
     Particles p;
     p.reserve(static_cast<std::size_t>(n));
     for (long k = 0; k < n; ++k) {
         const long layer = k / (nx * ny), in_layer = k % (nx * ny);
-        const double x = (static_cast<double>(in_layer % nx) + 0.5) * ax + packing.uniform(-bed.jitter, bed.jitter);
-        const double y = (static_cast<double>(in_layer / nx) + 0.5) * ay + packing.uniform(-bed.jitter, bed.jitter);
-        const double z = z0 + static_cast<double>(layer) * az + packing.uniform(-bed.jitter, bed.jitter);
-        const Vec3 v{sigma * velocities.normal(), sigma * velocities.normal(), sigma * velocities.normal()};
-        p.add(k + 1, scene.domain.wrap({x, y, z}), v, labels[static_cast<std::size_t>(k)], scene.species);
+        const double x = (static_cast<double>(in_layer % nx) + 0.5) * ax +
+                         packing.uniform(-bed.jitter, bed.jitter);
+        const double y = (static_cast<double>(in_layer / nx) + 0.5) * ay +
+                         packing.uniform(-bed.jitter, bed.jitter);
+        const double z =
+            z0 + static_cast<double>(layer) * az + packing.uniform(-bed.jitter, bed.jitter);
+        const Vec3 v{sigma * velocities.normal(), sigma * velocities.normal(),
+                     sigma * velocities.normal()};
+        p.add(k + 1, scene.domain.wrap({x, y, z}), v, labels[static_cast<std::size_t>(k)],
+              scene.species);
     }
     return p;
 }
@@ -168,7 +180,8 @@ Particles lattice_bed(const BedSpec& bed, const DemScene& scene, const Realizati
 void permute_species(Particles& p, const SpeciesTable& species, RandomStream& rng) {
     std::vector<SpeciesId> labels(p.species().begin(), p.species().end());
     rng.shuffle(labels.begin(), labels.end());
-    for (std::size_t i = 0; i < labels.size(); ++i) p.set_species(static_cast<Index>(i), labels[i], species);
+    for (std::size_t i = 0; i < labels.size(); ++i)
+        p.set_species(static_cast<Index>(i), labels[i], species);
 }
 
 }  // namespace efdem::dem

@@ -56,7 +56,8 @@ BedObservation observe_bed(const System& system, const BedObservationSettings& s
         }
     o.species_height.resize(s.species);
     for (std::size_t k = 0; k < s.species; ++k)
-        o.species_height[k] = count[k] > 0 ? sum[k] / count[k] : std::numeric_limits<double>::quiet_NaN();
+        o.species_height[k] =
+            count[k] > 0 ? sum[k] / count[k] : std::numeric_limits<double>::quiet_NaN();
     o.solid_fraction = solid_fraction_profile(p, system.domain(), s.profile_dz, s.profile_slabs);
     return o;
 }

@@ -17,18 +17,18 @@ namespace efdem::dem {
 
 /// How the bed quantities are measured (the observe.* keys of docs/scene_reference.md).
 struct BedObservationSettings {
-    double profile_dz = 1.0;         ///< slab thickness of phi(z) [d_p]
-    std::size_t profile_slabs = 1;   ///< slabs of phi(z), from the floor: [0, slabs dz)
-    double mixing_layer = 2.0;       ///< layer thickness of the Lacey index [d_p]
-    SpeciesId mixing_species = 0;    ///< the species whose concentration the index follows
-    std::size_t species = 2;         ///< species in the scene (one mean height each)
+    double profile_dz = 1.0;        ///< slab thickness of phi(z) [d_p]
+    std::size_t profile_slabs = 1;  ///< slabs of phi(z), from the floor: [0, slabs dz)
+    double mixing_layer = 2.0;      ///< layer thickness of the Lacey index [d_p]
+    SpeciesId mixing_species = 0;   ///< the species whose concentration the index follows
+    std::size_t species = 2;        ///< species in the scene (one mean height each)
 };
 
 struct BedObservation {
-    double pressure_drop = 0;         ///< Delta P across the bed [rho_s g d_p] (0 without gas_drag)
-    double pressure_drop_ratio = 0;   ///< Delta P / (W / A) [-]: 1 for a fully supported bed
-    double height = 0;                ///< height below which 99 % of the particle volume lies [d_p]
-    double mixing_index = 0;          ///< Lacey index of mixing_species over layers [-]
+    double pressure_drop = 0;        ///< Delta P across the bed [rho_s g d_p] (0 without gas_drag)
+    double pressure_drop_ratio = 0;  ///< Delta P / (W / A) [-]: 1 for a fully supported bed
+    double height = 0;               ///< height below which 99 % of the particle volume lies [d_p]
+    double mixing_index = 0;         ///< Lacey index of mixing_species over layers [-]
     std::vector<double> species_height;  ///< number-weighted mean centre height, per species [d_p]
     std::vector<double> solid_fraction;  ///< phi of each slab [-]
 
@@ -37,7 +37,8 @@ struct BedObservation {
     /// [Delta P, ratio, H, M, species heights..., phi...].
     std::vector<double> pack() const;
     /// \pre packed.size() == packed_size(settings).
-    static BedObservation unpack(std::span<const double> packed, const BedObservationSettings& settings);
+    static BedObservation unpack(std::span<const double> packed,
+                                 const BedObservationSettings& settings);
 };
 
 /// Measures `system` now. The weight uses the gravity effect's g (1 without one).

@@ -13,20 +13,25 @@ struct SettlingProgress {
     enum class Stage { free_fall, damped, relaxing, done };
     long realization = 0;
     Stage stage = Stage::free_fall;
-    double time = 0;             ///< settling time so far
-    long steps = 0;              ///< time steps so far
-    double stage_end = 0;        ///< when the stage ends (relaxing: at the latest, bed.settle.max_time)
+    double time = 0;       ///< settling time so far
+    long steps = 0;        ///< time steps so far
+    double stage_end = 0;  ///< when the stage ends (relaxing: at the latest, bed.settle.max_time)
     double ke_per_particle = 0;  ///< translational kinetic energy per particle
-    double ke_threshold = 0;     ///< the criterion of the relaxing stage: settled when ke_per_particle < it
+    double ke_threshold =
+        0;  ///< the criterion of the relaxing stage: settled when ke_per_particle < it
 };
 
 /// "free fall", "damped", "relaxing", "done".
 inline const char* to_string(SettlingProgress::Stage stage) {
     switch (stage) {
-        case SettlingProgress::Stage::free_fall: return "free fall";
-        case SettlingProgress::Stage::damped: return "damped";
-        case SettlingProgress::Stage::relaxing: return "relaxing";
-        case SettlingProgress::Stage::done: return "done";
+        case SettlingProgress::Stage::free_fall:
+            return "free fall";
+        case SettlingProgress::Stage::damped:
+            return "damped";
+        case SettlingProgress::Stage::relaxing:
+            return "relaxing";
+        case SettlingProgress::Stage::done:
+            return "done";
     }
     return "?";
 }

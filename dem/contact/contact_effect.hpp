@@ -11,7 +11,7 @@
 namespace efdem::dem {
 
 class ContactEffect : public Effect {
-public:
+  public:
     double time_scale() const override { return table_.min_contact_time(); }
     /// The pair type with the shortest contact time ("light-light").
     std::string time_scale_label() const override;
@@ -19,8 +19,9 @@ public:
     void describe(EffectReport& r) const override;
     const ContactTable& table() const { return table_; }
 
-protected:
-    ContactEffect(const ContactSpec& spec, const SpeciesTable& species, ContactTable::Partner partner)
+  protected:
+    ContactEffect(const ContactSpec& spec, const SpeciesTable& species,
+                  ContactTable::Partner partner)
         : table_(spec, species, partner) {}
     bool has_history() const { return table_.spec().tangential == TangentialModel::history; }
 

@@ -9,14 +9,18 @@
 namespace efdem::dem {
 
 namespace {
-bool active(const Vec3& v) { return v.x != 0.0 || v.y != 0.0 || v.z != 0.0; }
+bool active(const Vec3& v) {
+    return v.x != 0.0 || v.y != 0.0 || v.z != 0.0;
+}
 }  // namespace
 
 ContactHistory::ContactHistory(std::size_t n_particles) {
     for (auto& w : wall_) w.assign(n_particles, Vec3{});
 }
 
-void ContactHistory::attach(const NeighborList& list) { pair_.assign(list.size(), Vec3{}); }
+void ContactHistory::attach(const NeighborList& list) {
+    pair_.assign(list.size(), Vec3{});
+}
 
 void ContactHistory::stash(const NeighborList& list) {
     stash_.clear();
@@ -37,7 +41,8 @@ void ContactHistory::restore(const NeighborList& list, std::span<const Index> ne
         w.swap(moved);
     }
     std::vector<Index> old_to_new(new_to_old.size());
-    for (std::size_t k = 0; k < new_to_old.size(); ++k) old_to_new[new_to_old[k]] = static_cast<Index>(k);
+    for (std::size_t k = 0; k < new_to_old.size(); ++k)
+        old_to_new[new_to_old[k]] = static_cast<Index>(k);
     attach_stashed(list, old_to_new);
 }
 
@@ -67,7 +72,8 @@ void ContactHistory::attach_stashed(const NeighborList& list, std::span<const In
     for (std::size_t i = 0; i < n; ++i)
         for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
             const Index j = NeighborList::neighbor(ent[k]);
-            const Index lo = std::min(static_cast<Index>(i), j), hi = std::max(static_cast<Index>(i), j);
+            const Index lo = std::min(static_cast<Index>(i), j),
+                        hi = std::max(static_cast<Index>(i), j);
             for (std::uint32_t b = start[lo]; b < start[lo + 1]; ++b)
                 if (bucket[b].j == hi) {
                     pair_[k] = (lo == i) ? bucket[b].xi : -bucket[b].xi;
@@ -97,7 +103,8 @@ std::vector<PairHistoryRecord> ContactHistory::export_pairs(const NeighborList& 
     const auto tag = p.tag();
     for (std::size_t i = 0; i + 1 < off.size(); ++i)
         for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
-            if (active(pair_[k])) out.push_back({tag[i], tag[NeighborList::neighbor(ent[k])], pair_[k]});
+            if (active(pair_[k]))
+                out.push_back({tag[i], tag[NeighborList::neighbor(ent[k])], pair_[k]});
     return out;
 }
 

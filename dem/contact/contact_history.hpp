@@ -28,7 +28,7 @@ struct PairHistoryRecord {
 };
 
 class ContactHistory {
-public:
+  public:
     static constexpr int kFloor = 0;
     static constexpr int kLid = 1;
     static constexpr int kWalls = 2;
@@ -55,7 +55,7 @@ public:
     void import_pairs(const NeighborList& list, const Particles& p,
                       std::span<const PairHistoryRecord> records);
 
-private:
+  private:
     struct Stashed {
         Index i, j;  ///< old indices
         Vec3 xi;

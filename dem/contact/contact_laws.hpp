@@ -93,8 +93,8 @@ inline void add_contact_energy(double& e, double delta, const ContactCoeffs& c, 
  * \param xi      history spring of the pair (updated in place); ignored without history
  */
 template <class Normal, class Tangential>
-inline ContactForce contact_force(const Vec3& n, double delta, const Vec3& v_rel,
-                                  const Vec3& w_sum, const ContactCoeffs& c, double dt, Vec3* xi) {
+inline ContactForce contact_force(const Vec3& n, double delta, const Vec3& v_rel, const Vec3& w_sum,
+                                  const ContactCoeffs& c, double dt, Vec3* xi) {
     const double s_e = Normal::elastic_scale(delta, c.r_eff);
     const double s_d = Normal::damping_scale(delta, c.r_eff);
     const double vn = dot(v_rel, n);

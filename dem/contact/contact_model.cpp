@@ -19,8 +19,8 @@ double real_or_fallback(const Params& scope, const Params* fallback, const char*
         return fallback->get<double>(key, b);
     return scope.get<double>(key, b);
 }
-double real_or_fallback(const Params& scope, const Params* fallback, const char* key,
-                        double def, const Bounds& b) {
+double real_or_fallback(const Params& scope, const Params* fallback, const char* key, double def,
+                        const Bounds& b) {
     if (!scope.contains(key) && fallback && fallback->contains(key))
         return fallback->get<double>(key, b);
     return scope.get_or<double>(key, def, b);
@@ -45,10 +45,9 @@ ContactSpec ContactSpec::from_params(const Params& p, const Params* fb) {
         choice_or_fallback(p, fb, "damping", "restitution", {"restitution", "gamma", "none"});
     if (damping == "restitution") {
         s.damping = DampingModel::restitution;
-        s.restitution =
-            real_or_fallback(p, fb, "restitution",
-                             s.normal == NormalModel::hertz ? kHertzRestitutionRange
-                                                            : Bounds::closed(1e-3, 1.0));
+        s.restitution = real_or_fallback(
+            p, fb, "restitution",
+            s.normal == NormalModel::hertz ? kHertzRestitutionRange : Bounds::closed(1e-3, 1.0));
     } else if (damping == "gamma") {
         if (s.normal == NormalModel::hertz)
             p.fail("damping", "'gamma' (LAMMPS' single gamma_n) is only defined here for hooke",
@@ -134,8 +133,8 @@ ContactTable::ContactTable(const ContactSpec& spec, const SpeciesTable& species,
                 const auto sa = static_cast<SpeciesId>(a), sb = static_cast<SpeciesId>(b);
                 const double ma = species.mass(sa), mb = species.mass(sb);
                 const double ra = species.radius(sa), rb = species.radius(sb);
-                const auto t = derive(species[sa].name + "-" + species[sb].name, ma * mb / (ma + mb),
-                                      ra * rb / (ra + rb));
+                const auto t = derive(species[sa].name + "-" + species[sb].name,
+                                      ma * mb / (ma + mb), ra * rb / (ra + rb));
                 coeffs_[a * n_ + b] = t.coeffs;
                 if (b >= a) info_.push_back(t);
             }
@@ -171,7 +170,8 @@ PairTypeInfo ContactTable::derive(const std::string& label, double m_eff, double
                 c.eta_n = m_eff * spec_.gamma_n;
                 zeta = c.eta_n / (2 * std::sqrt(m_eff * spec_.kn));
                 break;
-            case DampingModel::none: break;
+            case DampingModel::none:
+                break;
         }
         // The time step must resolve the damping as well as the oscillation: an explicit step
         // removes the fraction dt eta_n/m_eff = 2 zeta omega0 dt of the relative velocity, and
@@ -197,7 +197,8 @@ PairTypeInfo ContactTable::derive(const std::string& label, double m_eff, double
         const double L = std::pow(m_eff / kp, 0.4);
         t.contact_time = h.contact_time * std::sqrt(m_eff / kp) * std::pow(L, -0.25);
     }
-    c.eta_t = spec_.tangential == TangentialModel::history ? spec_.tangential_damping * c.eta_n : 0.0;
+    c.eta_t =
+        spec_.tangential == TangentialModel::history ? spec_.tangential_damping * c.eta_n : 0.0;
     return t;
 }
 

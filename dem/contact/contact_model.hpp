@@ -5,20 +5,20 @@
 ///
 /// Scene keys, in the scope of the effect (`pair_contact.` or `wall_contact.`):
 ///
-/// | key                  | meaning                                              | default          |
+/// | key                  | meaning                                              | default |
 /// |----------------------|------------------------------------------------------|------------------|
-/// | normal               | `hooke` or `hertz`                                   | hooke            |
-/// | kn                   | normal stiffness [rho_s g d_p^2] (hertz: per d_p^0.5)| required         |
-/// | damping              | `restitution` (eta_n per pair, e exact for every     | restitution      |
-/// |                      | pair) or `gamma` (LAMMPS: one gamma_n for all pairs, |                  |
-/// |                      | eta_n = m_eff gamma_n; hooke only) or `none`         |                  |
-/// | restitution          | coefficient of restitution e in (0, 1]               | required if      |
-/// |                      |                                                      | damping = restitution |
-/// | gamma_n              | damping per unit effective mass [1/time]             | required if gamma |
-/// | tangential           | `history` (spring + dashpot + Coulomb) or `none`     | history          |
-/// | kt                   | tangential stiffness                                 | 2/7 kn           |
-/// | tangential_damping   | eta_t / eta_n (LAMMPS: gamma_t = gamma_n / 2)        | 0.5              |
-/// | mu                   | Coulomb friction coefficient                         | required if history |
+/// | normal               | `hooke` or `hertz`                                   | hooke | | kn |
+/// normal stiffness [rho_s g d_p^2] (hertz: per d_p^0.5)| required         | | damping |
+/// `restitution` (eta_n per pair, e exact for every     | restitution      | | | pair) or `gamma`
+/// (LAMMPS: one gamma_n for all pairs, |                  | |                      | eta_n = m_eff
+/// gamma_n; hooke only) or `none`         |                  | | restitution          | coefficient
+/// of restitution e in (0, 1]               | required if      | |                      | | damping
+/// = restitution | | gamma_n              | damping per unit effective mass [1/time]             |
+/// required if gamma | | tangential           | `history` (spring + dashpot + Coulomb) or `none` |
+/// history          | | kt                   | tangential stiffness | 2/7 kn           | |
+/// tangential_damping   | eta_t / eta_n (LAMMPS: gamma_t = gamma_n / 2)        | 0.5              |
+/// | mu                   | Coulomb friction coefficient                         | required if
+/// history |
 ///
 /// wall_contact reads the same keys; each key it does not set falls back to pair_contact's
 /// value when pair_contact is in the scene ("the same sub-models drive particle-floor contact").
@@ -62,10 +62,10 @@ struct ContactSpec {
 
 /// Derived numbers of one pair type, for `efdem --check` and the time-step limit.
 struct PairTypeInfo {
-    std::string label;          ///< "light-heavy", "light-wall"
-    double m_eff = 0;           ///< effective mass [rho_s d_p^3]
-    ContactCoeffs coeffs;       ///< what the kernel uses
-    double restitution = 1;     ///< resulting e (0 when overdamped)
+    std::string label;       ///< "light-heavy", "light-wall"
+    double m_eff = 0;        ///< effective mass [rho_s d_p^3]
+    ContactCoeffs coeffs;    ///< what the kernel uses
+    double restitution = 1;  ///< resulting e (0 when overdamped)
     /// Time scale the time step must resolve [sqrt(d_p/g)]: the duration of a head-on contact
     /// (hertz: at v_rel = 1), or for hooke the damping time 2 pi m_eff/eta_n when that is
     /// shorter (zeta > 1/sqrt(2), e < 0.043; overdamped contacts never end).
@@ -91,7 +91,7 @@ HertzDamping hertz_tsuji_damping(double e);
  * \endcode
  */
 class ContactTable {
-public:
+  public:
     enum class Partner { particle, wall };
     ContactTable(const ContactSpec& spec, const SpeciesTable& species, Partner partner);
 
@@ -102,7 +102,7 @@ public:
     double min_contact_time() const;
     const ContactSpec& spec() const { return spec_; }
 
-private:
+  private:
     PairTypeInfo derive(const std::string& label, double m_eff, double r_eff) const;
 
     ContactSpec spec_;
@@ -116,7 +116,8 @@ private:
 /// returns what f returns: the one place where the run-time NormalModel becomes a compile-time
 /// type. Force loops (with_contact_kernels), contact energies and reports all go through it;
 /// call it once per loop, never per pair.
-/// \code double e = with_normal_law(spec.normal, [&](auto n) { return decltype(n)::energy(kn, delta, r); }); \endcode
+/// \code double e = with_normal_law(spec.normal, [&](auto n) { return decltype(n)::energy(kn,
+/// delta, r); }); \endcode
 template <class F>
 decltype(auto) with_normal_law(NormalModel normal, F&& f) {
     if (normal == NormalModel::hertz) return f(HertzNormal{});
@@ -125,13 +126,16 @@ decltype(auto) with_normal_law(NormalModel normal, F&& f) {
 
 /// Calls f(Normal{}, Tangential{}) with the kernel types of the spec's sub-models (the normal
 /// law through with_normal_law): one dispatch per loop, never per pair.
-/// \code with_contact_kernels(spec, [&](auto n, auto t) { loop<decltype(n), decltype(t)>(); }); \endcode
+/// \code with_contact_kernels(spec, [&](auto n, auto t) { loop<decltype(n), decltype(t)>(); });
+/// \endcode
 template <class F>
 void with_contact_kernels(const ContactSpec& spec, F&& f) {
     const bool history = spec.tangential == TangentialModel::history;
     with_normal_law(spec.normal, [&](auto normal) {
-        if (history) f(normal, HistoryTangential{});
-        else f(normal, NoTangential{});
+        if (history)
+            f(normal, HistoryTangential{});
+        else
+            f(normal, NoTangential{});
     });
 }
 

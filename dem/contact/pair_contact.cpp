@@ -20,8 +20,7 @@ PairContact::PairContact(const ContactSpec& spec, const SpeciesTable& species)
     : ContactEffect(spec, species, ContactTable::Partner::particle), n_species_(species.size()) {}
 
 Needs PairContact::needs() const {
-    return {.neighbor_list = true,
-            .contact_history = has_history()};
+    return {.neighbor_list = true, .contact_history = has_history()};
 }
 
 namespace {
@@ -54,10 +53,12 @@ constexpr std::uint32_t kChunk = 32;
  * about as unpredictably as a coin flip, and a mispredicted branch costs more than this whole
  * test. The spring of a pair that does not touch is zeroed (when `hist` is given).
  */
-[[gnu::always_inline]] inline std::uint32_t gather_touching(
-    const Vec3 xi, const double ri, std::uint32_t k0, std::uint32_t k1,
-    const NeighborList::Entry* ent, const Vec3* x, const double* rad, const Vec3* shift,
-    Vec3* hist, Touching* out) {
+[[gnu::always_inline]] inline std::uint32_t gather_touching(const Vec3 xi, const double ri,
+                                                            std::uint32_t k0, std::uint32_t k1,
+                                                            const NeighborList::Entry* ent,
+                                                            const Vec3* x, const double* rad,
+                                                            const Vec3* shift, Vec3* hist,
+                                                            Touching* out) {
     std::uint32_t m = 0;
     for (std::uint32_t k = k0; k < k1; ++k) {
         const NeighborList::Entry e = ent[k];
@@ -130,8 +131,10 @@ void PairContact::add_forces(ForceContext& ctx) {
     with_contact_kernels(table_.spec(), [&](auto normal, auto tangential) {
         using N = decltype(normal);
         using T = decltype(tangential);
-        if (avx2) loop_avx2<N, T>(ctx);
-        else loop<N, T>(ctx);
+        if (avx2)
+            loop_avx2<N, T>(ctx);
+        else
+            loop<N, T>(ctx);
     });
 }
 
@@ -157,7 +160,8 @@ double PairContact::potential_energy(const ForceContext& ctx) const {
     const auto sp = ctx.particles.species();
     return with_normal_law(table_.spec().normal, [&](auto normal) {
         double e = 0;
-        for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t k, const Vec3& d, double radsum) {
+        for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t k, const Vec3& d,
+                                   double radsum) {
             add_contact_energy<decltype(normal)>(e, radsum - norm(d), table_(sp[i], sp[j]),
                                                  ctx.history ? &ctx.history->pairs()[k] : nullptr);
         });
@@ -167,17 +171,16 @@ double PairContact::potential_energy(const ForceContext& ctx) const {
 
 void PairContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const {
     const auto tag = ctx.particles.tag();
-    for_each_touching(ctx, [&](std::size_t i, Index j, std::uint32_t, const Vec3& d, double radsum) {
-        ++stats.contacts;
-        const double overlap = (radsum - norm(d)) / radsum;
-        if (overlap > stats.max_overlap) {
-            stats.max_overlap = overlap;
-            stats.max_overlap_tag = tag[i];
-            stats.max_overlap_partner = tag[j];
-        }
-    });
+    for_each_touching(ctx,
+                      [&](std::size_t i, Index j, std::uint32_t, const Vec3& d, double radsum) {
+                          ++stats.contacts;
+                          const double overlap = (radsum - norm(d)) / radsum;
+                          if (overlap > stats.max_overlap) {
+                              stats.max_overlap = overlap;
+                              stats.max_overlap_tag = tag[i];
+                              stats.max_overlap_partner = tag[j];
+                          }
+                      });
 }
-
-
 
 }  // namespace efdem::dem

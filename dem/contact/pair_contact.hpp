@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// PairContact: soft-sphere particle-particle contact with sub-models chosen by keyword
-/// (dem/contact/contact_model.hpp); the kernel is dem/contact/contact_laws.hpp. Doc: docs/effects/pair_contact.md.
+/// (dem/contact/contact_model.hpp); the kernel is dem/contact/contact_laws.hpp. Doc:
+/// docs/effects/pair_contact.md.
 
 #include "dem/contact/contact_effect.hpp"
 
@@ -14,7 +15,7 @@ namespace efdem::dem {
  * loop instantiated for that combination: no virtual call or branch on the model per pair.
  */
 class PairContact final : public ContactEffect {
-public:
+  public:
     explicit PairContact(const EffectSetup& setup);
     PairContact(const ContactSpec& spec, const SpeciesTable& species);
 
@@ -24,7 +25,7 @@ public:
     double potential_energy(const ForceContext& ctx) const override;
     void add_thermo(const ForceContext& ctx, ThermoStats& stats) const override;
 
-private:
+  private:
     /// The force loop; inlined into both builds below.
     template <class Normal, class Tangential>
     void loop(ForceContext& ctx) const;

@@ -41,9 +41,9 @@ void WallContact::loop(ForceContext& ctx, int wall, double z_wall, double normal
             if constexpr (Tangential::kHistory) hist[i] = Vec3{};
             continue;
         }
-        const ContactForce cf = contact_force<Normal, Tangential>(
-            nrm, delta, v[i], w[i] * rad[i], table_.wall(sp[i]), ctx.dt,
-            Tangential::kHistory ? hist + i : nullptr);
+        const ContactForce cf =
+            contact_force<Normal, Tangential>(nrm, delta, v[i], w[i] * rad[i], table_.wall(sp[i]),
+                                              ctx.dt, Tangential::kHistory ? hist + i : nullptr);
         f[i] += cf.total;
         if constexpr (Tangential::kHistory) tq[i] -= cross(nrm, cf.tangential) * rad[i];
     }
@@ -54,7 +54,8 @@ void WallContact::add_forces(ForceContext& ctx) {
         using N = decltype(normal);
         using T = decltype(tangential);
         loop<N, T>(ctx, ContactHistory::kFloor, 0.0, 1.0);
-        if (ctx.domain.has_lid()) loop<N, T>(ctx, ContactHistory::kLid, ctx.domain.lid_height, -1.0);
+        if (ctx.domain.has_lid())
+            loop<N, T>(ctx, ContactHistory::kLid, ctx.domain.lid_height, -1.0);
     });
 }
 
@@ -68,11 +69,12 @@ double WallContact::potential_energy(const ForceContext& ctx) const {
             const ContactCoeffs& c = table_.wall(sp[i]);
             auto add = [&](double delta, int wall) {
                 if (delta <= 0) return;
-                add_contact_energy<decltype(normal)>(e, delta, c,
-                                                     ctx.history ? &ctx.history->wall(wall)[i] : nullptr);
+                add_contact_energy<decltype(normal)>(
+                    e, delta, c, ctx.history ? &ctx.history->wall(wall)[i] : nullptr);
             };
             add(rad[i] - x[i].z, ContactHistory::kFloor);
-            if (ctx.domain.has_lid()) add(rad[i] - (ctx.domain.lid_height - x[i].z), ContactHistory::kLid);
+            if (ctx.domain.has_lid())
+                add(rad[i] - (ctx.domain.lid_height - x[i].z), ContactHistory::kLid);
         }
         return e;
     });
@@ -83,7 +85,8 @@ void WallContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const 
     const auto rad = ctx.particles.radius();
     for (std::size_t i = 0; i < x.size(); ++i) {
         double delta = rad[i] - x[i].z;
-        if (ctx.domain.has_lid()) delta = std::max(delta, rad[i] - (ctx.domain.lid_height - x[i].z));
+        if (ctx.domain.has_lid())
+            delta = std::max(delta, rad[i] - (ctx.domain.lid_height - x[i].z));
         if (delta > 0) {
             ++stats.wall_contacts;
             if (delta / (2 * rad[i]) > stats.max_overlap) {
@@ -94,7 +97,5 @@ void WallContact::add_thermo(const ForceContext& ctx, ThermoStats& stats) const 
         }
     }
 }
-
-
 
 }  // namespace efdem::dem

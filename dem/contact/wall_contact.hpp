@@ -10,7 +10,7 @@
 namespace efdem::dem {
 
 class WallContact final : public ContactEffect {
-public:
+  public:
     explicit WallContact(const EffectSetup& setup);
     WallContact(const ContactSpec& spec, const SpeciesTable& species);
 
@@ -20,7 +20,7 @@ public:
     double potential_energy(const ForceContext& ctx) const override;
     void add_thermo(const ForceContext& ctx, ThermoStats& stats) const override;
 
-private:
+  private:
     template <class Normal, class Tangential>
     void loop(ForceContext& ctx, int wall, double z_wall, double normal_sign) const;
 };

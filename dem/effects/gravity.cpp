@@ -4,7 +4,8 @@
 
 namespace efdem::dem {
 
-Gravity::Gravity(const EffectSetup& s) : g_(s.scope.get_or<double>("g", 1.0, Bounds::closed(0.0, 1e3))) {}
+Gravity::Gravity(const EffectSetup& s)
+    : g_(s.scope.get_or<double>("g", 1.0, Bounds::closed(0.0, 1e3))) {}
 
 void Gravity::add_forces(ForceContext& ctx) {
     Vec3* f = ctx.particles.force().data();
@@ -21,6 +22,8 @@ double Gravity::potential_energy(const ForceContext& ctx) const {
     return e;
 }
 
-void Gravity::describe(EffectReport& r) const { r.add("g", fmt::format("{} (downwards)", g_)); }
+void Gravity::describe(EffectReport& r) const {
+    r.add("g", fmt::format("{} (downwards)", g_));
+}
 
 }  // namespace efdem::dem

@@ -8,7 +8,7 @@ namespace efdem::dem {
 
 /// F_i = -m_i g e_z.  Key: `gravity.g` (magnitude [g], default 1).
 class Gravity final : public Effect {
-public:
+  public:
     explicit Gravity(const EffectSetup& setup);
     explicit Gravity(double g) : g_(g) {}
     std::string_view name() const override { return "gravity"; }
@@ -17,7 +17,7 @@ public:
     void describe(EffectReport& r) const override;
     double g() const { return g_; }
 
-private:
+  private:
     double g_;
 };
 

@@ -9,7 +9,7 @@ namespace efdem::dem {
 
 /// F_i = -gamma m_i v_i.  Key: `viscous_damping.gamma` [1/time], required, >= 0.
 class ViscousDamping final : public Effect {
-public:
+  public:
     explicit ViscousDamping(const EffectSetup& setup);
     explicit ViscousDamping(double gamma) : gamma_(gamma) {}
     std::string_view name() const override { return "viscous_damping"; }
@@ -18,7 +18,7 @@ public:
     /// Changes gamma between runs (the settling protocol switches the damping on and off).
     void set_gamma(double gamma) { gamma_ = gamma; }
 
-private:
+  private:
     double gamma_;
 };
 

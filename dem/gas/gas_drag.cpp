@@ -29,7 +29,8 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     if (!s.law)
         p.fail("law", "names an unknown drag law '" + law + "'",
                fmt::format("known drag laws: {}", fmt::join(drag_law_names(), ", ")));
-    s.superficial_velocity = p.get<double>("superficial_velocity", Bounds::closed(0.0, kMaxSuperficialVelocity));
+    s.superficial_velocity =
+        p.get<double>("superficial_velocity", Bounds::closed(0.0, kMaxSuperficialVelocity));
     s.phi_cap = p.get_or<double>("phi_cap", 0.70, Bounds::open(0.0, 1.0));
     s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::at_least(0.1));
 
@@ -48,9 +49,12 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
         s.A = p.get<double>("A", Bounds::closed(1e-6, 1e6));
         s.physical = false;
     } else {
-        s.gas.viscosity = p.get_or<double>("gas_viscosity", 1.8e-5, Bounds::closed(1e-7, 1e3));  // Pa s
-        s.gas.particle_density = p.get_or<double>("particle_density", 900.0, Bounds::closed(1.0, 1e5));  // kg/m^3
-        s.gas.particle_diameter = p.get_or<double>("particle_diameter", 1e-4, Bounds::closed(1e-8, 1.0));  // m
+        s.gas.viscosity =
+            p.get_or<double>("gas_viscosity", 1.8e-5, Bounds::closed(1e-7, 1e3));  // Pa s
+        s.gas.particle_density =
+            p.get_or<double>("particle_density", 900.0, Bounds::closed(1.0, 1e5));  // kg/m^3
+        s.gas.particle_diameter =
+            p.get_or<double>("particle_diameter", 1e-4, Bounds::closed(1e-8, 1.0));    // m
         s.gas.gravity = p.get_or<double>("gravity", 9.81, Bounds::closed(1e-3, 1e4));  // m/s^2
         s.A = s.gas.drag_number();
         s.physical = true;

@@ -30,8 +30,8 @@
 #include <string>
 #include <vector>
 
-#include "dem/gas/drag_laws.hpp"
 #include "dem/effect.hpp"
+#include "dem/gas/drag_laws.hpp"
 
 namespace efdem::dem {
 

@@ -59,8 +59,8 @@ void SlabFields::update(const Particles& p, const Domain& domain) {
 
 std::size_t SlabFields::split_two(const Particles& p) {
     // No store into shared sums here: the iterations are independent (scatter() adds up).
-    const SlabSplit r = split_two_slabs(p.size(), p.x().data(), p.radius().data(), dz_,
-                                        kMaxSlabs, first_.data(), count_.data(), weights_.data());
+    const SlabSplit r = split_two_slabs(p.size(), p.x().data(), p.radius().data(), dz_, kMaxSlabs,
+                                        first_.data(), count_.data(), weights_.data());
     if (r.out_of_range) report_blown_up(p);
     return r.top;
 }

@@ -19,7 +19,7 @@ namespace {
 
 /// Line reader over gzip or plain files (zlib reads both transparently).
 class GzLines {
-public:
+  public:
     explicit GzLines(const std::filesystem::path& path) : path_(path.string()) {
         std::error_code ec;
         if (!std::filesystem::is_regular_file(path, ec))
@@ -53,7 +53,7 @@ public:
     int line_number() const { return line_; }
     const std::string& path() const { return path_; }
 
-private:
+  private:
     std::string path_;
     gzFile file_ = nullptr;
     int line_ = 0;
@@ -82,11 +82,13 @@ std::vector<double> numbers(const std::string& line, std::size_t want, const GzL
                              fmt::format("'{}' in a {} line is not a number", tok, what));
         }
         if (!std::isfinite(out.back()))
-            throw InputError({in.path(), in.line_number()}, fmt::format("non-finite value in a {} line", what));
+            throw InputError({in.path(), in.line_number()},
+                             fmt::format("non-finite value in a {} line", what));
     }
     if (out.size() < want)
-        throw InputError({in.path(), in.line_number()},
-                         fmt::format("a {} line needs at least {} numbers, has {}", what, want, out.size()));
+        throw InputError(
+            {in.path(), in.line_number()},
+            fmt::format("a {} line needs at least {} numbers, has {}", what, want, out.size()));
     return out;
 }
 
@@ -124,10 +126,12 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
     while (in.next(line)) {
         const std::string s = strip(line);
         if (s.empty()) continue;
-        const bool is_number = std::isdigit(static_cast<unsigned char>(s[0])) || s[0] == '-' || s[0] == '+' || s[0] == '.';
+        const bool is_number = std::isdigit(static_cast<unsigned char>(s[0])) || s[0] == '-' ||
+                               s[0] == '+' || s[0] == '.';
         if (!is_number) {  // a section keyword
             section = s.substr(0, s.find_first_of(" \t"));
-            if (section == "Atoms" && line.find("sphere") == std::string::npos && line.find('#') != std::string::npos)
+            if (section == "Atoms" && line.find("sphere") == std::string::npos &&
+                line.find('#') != std::string::npos)
                 throw InputError({in.path(), in.line_number()},
                                  "the Atoms section is not of atom_style sphere");
             continue;
@@ -150,8 +154,10 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
             const auto id = static_cast<Tag>(whole_number(v[0], 1, kMaxAtomId, in, "the atom id"));
             const long type = whole_number(v[1], 1, 255, in, "the atom type");
             if (type > static_cast<long>(species.size()))
-                throw InputError({in.path(), in.line_number()},
-                                 fmt::format("atom type {} has no species: species.names lists {} species", type, species.size()));
+                throw InputError(
+                    {in.path(), in.line_number()},
+                    fmt::format("atom type {} has no species: species.names lists {} species", type,
+                                species.size()));
             if (static_cast<long>(atoms.size()) >= kMaxRealizationParticles)
                 throw InputError(
                     {in.path(), in.line_number()},
@@ -176,7 +182,8 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
                         "atom {} is at z = {:g}, outside the domain (allowed: 0 <= z <= {:g})", id,
                         z, domain.has_lid() ? domain.lid_height : kMaxDomainLength));
             if (index_of.count(id))
-                throw InputError({in.path(), in.line_number()}, fmt::format("atom id {} appears twice", id));
+                throw InputError({in.path(), in.line_number()},
+                                 fmt::format("atom id {} appears twice", id));
             index_of.emplace(id, atoms.size());
             atoms.push_back({id, sp, {v[4], v[5], v[6]}, {}, {}});
         } else if (section == "Velocities") {
@@ -184,21 +191,27 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
             const auto it = index_of.find(
                 static_cast<Tag>(whole_number(v[0], 1, kMaxAtomId, in, "the atom id")));
             if (it == index_of.end())
-                throw InputError({in.path(), in.line_number()}, "velocity of an atom id not in the Atoms section");
+                throw InputError({in.path(), in.line_number()},
+                                 "velocity of an atom id not in the Atoms section");
             atoms[it->second].v = {v[1], v[2], v[3]};
             atoms[it->second].w = {v[4], v[5], v[6]};
         }
     }
-    if (n_atoms < 0) throw InputError({in.path(), 0}, "the header does not give the number of atoms");
+    if (n_atoms < 0)
+        throw InputError({in.path(), 0}, "the header does not give the number of atoms");
     if (static_cast<long>(atoms.size()) != n_atoms)
-        throw InputError({in.path(), 0}, fmt::format("the header announces {} atoms but the Atoms section "
-                                                     "has {} (truncated file?)", n_atoms, atoms.size()));
+        throw InputError({in.path(), 0},
+                         fmt::format("the header announces {} atoms but the Atoms section "
+                                     "has {} (truncated file?)",
+                                     n_atoms, atoms.size()));
     for (int a = 0; a < 2; ++a) {
         const double want = a == 0 ? domain.lx : domain.ly;
         if (!have_box[a] || std::abs(box[a][0]) > 1e-12 || std::abs(box[a][1] - want) > 1e-9 * want)
-            throw InputError({in.path(), 0},
-                             fmt::format("the box in {} is [{}, {}], but domain.{} = {} (the box must start at 0)",
-                                         a == 0 ? "x" : "y", box[a][0], box[a][1], a == 0 ? "lx" : "ly", want));
+            throw InputError(
+                {in.path(), 0},
+                fmt::format(
+                    "the box in {} is [{}, {}], but domain.{} = {} (the box must start at 0)",
+                    a == 0 ? "x" : "y", box[a][0], box[a][1], a == 0 ? "lx" : "ly", want));
     }
     // A deterministic particle order: by id.
     std::sort(atoms.begin(), atoms.end(), [](const Atom& a, const Atom& b) { return a.id < b.id; });

@@ -17,7 +17,7 @@
 namespace efdem::dem {
 
 class ThermoLog {
-public:
+  public:
     /// Opens (truncates) `file` and writes the header row; RuntimeFailure if it cannot.
     explicit ThermoLog(const std::filesystem::path& file);
     ~ThermoLog();
@@ -25,7 +25,7 @@ public:
     ThermoLog& operator=(const ThermoLog&) = delete;
     void write(const System& system);
 
-private:
+  private:
     std::FILE* file_ = nullptr;
     std::filesystem::path path_;
 };

@@ -31,7 +31,7 @@
 namespace efdem::dem {
 
 class VtkSeriesWriter {
-public:
+  public:
     /// Files are `<directory>/<stem>_<index>.vtp` and `<directory>/<stem>.pvd`.
     VtkSeriesWriter(std::filesystem::path directory, std::string stem);
     /// Writes a snapshot of `system` at its current time; RuntimeFailure if the files cannot be
@@ -40,7 +40,7 @@ public:
     const std::filesystem::path& collection() const { return pvd_; }
     std::size_t snapshots() const { return entries_.size(); }
 
-private:
+  private:
     std::filesystem::path directory_;
     std::string stem_;
     std::filesystem::path pvd_;

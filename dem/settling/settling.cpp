@@ -16,12 +16,14 @@
 namespace efdem::dem {
 
 Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& scene,
-                     const Params& root, const RealizationSpec& spec, const SettlingReport& report) {
+                     const Params& root, const RealizationSpec& spec,
+                     const SettlingReport& report) {
     for (const char* needed : {"pair_contact", "wall_contact"}) {
         bool listed = false;
         for (const auto& n : scene.effect_names) listed |= n == needed;
         if (!listed)
-            root.scope("bed").fail("settle", fmt::format("needs '{}' in 'effects' to settle the bed", needed),
+            root.scope("bed").fail("settle",
+                                   fmt::format("needs '{}' in 'effects' to settle the bed", needed),
                                    "false, or list pair_contact and wall_contact in effects");
     }
     // The settling run uses the scene's own contact laws and gravity, plus a damping stage.
@@ -72,7 +74,8 @@ Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& sc
     };
 
     const long free_fall = steps(settle_free_fall_time(top));  // the top layer reaches the bed
-    tell(SettlingProgress::Stage::free_fall, static_cast<double>(free_fall) * scene.dt, ke_per_particle());  // the start
+    tell(SettlingProgress::Stage::free_fall, static_cast<double>(free_fall) * scene.dt,
+         ke_per_particle());  // the start
     run_stage(SettlingProgress::Stage::free_fall, free_fall);
     damping->set_gamma(bed.settle_damping);
     run_stage(SettlingProgress::Stage::damped, steps(bed.settle_damped_time));
@@ -87,9 +90,10 @@ Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& sc
     }
     tell(SettlingProgress::Stage::done, sys.time(), ke);
     if (ke >= threshold)
-        log::warn("realization {}: settling stopped after {:.4g} time units with kinetic energy {:.3g} "
-                  "per particle, above bed.settle.ke_threshold x m_min g d = {:.3g}",
-                  spec.realization, sys.time(), ke, threshold);
+        log::warn(
+            "realization {}: settling stopped after {:.4g} time units with kinetic energy {:.3g} "
+            "per particle, above bed.settle.ke_threshold x m_min g d = {:.3g}",
+            spec.realization, sys.time(), ke, threshold);
     Particles settled = sys.particles();
     for (auto& v : settled.v()) v = Vec3{};  // the packed bed starts at rest
     for (auto& w : settled.omega()) w = Vec3{};

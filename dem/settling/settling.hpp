@@ -25,6 +25,7 @@ namespace efdem::dem {
 /// Settles `particles` with the scene's gravity, pair_contact and wall_contact (InputError on
 /// bed.settle if the scene lacks the contact effects). Returns the settled particles, at rest.
 Particles settle_bed(Particles particles, const BedSpec& bed, const DemScene& scene,
-                     const Params& root, const RealizationSpec& spec, const SettlingReport& report = {});
+                     const Params& root, const RealizationSpec& spec,
+                     const SettlingReport& report = {});
 
 }  // namespace efdem::dem

@@ -27,7 +27,8 @@ std::uint64_t CheckpointHeader::checksum() const {
     h = hash_text(scene_text, h);
     h = hash_text(parameters, h);
     const StepperState& s = stepper;
-    for (double d : {s.micro_time, s.particle_steps, s.height_lo, s.height_hi}) h = hash_value(d, h);
+    for (double d : {s.micro_time, s.particle_steps, s.height_lo, s.height_hi})
+        h = hash_value(d, h);
     h = hash_value(s.samples_taken, h);
     h = fnv1a_array(s.lifting, h);
     h = fnv1a_array(s.observable, h);
@@ -58,7 +59,8 @@ std::string checkpoint_file_name(const std::string& prefix, long sequence) {
 
 bool is_checkpoint_file_name(const std::string& name, const std::string& prefix) {
     const std::string head = prefix + "_ckpt_";
-    if (name.size() != head.size() + 8 + 3 || name.rfind(head, 0) != 0 || !name.ends_with(".h5")) return false;
+    if (name.size() != head.size() + 8 + 3 || name.rfind(head, 0) != 0 || !name.ends_with(".h5"))
+        return false;
     for (std::size_t k = head.size(); k < head.size() + 8; ++k)
         if (!std::isdigit(static_cast<unsigned char>(name[k]))) return false;
     return true;

@@ -84,12 +84,12 @@ struct RealizationState;
 /// stepper does not depend on HDF5).
 /// Thrown on every rank alike (collectively agreed) when a checkpoint would not fit on the disk.
 class CheckpointSpaceError : public RuntimeFailure {
-public:
+  public:
     explicit CheckpointSpaceError(const std::string& message) : RuntimeFailure(message) {}
 };
 
 class CheckpointSink {
-public:
+  public:
     virtual ~CheckpointSink() = default;
     /// Collective; `header` on the root only. Returns the path written.
     virtual std::filesystem::path write(long sequence, const std::vector<RealizationState>& local,

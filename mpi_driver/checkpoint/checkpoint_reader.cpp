@@ -22,7 +22,8 @@ constexpr const char* kPartialWrite =
 template <class T>
 T with_checkpoint(const std::filesystem::path& path, const std::function<T(const H5File&)>& body) {
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) refuse(path, "file not found (restart=FILE names no file)");
+    if (!std::filesystem::is_regular_file(path, ec))
+        refuse(path, "file not found (restart=FILE names no file)");
     try {
         const H5File f = H5File::open(path, false);
         return body(f);
@@ -34,7 +35,8 @@ T with_checkpoint(const std::filesystem::path& path, const std::function<T(const
 
 std::vector<Vec3> vectors(const std::vector<double>& flat) {
     std::vector<Vec3> out(flat.size() / 3);
-    for (std::size_t i = 0; i < out.size(); ++i) out[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
+    for (std::size_t i = 0; i < out.size(); ++i)
+        out[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
     return out;
 }
 }  // namespace
@@ -42,20 +44,26 @@ std::vector<Vec3> vectors(const std::vector<double>& flat) {
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
     return with_checkpoint<CheckpointHeader>(path, [&](const H5File& f) {
         if (f.exists("/samples") && !f.exists("/realizations"))
-            throw InputError(SourceLocation{path.string(), 0},
-                             "restart= names an efdem run file (the record of a run), not a checkpoint; checkpoints "
-                             "are the PREFIX_ckpt_NNNNNNNN.h5 files in checkpoint.directory (written every "
-                             "checkpoint.interval and when a stop signal ends a run)");
+            throw InputError(
+                SourceLocation{path.string(), 0},
+                "restart= names an efdem run file (the record of a run), not a checkpoint; "
+                "checkpoints "
+                "are the PREFIX_ckpt_NNNNNNNN.h5 files in checkpoint.directory (written every "
+                "checkpoint.interval and when a stop signal ends a run)");
         if (!f.has_attribute("/", "format_version"))
-            refuse(path, path.extension() == ".tmp" ? kPartialWrite
-                                                    : "is not an efdem checkpoint (no format_version attribute)");
+            refuse(path, path.extension() == ".tmp"
+                             ? kPartialWrite
+                             : "is not an efdem checkpoint (no format_version attribute)");
         CheckpointHeader h;
         h.format_version = f.attribute_integer("/", "format_version");
-        if (h.format_version < kOldestReadableCheckpointFormat || h.format_version > kCheckpointFormatVersion)
-            refuse(path, fmt::format("has format version {}; this efdem reads versions {} to {}", h.format_version,
-                                     kOldestReadableCheckpointFormat, kCheckpointFormatVersion));
+        if (h.format_version < kOldestReadableCheckpointFormat ||
+            h.format_version > kCheckpointFormatVersion)
+            refuse(path, fmt::format("has format version {}; this efdem reads versions {} to {}",
+                                     h.format_version, kOldestReadableCheckpointFormat,
+                                     kCheckpointFormatVersion));
         if (!f.has_attribute("/", "complete") || f.attribute_integer("/", "complete") != 1)
-            refuse(path, "is incomplete: its writing was interrupted (use the previous checkpoint)");
+            refuse(path,
+                   "is incomplete: its writing was interrupted (use the previous checkpoint)");
         h.mode = f.attribute_text("/", "mode");
         h.realizations = f.attribute_integer("/", "realizations");
         h.sequence = f.attribute_integer("/", "sequence");
@@ -82,13 +90,14 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         if (h.format_version >= 3) {
             h.stepper.active = f.read_integers("/driver/active");
             const auto failures = f.read_integers("/driver/failures");
-            if (h.stepper.active.size() != static_cast<std::size_t>(h.realizations) || failures.size() != 1)
+            if (h.stepper.active.size() != static_cast<std::size_t>(h.realizations) ||
+                failures.size() != 1)
                 refuse(path, "has a malformed /driver/active or /driver/failures dataset");
             h.stepper.failures = failures[0];
         }
         for (std::size_t r = 0; r < lifting.size(); r += 4)
-            h.stepper.lifting.push_back({from_stored(lifting[r]), from_stored(lifting[r + 1]), from_stored(lifting[r + 2]),
-                                         from_stored(lifting[r + 3])});
+            h.stepper.lifting.push_back({from_stored(lifting[r]), from_stored(lifting[r + 1]),
+                                         from_stored(lifting[r + 2]), from_stored(lifting[r + 3])});
         h.stepper.observable = f.read_doubles("/driver/observable");
         h.stepper.recorded = f.read_doubles("/driver/recorded");
         if (h.format_version >= 2) {
@@ -106,13 +115,14 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
     });
 }
 
-std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem::path& path, long first,
-                                                           int count) {
+std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem::path& path,
+                                                           long first, int count) {
     return with_checkpoint<std::vector<RealizationState>>(path, [&](const H5File& f) {
         const auto meta = f.read_integers("/realizations/meta");
         const auto rows = static_cast<long>(meta.size() / 6);
         if (first + count > rows)
-            refuse(path, fmt::format("holds {} realizations; realization {} was asked for", rows, first + count - 1));
+            refuse(path, fmt::format("holds {} realizations; realization {} was asked for", rows,
+                                     first + count - 1));
         const auto checksum = f.read_integers("/realizations/checksum");
         const auto time = f.read_doubles("/realizations/time");
         hsize_t n_off = 0, p_off = 0;
@@ -128,7 +138,9 @@ std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem
             s.index = m[0];
             s.step = m[1];
             s.time = time.at(static_cast<std::size_t>(r));
-            auto block = [&](const char* name) { return vectors(f.read_doubles(fmt::format("/realizations/{}", name), n_off, n)); };
+            auto block = [&](const char* name) {
+                return vectors(f.read_doubles(fmt::format("/realizations/{}", name), n_off, n));
+            };
             s.x = block("x");
             s.v = block("v");
             s.omega = block("omega");
@@ -147,9 +159,12 @@ std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem
             const auto px = f.read_doubles("/realizations/pair_xi", p_off, np);
             if (pt.size() != 2 * np || px.size() != 3 * np || s.x.size() != n)
                 refuse(path, fmt::format("realization {} is truncated", r));
-            for (hsize_t k = 0; k < np; ++k) s.pairs.push_back({pt[2 * k], pt[2 * k + 1], {px[3 * k], px[3 * k + 1], px[3 * k + 2]}});
+            for (hsize_t k = 0; k < np; ++k)
+                s.pairs.push_back(
+                    {pt[2 * k], pt[2 * k + 1], {px[3 * k], px[3 * k + 1], px[3 * k + 2]}});
             if (s.checksum() != from_stored(checksum.at(static_cast<std::size_t>(r))))
-                refuse(path, fmt::format("is corrupted: the checksum of realization {} does not match", r));
+                refuse(path, fmt::format(
+                                 "is corrupted: the checksum of realization {} does not match", r));
             out.push_back(std::move(s));
             n_off += n;
             p_off += np;

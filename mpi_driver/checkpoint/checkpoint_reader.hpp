@@ -19,7 +19,7 @@ namespace efdem::mpi_driver {
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path);
 
 /// Realizations [first, first + count), each verified against its stored checksum.
-std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem::path& path, long first,
-                                                           int count);
+std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem::path& path,
+                                                           long first, int count);
 
 }  // namespace efdem::mpi_driver

@@ -18,7 +18,8 @@ namespace efdem::mpi_driver {
 namespace {
 std::string read_whole_file(const std::filesystem::path& p) {
     std::ifstream in(p, std::ios::binary);
-    if (!in) throw RuntimeFailure(fmt::format("checkpoint: cannot read the output file {}", p.string()));
+    if (!in)
+        throw RuntimeFailure(fmt::format("checkpoint: cannot read the output file {}", p.string()));
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
@@ -37,18 +38,20 @@ std::vector<double> flatten(const std::vector<Vec3>& v, std::size_t rows) {
 /// A parallel-HDF5 file being written collectively: shared datasets, each rank writing one
 /// contiguous block of rows (its realizations are consecutive in global order).
 class CollectiveFile {
-public:
+  public:
     CollectiveFile(const std::filesystem::path& path, MPI_Comm comm) : path_(path.string()) {
         H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
         const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
         H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
         file_ = H5Fcreate(path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
         H5Pclose(fapl);
-        if (file_ < 0) throw RuntimeFailure(fmt::format("cannot create the checkpoint file {}", path_));
+        if (file_ < 0)
+            throw RuntimeFailure(fmt::format("cannot create the checkpoint file {}", path_));
         dxpl_ = H5Pcreate(H5P_DATASET_XFER);
         H5Pset_dxpl_mpio(dxpl_, H5FD_MPIO_COLLECTIVE);
         const hid_t g = H5Gcreate2(file_, "/realizations", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        if (g < 0) throw RuntimeFailure(fmt::format("HDF5 error in {}: create /realizations", path_));
+        if (g < 0)
+            throw RuntimeFailure(fmt::format("HDF5 error in {}: create /realizations", path_));
         H5Gclose(g);
     }
     ~CollectiveFile() {
@@ -60,18 +63,21 @@ public:
 
     /// Dataset `name` of total_rows x width; this rank writes rows [first, first + rows).
     template <class T>
-    void write_block(const std::string& name, hid_t type, hsize_t total_rows, hsize_t width, hsize_t first,
-                     const std::vector<T>& data) {
+    void write_block(const std::string& name, hid_t type, hsize_t total_rows, hsize_t width,
+                     hsize_t first, const std::vector<T>& data) {
         const hsize_t rows = width == 0 ? 0 : data.size() / width;
         const int rank = width == 1 ? 1 : 2;
         const hsize_t dims[2] = {total_rows, width};
         const hid_t fspace = H5Screate_simple(rank, dims, nullptr);
-        const hid_t d = H5Dcreate2(file_, name.c_str(), type, fspace, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        const hid_t d =
+            H5Dcreate2(file_, name.c_str(), type, fspace, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         herr_t status = d < 0 ? -1 : 0;
         if (status >= 0 && total_rows > 0) {
             const hsize_t start[2] = {first, 0}, count[2] = {rows, width};
-            if (rows > 0) H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, count, nullptr);
-            else H5Sselect_none(fspace);
+            if (rows > 0)
+                H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, count, nullptr);
+            else
+                H5Sselect_none(fspace);
             const hsize_t mdims[2] = {std::max<hsize_t>(rows, 1), width};
             const hid_t mspace = H5Screate_simple(rank, mdims, nullptr);
             if (rows == 0) H5Sselect_none(mspace);
@@ -80,10 +86,11 @@ public:
         }
         if (d >= 0) H5Dclose(d);
         H5Sclose(fspace);
-        if (status < 0) throw RuntimeFailure(fmt::format("HDF5 error in {}: write {}", path_, name));
+        if (status < 0)
+            throw RuntimeFailure(fmt::format("HDF5 error in {}: write {}", path_, name));
     }
 
-private:
+  private:
     std::string path_;
     hid_t file_ = -1;
     hid_t dxpl_ = -1;
@@ -93,12 +100,17 @@ private:
 CheckpointWriter::CheckpointWriter(const EnsembleLayout& layout, const CheckpointSettings& settings,
                                    std::string prefix, CheckpointHeader identity,
                                    std::vector<std::filesystem::path> outputs)
-    : layout_(layout), settings_(settings), prefix_(std::move(prefix)), identity_(std::move(identity)),
+    : layout_(layout),
+      settings_(settings),
+      prefix_(std::move(prefix)),
+      identity_(std::move(identity)),
       outputs_(std::move(outputs)) {}
 
-std::filesystem::path CheckpointWriter::write(long sequence, const std::vector<RealizationState>& local,
+std::filesystem::path CheckpointWriter::write(long sequence,
+                                              const std::vector<RealizationState>& local,
                                               const CheckpointHeader* header) const {
-    const std::filesystem::path final_path = settings_.directory / checkpoint_file_name(prefix_, sequence);
+    const std::filesystem::path final_path =
+        settings_.directory / checkpoint_file_name(prefix_, sequence);
     std::filesystem::path tmp = final_path;
     tmp += ".tmp";
     ensure_space(final_path, local);
@@ -110,16 +122,19 @@ std::filesystem::path CheckpointWriter::write(long sequence, const std::vector<R
     write_header(tmp, sequence, *header);
     std::error_code ec;
     std::filesystem::rename(tmp, final_path, ec);
-    if (ec) throw RuntimeFailure(fmt::format("cannot rename the checkpoint {} to {}: {}", tmp.string(),
-                                             final_path.string(), ec.message()));
+    if (ec)
+        throw RuntimeFailure(fmt::format("cannot rename the checkpoint {} to {}: {}", tmp.string(),
+                                         final_path.string(), ec.message()));
     prune(final_path);
     return final_path;
 }
 
-void CheckpointWriter::ensure_space(const std::filesystem::path& path, const std::vector<RealizationState>& local) const {
+void CheckpointWriter::ensure_space(const std::filesystem::path& path,
+                                    const std::vector<RealizationState>& local) const {
     // A collective write that runs out of space can leave ranks waiting for each other in MPI-IO;
     // so the space is looked at first, and every rank gives up together if it is short.
-    double bytes = 0;  // what this rank's rows take (x, v, omega, force, torque, reference, walls, tag, species; pairs)
+    double bytes = 0;  // what this rank's rows take (x, v, omega, force, torque, reference, walls,
+                       // tag, species; pairs)
     for (const auto& s : local)
         bytes += static_cast<double>(s.particles()) * (8 * sizeof(Vec3) + sizeof(dem::Tag) + 1) +
                  static_cast<double>(s.pairs.size()) * sizeof(dem::PairHistoryRecord);
@@ -140,10 +155,11 @@ void CheckpointWriter::ensure_space(const std::filesystem::path& path, const std
     }
     MPI_Bcast(verdict, 2, MPI_DOUBLE, 0, layout_.mpi().comm());
     if (verdict[0] == 0.0)
-        throw CheckpointSpaceError(fmt::format(
-            "cannot write the checkpoint {}: no space left on device for it ({:.3g} MB more are needed; the disk "
-            "or the quota is full); the checkpoints already written are untouched",
-            path.string(), verdict[1] / 1e6));
+        throw CheckpointSpaceError(
+            fmt::format("cannot write the checkpoint {}: no space left on device for it ({:.3g} MB "
+                        "more are needed; the disk "
+                        "or the quota is full); the checkpoints already written are untouched",
+                        path.string(), verdict[1] / 1e6));
 }
 
 void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
@@ -173,12 +189,12 @@ void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
     for (const auto& s : local) {
         const std::size_t n = s.particles();
         meta.insert(meta.end(), {s.index, s.step, static_cast<std::int64_t>(n),
-                                 static_cast<std::int64_t>(s.pairs.size()), s.reference.empty() ? 0 : 1,
-                                 s.wall[0].empty() ? 0 : 1});
+                                 static_cast<std::int64_t>(s.pairs.size()),
+                                 s.reference.empty() ? 0 : 1, s.wall[0].empty() ? 0 : 1});
         checksum.push_back(to_stored(s.checksum()));
         time.push_back(s.time);
-        const std::vector<Vec3>* arrays[8] = {&s.x, &s.v, &s.omega, &s.force, &s.torque,
-                                                   &s.reference, &s.wall[0], &s.wall[1]};
+        const std::vector<Vec3>* arrays[8] = {&s.x,      &s.v,         &s.omega,   &s.force,
+                                              &s.torque, &s.reference, &s.wall[0], &s.wall[1]};
         for (int a = 0; a < 8; ++a) {
             const auto flat = flatten(*arrays[a], n);
             blocks[a].insert(blocks[a].end(), flat.begin(), flat.end());
@@ -196,9 +212,11 @@ void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
     f.write_block("/realizations/meta", H5T_NATIVE_INT64, R, 6, first, meta);
     f.write_block("/realizations/checksum", H5T_NATIVE_INT64, R, 1, first, checksum);
     f.write_block("/realizations/time", H5T_NATIVE_DOUBLE, R, 1, first, time);
-    const char* names[8] = {"x", "v", "omega", "force", "torque", "reference", "wall_floor", "wall_lid"};
+    const char* names[8] = {"x",      "v",         "omega",      "force",
+                            "torque", "reference", "wall_floor", "wall_lid"};
     for (int a = 0; a < 8; ++a)
-        f.write_block(fmt::format("/realizations/{}", names[a]), H5T_NATIVE_DOUBLE, n_total, 3, n_first, blocks[a]);
+        f.write_block(fmt::format("/realizations/{}", names[a]), H5T_NATIVE_DOUBLE, n_total, 3,
+                      n_first, blocks[a]);
     f.write_block("/realizations/tag", H5T_NATIVE_INT64, n_total, 1, n_first, tags);
     f.write_block("/realizations/species", H5T_NATIVE_UINT8, n_total, 1, n_first, species);
     f.write_block("/realizations/pair_tags", H5T_NATIVE_INT64, p_total, 2, p_first, pair_tags);
@@ -215,7 +233,8 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
         if (std::filesystem::exists(p))  // stored by what follows the prefix: restarts may rename
             h.outputs.push_back({p.filename().string().substr(prefix_.size()), read_whole_file(p)});
     // In the order a reader lists them (by name), so that the checksum is computed alike.
-    std::sort(h.outputs.begin(), h.outputs.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+    std::sort(h.outputs.begin(), h.outputs.end(),
+              [](const auto& a, const auto& b) { return a.name < b.name; });
 
     H5File f = H5File::open(tmp, true);
     f.attribute("/", "format_version", h.format_version);
@@ -227,10 +246,12 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     f.write_text("/parameters", h.parameters);
     f.create_group("/driver");
     const StepperState& s = h.stepper;
-    const std::vector<double> reals{h.driver.t_origin, s.micro_time, s.particle_steps, s.height_lo, s.height_hi};
+    const std::vector<double> reals{h.driver.t_origin, s.micro_time, s.particle_steps, s.height_lo,
+                                    s.height_hi};
     f.write("/driver/reals", std::span<const double>(reals), {reals.size()});
-    const std::vector<std::int64_t> integers{s.samples_taken, h.driver.coarse_steps, h.driver.without_progress,
-                                             h.driver.fell_back ? 1 : 0, h.driver.warmed_up ? 1 : 0};
+    const std::vector<std::int64_t> integers{s.samples_taken, h.driver.coarse_steps,
+                                             h.driver.without_progress, h.driver.fell_back ? 1 : 0,
+                                             h.driver.warmed_up ? 1 : 0};
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
     std::vector<std::int64_t> lifting;
     for (const auto& st : s.lifting)
@@ -241,12 +262,14 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     f.write("/driver/failures", std::span<const std::int64_t>(failures), {1});
     f.write("/driver/observable", std::span<const double>(s.observable), {s.observable.size()});
     f.write("/driver/recorded", std::span<const double>(s.recorded), {s.recorded.size()});
-    f.write("/driver/integrator", std::span<const double>(h.driver.integrator), {h.driver.integrator.size()});
+    f.write("/driver/integrator", std::span<const double>(h.driver.integrator),
+            {h.driver.integrator.size()});
     f.write_text("/driver/integrator_text", h.driver.integrator_text);
     f.create_group("/output");
     for (const auto& o : h.outputs)
-        f.write_bytes("/output/" + o.name, std::span<const std::uint8_t>(
-                                               reinterpret_cast<const std::uint8_t*>(o.bytes.data()), o.bytes.size()));
+        f.write_bytes("/output/" + o.name,
+                      std::span<const std::uint8_t>(
+                          reinterpret_cast<const std::uint8_t*>(o.bytes.data()), o.bytes.size()));
     f.attribute("/", "header_checksum", to_stored(h.checksum()));
     f.flush();
     f.attribute("/", "complete", std::int64_t{1});  // last: marks the file as whole
@@ -260,7 +283,8 @@ void CheckpointWriter::prune(const std::filesystem::path& current) const {
         const std::string name = e.path().filename().string();
         if (is_checkpoint_file_name(name, prefix_)) found.push_back(e.path());
         // Left by a job killed while writing; never a restart candidate.
-        else if (name.ends_with(".h5.tmp") && is_checkpoint_file_name(name.substr(0, name.size() - 4), prefix_))
+        else if (name.ends_with(".h5.tmp") &&
+                 is_checkpoint_file_name(name.substr(0, name.size() - 4), prefix_))
             std::filesystem::remove(e.path(), ec);
     }
     std::sort(found.begin(), found.end());

@@ -19,14 +19,14 @@
 #include <vector>
 
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
-#include "mpi_driver/ensemble/ensemble_layout.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
 #include "mpi_driver/checkpoint/checkpoint_settings.hpp"
+#include "mpi_driver/checkpoint/realization_state.hpp"
+#include "mpi_driver/ensemble/ensemble_layout.hpp"
 
 namespace efdem::mpi_driver {
 
 class CheckpointWriter final : public CheckpointSink {
-public:
+  public:
     /// `identity`: mode, realizations, scene text and parameters (copied into every header);
     /// `outputs`: the run's output files, saved whole so that a restart continues them.
     CheckpointWriter(const EnsembleLayout& layout, const CheckpointSettings& settings,
@@ -38,11 +38,14 @@ public:
     std::filesystem::path write(long sequence, const std::vector<RealizationState>& local,
                                 const CheckpointHeader* header) const override;
 
-private:
+  private:
     /// Collective: CheckpointSpaceError on every rank when the directory has too little space.
-    void ensure_space(const std::filesystem::path& path, const std::vector<RealizationState>& local) const;
-    void write_realizations(const std::filesystem::path& tmp, const std::vector<RealizationState>& local) const;
-    void write_header(const std::filesystem::path& tmp, long sequence, const CheckpointHeader& header) const;
+    void ensure_space(const std::filesystem::path& path,
+                      const std::vector<RealizationState>& local) const;
+    void write_realizations(const std::filesystem::path& tmp,
+                            const std::vector<RealizationState>& local) const;
+    void write_header(const std::filesystem::path& tmp, long sequence,
+                      const CheckpointHeader& header) const;
     void prune(const std::filesystem::path& current) const;
 
     const EnsembleLayout& layout_;

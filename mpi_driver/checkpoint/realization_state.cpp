@@ -73,7 +73,8 @@ std::vector<std::uint8_t> pack(const RealizationState& s) {
     put(out, s.index);
     put(out, s.time);
     put(out, s.step);
-    for (const auto* a : {&s.x, &s.v, &s.omega, &s.force, &s.torque, &s.reference}) put_array(out, *a);
+    for (const auto* a : {&s.x, &s.v, &s.omega, &s.force, &s.torque, &s.reference})
+        put_array(out, *a);
     put_array(out, s.tag);
     put_array(out, s.species);
     put_array(out, s.pairs);

@@ -16,14 +16,14 @@
 namespace efdem::mpi_driver {
 
 struct RealizationState {
-    long index = -1;   ///< global realization index
-    double time = 0;   ///< simulated time
-    long step = 0;     ///< DEM step counter
+    long index = -1;  ///< global realization index
+    double time = 0;  ///< simulated time
+    long step = 0;    ///< DEM step counter
     std::vector<Vec3> x, v, omega, force, torque;
     std::vector<dem::Tag> tag;
     std::vector<std::uint8_t> species;
-    std::vector<Vec3> reference;                  ///< positions of the last list build
-    std::vector<dem::PairHistoryRecord> pairs;         ///< active pair springs by tags
+    std::vector<Vec3> reference;                          ///< positions of the last list build
+    std::vector<dem::PairHistoryRecord> pairs;            ///< active pair springs by tags
     std::vector<Vec3> wall[dem::ContactHistory::kWalls];  ///< per particle (empty: none)
 
     std::size_t particles() const { return x.size(); }

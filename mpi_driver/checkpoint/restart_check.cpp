@@ -35,19 +35,23 @@ bool may_change_on_restart(const std::string& key) {
 }
 
 std::string check_restart(const std::filesystem::path& path, const CheckpointHeader& h,
-                          const std::string& parameters_now, long realizations_now, bool allow_physics_change) {
+                          const std::string& parameters_now, long realizations_now,
+                          bool allow_physics_change) {
     const SourceLocation where{path.string(), 0};
     if (h.realizations != realizations_now)
-        throw InputError(where, fmt::format("checkpoint holds {} realizations but this run has {} (ranks x "
-                                            "ensemble.realizations_per_rank); restart with the same number",
-                                            h.realizations, realizations_now));
+        throw InputError(
+            where, fmt::format("checkpoint holds {} realizations but this run has {} (ranks x "
+                               "ensemble.realizations_per_rank); restart with the same number",
+                               h.realizations, realizations_now));
     const auto then = parse_lines(h.parameters), now = parse_lines(parameters_now);
     std::vector<std::string> changes;
     for (const auto& [key, value] : now) {
         if (may_change_on_restart(key)) continue;
         const auto it = then.find(key);
-        if (it == then.end()) changes.push_back(fmt::format("{} = {} (not in the checkpoint)", key, value));
-        else if (it->second != value) changes.push_back(fmt::format("{} = {} (checkpoint: {})", key, value, it->second));
+        if (it == then.end())
+            changes.push_back(fmt::format("{} = {} (not in the checkpoint)", key, value));
+        else if (it->second != value)
+            changes.push_back(fmt::format("{} = {} (checkpoint: {})", key, value, it->second));
     }
     for (const auto& [key, value] : then)
         if (!may_change_on_restart(key) && !now.contains(key))
@@ -57,12 +61,14 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
     for (std::size_t k = 0; k < changes.size() && k < 8; ++k) list += (k ? "; " : "") + changes[k];
     if (changes.size() > 8) list += fmt::format("; and {} more", changes.size() - 8);
     if (!allow_physics_change)
-        throw InputError(where, fmt::format("checkpoint was written by a scene with different physics: {}. "
-                                            "Restart with the checkpoint's scene, or accept the change "
-                                            "with restart.allow_physics_change=true",
-                                            list));
-    return fmt::format("restart from {} with changed physics (restart.allow_physics_change = true): {}",
-                       path.string(), list);
+        throw InputError(
+            where, fmt::format("checkpoint was written by a scene with different physics: {}. "
+                               "Restart with the checkpoint's scene, or accept the change "
+                               "with restart.allow_physics_change=true",
+                               list));
+    return fmt::format(
+        "restart from {} with changed physics (restart.allow_physics_change = true): {}",
+        path.string(), list);
 }
 
 }  // namespace efdem::mpi_driver

@@ -10,22 +10,23 @@
 #include <vector>
 
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint/realization_state.hpp"
 #include "mpi_driver/ensemble/mpi_broadcast.hpp"
 #include "mpi_driver/ensemble/mpi_session.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
 
 namespace efdem::mpi_driver {
 
 struct RestartData {
     std::filesystem::path path;
-    CheckpointHeader header;                 ///< root: complete; elsewhere only header.stepper counters
-    std::vector<RealizationState> local;     ///< this rank's realizations
+    CheckpointHeader header;  ///< root: complete; elsewhere only header.stepper counters
+    std::vector<RealizationState> local;  ///< this rank's realizations
 };
 
 /// Collective. `parameters`: the current scene's parameter_lines(). The agreement's exit code
 /// is 0 when `out` is ready.
-Agreement load_restart(const MpiComm& mpi, const std::filesystem::path& path, const std::string& parameters,
-                       int per_rank, bool allow_physics_change, RestartData& out);
+Agreement load_restart(const MpiComm& mpi, const std::filesystem::path& path,
+                       const std::string& parameters, int per_rank, bool allow_physics_change,
+                       RestartData& out);
 
 /// Root: puts the run's output files back as they were at the checkpoint, so that the
 /// recorders continue them (RuntimeFailure if a file cannot be written).

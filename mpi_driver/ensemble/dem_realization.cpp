@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 
-#include "coarse/demixing/colour_lifting.hpp"
 #include "coarse/dem_adapters/apply_colours.hpp"
 #include "coarse/dem_adapters/realization_observables.hpp"
+#include "coarse/demixing/colour_lifting.hpp"
 #include "core/contracts.hpp"
 #include "core/error.hpp"
 #include "dem/gas/gas_drag.hpp"
@@ -19,9 +19,11 @@ DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem:
                                const RealizationOutput& output, bool restarting,
                                std::optional<dem::BedObservationSettings> bed)
     : system_(std::move(system)), observed_(observed), other_(other), output_(output), bed_(bed) {
-    const std::string stem = fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
+    const std::string stem =
+        fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
     if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
-    if (output_.thermo_every > 0) thermo_ = std::make_unique<dem::ThermoLog>(output_.directory / (stem + "_thermo.csv"));
+    if (output_.thermo_every > 0)
+        thermo_ = std::make_unique<dem::ThermoLog>(output_.directory / (stem + "_thermo.csv"));
     if (!restarting) after_sample(0);
 }
 
@@ -61,17 +63,22 @@ void DemRealization::after_sample(long samples_taken) {
     if (thermo_ && samples_taken % output_.thermo_every == 0) thermo_->write(system_);
 }
 
-std::vector<std::string> continuation_parameters() { return {"gas_drag.superficial_velocity"}; }
+std::vector<std::string> continuation_parameters() {
+    return {"gas_drag.superficial_velocity"};
+}
 
 void DemRealization::set_parameter(const std::string& key, double value) {
     EFDEM_EXPECTS(key == "gas_drag.superficial_velocity");
     auto* gas = dynamic_cast<dem::GasDrag*>(system_.find_effect("gas_drag"));
-    if (!gas) throw RuntimeFailure(fmt::format("{} cannot be set: the scene does not list gas_drag in its effects", key));
+    if (!gas)
+        throw RuntimeFailure(
+            fmt::format("{} cannot be set: the scene does not list gas_drag in its effects", key));
     // The scene key's own bounds; the coarse solvers keep to them (ContinuationSettings::
     // evaluation_min/max), so this is the last line against a value no bed can be run at.
     if (!(value >= 0.0 && value <= dem::kMaxSuperficialVelocity))
-        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: outside [0, {:g}]", key, value,
-                                         dem::kMaxSuperficialVelocity));
+        throw RuntimeFailure(
+            fmt::format("{} = {:g} asked for by the coarse solver: outside [0, {:g}]", key, value,
+                        dem::kMaxSuperficialVelocity));
     gas->set_superficial_velocity(value);
 }
 
@@ -105,10 +112,12 @@ void DemRealization::restore_state(const RealizationState& s) {
     auto refuse = [&](const std::string& what) {
         throw RuntimeFailure(fmt::format("realization {}: {}", index(), what), index());
     };
-    if (s.index != index()) refuse(fmt::format("the checkpoint holds realization {} here", s.index));
+    if (s.index != index())
+        refuse(fmt::format("the checkpoint holds realization {} here", s.index));
     if (s.particles() != n || s.v.size() != n || s.omega.size() != n || s.force.size() != n ||
         s.torque.size() != n || s.tag.size() != n || s.species.size() != n)
-        refuse(fmt::format("the checkpoint has {} particles, the scene builds {}", s.particles(), n));
+        refuse(
+            fmt::format("the checkpoint has {} particles, the scene builds {}", s.particles(), n));
     // Storage order: put the particle with tag s.tag[k] at index k.
     std::unordered_map<dem::Tag, dem::Index> where;
     where.reserve(n);
@@ -116,7 +125,8 @@ void DemRealization::restore_state(const RealizationState& s) {
     std::vector<dem::Index> new_to_old(n);
     for (std::size_t k = 0; k < n; ++k) {
         const auto it = where.find(s.tag[k]);
-        if (it == where.end()) refuse(fmt::format("particle tag {} is not in the scene's bed", s.tag[k]));
+        if (it == where.end())
+            refuse(fmt::format("particle tag {} is not in the scene's bed", s.tag[k]));
         new_to_old[k] = it->second;
     }
     p.permute(new_to_old);
@@ -127,12 +137,14 @@ void DemRealization::restore_state(const RealizationState& s) {
     std::vector<dem::SpeciesId> species(n);
     for (std::size_t i = 0; i < n; ++i) {
         all[i] = static_cast<dem::Index>(i);
-        if (s.species[i] >= system_.species().size()) refuse(fmt::format("species id {} does not exist", s.species[i]));
+        if (s.species[i] >= system_.species().size())
+            refuse(fmt::format("species id {} does not exist", s.species[i]));
         species[i] = s.species[i];
     }
     system_.set_species(all, species);  // radii, masses, inertia (and the effects' caches)
     if (system_.neighbor_list()) {
-        if (s.reference.size() != n) refuse("the checkpoint has no neighbour-list reference positions");
+        if (s.reference.size() != n)
+            refuse("the checkpoint has no neighbour-list reference positions");
         system_.restore_neighbors(s.reference, s.pairs);
     }
     if (dem::ContactHistory* h = system_.contact_history())

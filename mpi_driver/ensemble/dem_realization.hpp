@@ -33,7 +33,7 @@ struct RealizationOutput {
 };
 
 class DemRealization final : public Realization {
-public:
+  public:
     /// `observed`: the species whose heights make the ICDF (colour 1); `other`: colour 0.
     /// `restarting`: the state will be restored from a checkpoint, so the per-realization
     /// outputs do not record the (discarded) initial state.
@@ -62,7 +62,7 @@ public:
     dem::System& system() { return system_; }
     const dem::System& system() const { return system_; }
 
-private:
+  private:
     dem::System system_;
     dem::SpeciesId observed_, other_;
     RealizationOutput output_;
@@ -74,7 +74,7 @@ private:
 /// Minimal-change recolouring (physics.md §9) of one realization: payload in = heights (reals)
 /// and colours (bytes), payload out = colours.
 class ColourLifter final : public Lifter {
-public:
+  public:
     LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
                      const coarse::ProbabilityGrid& grid, RandomStream& rng) const override;
 };

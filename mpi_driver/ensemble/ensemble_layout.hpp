@@ -17,7 +17,7 @@
 namespace efdem::mpi_driver {
 
 class EnsembleLayout {
-public:
+  public:
     EnsembleLayout(const MpiComm& mpi, int per_rank);
 
     int size() const { return size_; }           ///< R
@@ -41,7 +41,7 @@ public:
     std::vector<std::vector<T>> scatter_arrays(const std::vector<std::vector<T>>& on_root,
                                                const std::vector<std::size_t>& local_lengths) const;
 
-private:
+  private:
     const MpiComm* mpi_;
     int per_rank_;
     int size_;

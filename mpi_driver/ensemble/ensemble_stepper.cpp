@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdio>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -13,11 +13,19 @@
 
 namespace efdem::mpi_driver {
 
-EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, std::vector<std::unique_ptr<Realization>> local,
-                                 const StepperSettings& settings, coarse::EnsembleObservable& observable,
-                                 const Lifter& lifter, RunRecorder* recorder, Progress* progress)
-    : layout_(layout), local_(std::move(local)), settings_(settings), observable_(&observable),
-      lifter_(lifter), recorder_(recorder), progress_(progress), grid_(settings.quantiles) {
+EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout,
+                                 std::vector<std::unique_ptr<Realization>> local,
+                                 const StepperSettings& settings,
+                                 coarse::EnsembleObservable& observable, const Lifter& lifter,
+                                 RunRecorder* recorder, Progress* progress)
+    : layout_(layout),
+      local_(std::move(local)),
+      settings_(settings),
+      observable_(&observable),
+      lifter_(lifter),
+      recorder_(recorder),
+      progress_(progress),
+      grid_(settings.quantiles) {
     EFDEM_EXPECTS(static_cast<int>(local_.size()) == layout.per_rank());
     active_.assign(static_cast<std::size_t>(layout_.size()), 1);
     if (layout_.is_root())
@@ -41,7 +49,8 @@ int EnsembleStepper::active_realizations() const {
 }
 
 bool EnsembleStepper::needs_top_half() const {
-    return observable_->needs_top_half() || (settings_.recorded && settings_.recorded->needs_top_half());
+    return observable_->needs_top_half() ||
+           (settings_.recorded && settings_.recorded->needs_top_half());
 }
 
 std::string EnsembleStepper::where_saved() const {
@@ -49,12 +58,14 @@ std::string EnsembleStepper::where_saved() const {
     // healthy state saved.
     if (!writer_) return "there is no checkpoint to restart from (this efdem has no HDF5)";
     if (!periodic_checkpoints_ && last_checkpoint_.empty())
-        return "checkpointing is off (checkpoint.interval = 0): there is no checkpoint to restart from";
+        return "checkpointing is off (checkpoint.interval = 0): there is no checkpoint to restart "
+               "from";
     if (last_checkpoint_.empty())
         return "no checkpoint had been written yet (checkpoint.interval sets how often one is)";
-    return fmt::format("the failed state is not checkpointed; the newest checkpoint, {} (t = {:.6g}), "
-                       "holds the last saved healthy state (restart=FILE)",
-                       last_checkpoint_.string(), last_checkpoint_time_);
+    return fmt::format(
+        "the failed state is not checkpointed; the newest checkpoint, {} (t = {:.6g}), "
+        "holds the last saved healthy state (restart=FILE)",
+        last_checkpoint_.string(), last_checkpoint_time_);
 }
 
 namespace {
@@ -67,7 +78,8 @@ std::string naming(long realization, const std::string& message) {
 
 void EnsembleStepper::fail(const std::string& message, long realization) const {
     // Used where the ranks cannot agree first (keeping or restoring states, checkpoints).
-    layout_.mpi().abort(fmt::format("{}; {}", naming(realization, message), where_saved()), kExitRuntimeFailure);
+    layout_.mpi().abort(fmt::format("{}; {}", naming(realization, message), where_saved()),
+                        kExitRuntimeFailure);
 }
 
 int EnsembleStepper::agree(const std::vector<Failure>& failures, bool with_signal) {
@@ -78,10 +90,12 @@ int EnsembleStepper::agree(const std::vector<Failure>& failures, bool with_signa
     return global[0];
 }
 
-std::vector<std::string> EnsembleStepper::gather_failure_messages(const std::vector<Failure>& failures) const {
+std::vector<std::string> EnsembleStepper::gather_failure_messages(
+    const std::vector<Failure>& failures) const {
     std::vector<std::vector<std::uint8_t>> mine(local_.size());
     for (const Failure& f : failures)
-        mine[static_cast<std::size_t>(f.realization - layout_.first_index())].assign(f.message.begin(), f.message.end());
+        mine[static_cast<std::size_t>(f.realization - layout_.first_index())].assign(
+            f.message.begin(), f.message.end());
     std::vector<std::string> out;
     for (const auto& m : layout_.gather_arrays(mine)) out.emplace_back(m.begin(), m.end());
     return out;
@@ -92,7 +106,8 @@ void EnsembleStepper::on_failures(const std::vector<Failure>& failures) {
     const auto R = static_cast<std::size_t>(layout_.size());
     std::vector<int> mine(R, 0), all(R, 0);
     for (const Failure& f : failures) mine[static_cast<std::size_t>(f.realization)] = 1;
-    MPI_Allreduce(mine.data(), all.data(), static_cast<int>(R), MPI_INT, MPI_MAX, layout_.mpi().comm());
+    MPI_Allreduce(mine.data(), all.data(), static_cast<int>(R), MPI_INT, MPI_MAX,
+                  layout_.mpi().comm());
     std::vector<long> failed;
     for (std::size_t r = 0; r < R; ++r)
         if (all[r]) failed.push_back(static_cast<long>(r));
@@ -103,9 +118,12 @@ void EnsembleStepper::on_failures(const std::vector<Failure>& failures) {
     // Why the run cannot survive these failures (empty: it can; abort needs no reason).
     std::string fatal;
     if (total > policy.max_failures)
-        fatal = fmt::format("{} realization failures, more than ensemble.max_failures = {}", total, policy.max_failures);
-    else if ((drop ? healthy : healthy + static_cast<int>(failed.size())) < policy.min_active || healthy < 1)
-        fatal = fmt::format("only {} healthy realization(s) would remain; the run needs {}", healthy, policy.min_active);
+        fatal = fmt::format("{} realization failures, more than ensemble.max_failures = {}", total,
+                            policy.max_failures);
+    else if ((drop ? healthy : healthy + static_cast<int>(failed.size())) < policy.min_active ||
+             healthy < 1)
+        fatal = fmt::format("only {} healthy realization(s) would remain; the run needs {}",
+                            healthy, policy.min_active);
     if (policy.action == FailurePolicy::Action::abort) fail_agreed(failures);
     if (!fatal.empty()) {
         std::vector<Failure> told = failures;
@@ -113,9 +131,12 @@ void EnsembleStepper::on_failures(const std::vector<Failure>& failures) {
         fail_agreed(told);
     }
     for (const Failure& f : failures)
-        std::fprintf(stderr, "efdem: [rank %d of %d] warning: realization %ld at t = %.6g: %s; %s (ensemble.on_failure)\n",
-                     layout_.mpi().rank(), layout_.mpi().size(), f.realization, time(), f.message.c_str(),
-                     drop ? "dropped from the ensemble" : "to be rebuilt from a healthy realization");
+        std::fprintf(
+            stderr,
+            "efdem: [rank %d of %d] warning: realization %ld at t = %.6g: %s; %s "
+            "(ensemble.on_failure)\n",
+            layout_.mpi().rank(), layout_.mpi().size(), f.realization, time(), f.message.c_str(),
+            drop ? "dropped from the ensemble" : "to be rebuilt from a healthy realization");
     std::fflush(stderr);
     const std::vector<std::string> reasons = gather_failure_messages(failures);
     failures_ = total;
@@ -125,8 +146,8 @@ void EnsembleStepper::on_failures(const std::vector<Failure>& failures) {
         for (long f : failed) active_[static_cast<std::size_t>(f)] = 0;
         if (layout_.is_root() && recorder_)
             for (long f : failed)
-                recorder_->failure({time(), f, reasons[static_cast<std::size_t>(f)], "dropped", -1, time(),
-                                    active_realizations()});
+                recorder_->failure({time(), f, reasons[static_cast<std::size_t>(f)], "dropped", -1,
+                                    time(), active_realizations()});
         return;
     }
     // cpi: the coarse step is redone from its resume point with the changed ensemble.
@@ -140,21 +161,25 @@ void EnsembleStepper::fail_agreed(const std::vector<Failure>& failures) {
     // The failing rank says what failed (with its rank in the prefix); the root gets the
     // messages so that the run file can say it too.
     for (const Failure& f : failures) {
-        const std::string text = fmt::format("{}; {}", naming(f.realization, f.message), where_saved());
-        std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", layout_.mpi().rank(), layout_.mpi().size(),
-                     text.c_str());
+        const std::string text =
+            fmt::format("{}; {}", naming(f.realization, f.message), where_saved());
+        std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", layout_.mpi().rank(),
+                     layout_.mpi().size(), text.c_str());
     }
     std::fflush(stderr);
     const std::vector<std::string> all = gather_failure_messages(failures);
     std::string summary;
     for (std::size_t r = 0; r < all.size(); ++r)
         if (!all[r].empty())
-            summary += fmt::format("{}realization {} at t = {:.6g}: {}", summary.empty() ? "" : "; ", r, time(), all[r]);
-    throw RunFailed(summary.empty() ? std::string("a realization failed (see the messages above)") : summary);
+            summary += fmt::format("{}realization {} at t = {:.6g}: {}",
+                                   summary.empty() ? "" : "; ", r, time(), all[r]);
+    throw RunFailed(summary.empty() ? std::string("a realization failed (see the messages above)")
+                                    : summary);
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
-    double buf[3] = {static_cast<double>(static_cast<int>(m.command)), m.value, m.top_half ? 1.0 : 0.0};
+    double buf[3] = {static_cast<double>(static_cast<int>(m.command)), m.value,
+                     m.top_half ? 1.0 : 0.0};
     MPI_Bcast(buf, 3, MPI_DOUBLE, 0, layout_.mpi().comm());
     return {static_cast<Command>(static_cast<int>(buf[0])), buf[1], buf[2] != 0.0};
 }
@@ -184,9 +209,12 @@ void EnsembleStepper::finish(int exit_code) {
 
 void EnsembleStepper::record(const SampleRecord& s) {
     if (!recorder_) return;
-    if (provisional_) pending_.push_back(s);  // recorded when the jump before it is kept
-    else if (has_resume_point_) since_mark_.push_back(s);
-    else recorder_->sample(s);
+    if (provisional_)
+        pending_.push_back(s);  // recorded when the jump before it is kept
+    else if (has_resume_point_)
+        since_mark_.push_back(s);
+    else
+        recorder_->sample(s);
 }
 
 void EnsembleStepper::flush_since_mark() {
@@ -270,7 +298,8 @@ void EnsembleStepper::do_go_back() {
     try {
         for (std::size_t j = 0; j < local_.size(); ++j) local_[j]->restore_state(kept_[j]);
     } catch (const std::exception& e) {
-        fail(std::string("going back to the state before a rejected jump: ") + e.what(), local_.front()->index());
+        fail(std::string("going back to the state before a rejected jump: ") + e.what(),
+             local_.front()->index());
     }
     // The rejected burst's work was done: it stays in the cost.
     const double micro = micro_time_, steps = particle_steps_;
@@ -295,18 +324,42 @@ void EnsembleStepper::serve() {
     while (true) {
         const Message m = broadcast({Command::finish, 0.0, false});
         switch (m.command) {
-            case Command::run: do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr); break;
-            case Command::lift: do_lift(m.value, m.top_half, nullptr, false); break;
-            case Command::lift_members: do_lift(m.value, m.top_half, nullptr, true); break;
-            case Command::checkpoint: do_checkpoint(std::lround(m.value), nullptr, false); break;
-            case Command::keep: do_keep(); break;
-            case Command::go_back: do_go_back(); break;
-            case Command::confirm: do_confirm(); break;
-            case Command::mark: do_mark(); break;
-            case Command::checkpoint_mark: do_checkpoint(std::lround(m.value), nullptr, true); break;
-            case Command::rebuild: do_rebuild(m.top_half); break;
-            case Command::set_parameter: do_set_parameter(m.value); break;
-            case Command::finish: finish_code_ = static_cast<int>(m.value); return;
+            case Command::run:
+                do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr);
+                break;
+            case Command::lift:
+                do_lift(m.value, m.top_half, nullptr, false);
+                break;
+            case Command::lift_members:
+                do_lift(m.value, m.top_half, nullptr, true);
+                break;
+            case Command::checkpoint:
+                do_checkpoint(std::lround(m.value), nullptr, false);
+                break;
+            case Command::keep:
+                do_keep();
+                break;
+            case Command::go_back:
+                do_go_back();
+                break;
+            case Command::confirm:
+                do_confirm();
+                break;
+            case Command::mark:
+                do_mark();
+                break;
+            case Command::checkpoint_mark:
+                do_checkpoint(std::lround(m.value), nullptr, true);
+                break;
+            case Command::rebuild:
+                do_rebuild(m.top_half);
+                break;
+            case Command::set_parameter:
+                do_set_parameter(m.value);
+                break;
+            case Command::finish:
+                finish_code_ = static_cast<int>(m.value);
+                return;
         }
     }
 }
@@ -327,7 +380,8 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
     try {
         if (!at_resume_point)
             for (const auto& r : local_) states.push_back(r->save_state());
-        last_checkpoint_ = writer_->write(sequence, at_resume_point ? resume_states_ : states, header);
+        last_checkpoint_ =
+            writer_->write(sequence, at_resume_point ? resume_states_ : states, header);
         last_checkpoint_time_ = at_resume_point ? resume_time_ : time();
         return last_checkpoint_;
     } catch (const CheckpointSpaceError& e) {
@@ -335,7 +389,8 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
         if (layout_.is_root()) std::fprintf(stderr, "efdem: error: %s\n", e.what());
         throw RunFailed(e.what());
     } catch (const std::exception& e) {
-        layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()), kExitRuntimeFailure);
+        layout_.mpi().abort(fmt::format("writing checkpoint {}: {}", sequence, e.what()),
+                            kExitRuntimeFailure);
     }
 }
 
@@ -376,13 +431,15 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
     std::vector<Failure> failures;
     for (long s = 0; s < samples; ++s) {
         for (auto& r : local_) {
-            if (!is_active(*r)) {  // dropped after a failure: not advanced, but its clock keeps time
+            if (!is_active(
+                    *r)) {  // dropped after a failure: not advanced, but its clock keeps time
                 r->set_time(r->time() + static_cast<double>(settings_.steps_per_sample) * r->dt());
                 continue;
             }
             try {
                 r->advance(settings_.steps_per_sample);
-                if (!injected_fired_ && r->index() == inject.realization && r->time() >= inject.time) {
+                if (!injected_fired_ && r->index() == inject.realization &&
+                    r->time() >= inject.time) {
                     injected_fired_ = true;
                     throw RuntimeFailure("injected failure (debug.fail_realization)", r->index());
                 }
@@ -421,7 +478,8 @@ namespace {
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Index>& rows) {
     if (all.size() == 0 || static_cast<Eigen::Index>(rows.size()) == all.rows()) return all;
     Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), all.cols());
-    for (std::size_t k = 0; k < rows.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = all.row(rows[k]);
+    for (std::size_t k = 0; k < rows.size(); ++k)
+        out.row(static_cast<Eigen::Index>(k)) = all.row(rows[k]);
     return out;
 }
 }  // namespace
@@ -439,14 +497,16 @@ BedRecord bed_record(const Eigen::MatrixXd& packed, const dem::BedObservationSet
     b.solid_fraction.resize(n, static_cast<Eigen::Index>(settings.profile_slabs));
     for (Eigen::Index r = 0; r < n; ++r) {
         const Eigen::VectorXd row = packed.row(r).transpose();
-        const dem::BedObservation o =
-            dem::BedObservation::unpack({row.data(), static_cast<std::size_t>(row.size())}, settings);
+        const dem::BedObservation o = dem::BedObservation::unpack(
+            {row.data(), static_cast<std::size_t>(row.size())}, settings);
         b.pressure_drop[r] = o.pressure_drop;
         b.pressure_drop_ratio[r] = o.pressure_drop_ratio;
         b.height[r] = o.height;
         b.mixing_index[r] = o.mixing_index;
-        b.species_height.row(r) = Eigen::Map<const Eigen::RowVectorXd>(o.species_height.data(), b.species_height.cols());
-        b.solid_fraction.row(r) = Eigen::Map<const Eigen::RowVectorXd>(o.solid_fraction.data(), b.solid_fraction.cols());
+        b.species_height.row(r) =
+            Eigen::Map<const Eigen::RowVectorXd>(o.species_height.data(), b.species_height.cols());
+        b.solid_fraction.row(r) =
+            Eigen::Map<const Eigen::RowVectorXd>(o.solid_fraction.data(), b.solid_fraction.cols());
     }
     return b;
 }
@@ -456,7 +516,9 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     const double start = MPI_Wtime();
     const auto m = static_cast<Eigen::Index>(grid_.values().size());
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    const auto bed_width = settings_.bed ? static_cast<Eigen::Index>(dem::BedObservation::packed_size(*settings_.bed)) : 0;
+    const auto bed_width =
+        settings_.bed ? static_cast<Eigen::Index>(dem::BedObservation::packed_size(*settings_.bed))
+                      : 0;
     std::vector<Eigen::VectorXd> icdf, top_icdf, scalars, bed;
     for (const auto& r : local_) {
         if (!is_active(*r)) {  // dropped: a row of NaN in the record, not in the means
@@ -478,7 +540,8 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
     const Eigen::MatrixXd all_top_rows = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
     const Eigen::MatrixXd all_scalar_rows = layout_.gather_rows(scalars);
-    const Eigen::MatrixXd all_bed_rows = bed_width > 0 ? layout_.gather_rows(bed) : Eigen::MatrixXd();
+    const Eigen::MatrixXd all_bed_rows =
+        bed_width > 0 ? layout_.gather_rows(bed) : Eigen::MatrixXd();
     if (!layout_.is_root()) {
         overhead_.restrict_seconds += MPI_Wtime() - start;
         ++overhead_.samples;
@@ -500,7 +563,8 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     rec.com = all_scalar_rows.col(0);
     if (settings_.bed) {
         rec.bed = bed_record(all_bed_rows, *settings_.bed);
-        rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(), *settings_.bed);
+        rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(),
+                                  *settings_.bed);
     }
     rec.top_mean = top ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
@@ -528,11 +592,12 @@ void EnsembleStepper::take_sample(bool top, coarse::BurstSamples* out) {
     if (progress_) progress_->update(rec.time, particle_steps_, "");
 }
 
-void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target, bool members,
-                              const std::vector<char>* only) {
+void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* target,
+                              bool members, const std::vector<char>* only) {
     const double start = MPI_Wtime();
     auto lifted_here = [&](long index) {
-        return active_[static_cast<std::size_t>(index)] != 0 && (!only || (*only)[static_cast<std::size_t>(index)] != 0);
+        return active_[static_cast<std::size_t>(index)] != 0 &&
+               (!only || (*only)[static_cast<std::size_t>(index)] != 0);
     };
     const auto m = static_cast<Eigen::Index>(grid_.values().size());
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -544,7 +609,8 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
     std::vector<Eigen::VectorXd> top_icdf, own_icdf;
     std::vector<std::size_t> out_reals, out_bytes;
     for (const auto& r : local_) {
-        if (!lifted_here(r->index())) {  // dropped, or not among `only`: nothing sent, nothing changed
+        if (!lifted_here(
+                r->index())) {  // dropped, or not among `only`: nothing sent, nothing changed
             reals.emplace_back();
             bytes.emplace_back();
             if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
@@ -595,7 +661,8 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
             if (!lifted_here(r)) {
                 last_lift_.changed.push_back(0);
                 last_lift_.max_deviation.push_back(std::numeric_limits<double>::quiet_NaN());
-                last_lift_.messages.emplace_back(active_[static_cast<std::size_t>(r)] ? "" : "dropped");
+                last_lift_.messages.emplace_back(active_[static_cast<std::size_t>(r)] ? ""
+                                                                                      : "dropped");
                 lifted_reals.emplace_back();
                 lifted_bytes.emplace_back();
                 continue;
@@ -607,17 +674,19 @@ void EnsembleStepper::do_lift(double new_time, bool top, const Eigen::VectorXd* 
                 if (member_repair_) {
                     const coarse::RepairReport report = member_repair_(x);
                     if (report.changed())
-                        repaired = fmt::format("its own target (X_r + increment) repaired by up to {:.3g} d_p",
-                                               report.max_adjustment);
+                        repaired = fmt::format(
+                            "its own target (X_r + increment) repaired by up to {:.3g} d_p",
+                            report.max_adjustment);
                 }
             }
-            const Eigen::VectorXd goal =
-                observable_->lift_target(x, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
+            const Eigen::VectorXd goal = observable_->lift_target(
+                x, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
             LiftOutcome res = lifter_.lift(goal, {all_reals[r], all_bytes[r]}, grid_, lifting_[r]);
             last_lift_.changed.push_back(res.changed);
             last_lift_.max_deviation.push_back(res.max_deviation);
-            last_lift_.messages.push_back(repaired.empty() || res.message.empty() ? repaired + res.message
-                                                                                   : repaired + "; " + res.message);
+            last_lift_.messages.push_back(repaired.empty() || res.message.empty()
+                                              ? repaired + res.message
+                                              : repaired + "; " + res.message);
             lifted_reals.push_back(std::move(res.payload.reals));
             lifted_bytes.push_back(std::move(res.payload.bytes));
         }
@@ -644,7 +713,8 @@ void EnsembleStepper::rebuild_after_failure() {
     do_rebuild(observable_->needs_top_half());
 }
 
-void EnsembleStepper::send_states(const std::vector<long>& failed, const std::vector<long>& donors) {
+void EnsembleStepper::send_states(const std::vector<long>& failed,
+                                  const std::vector<long>& donors) {
     // The donor's state at the resume point goes to the failed realization's rank.
     const long k = layout_.per_rank();
     const int me = layout_.mpi().rank();
@@ -663,7 +733,8 @@ void EnsembleStepper::send_states(const std::vector<long>& failed, const std::ve
                 long n = 0;
                 MPI_Recv(&n, 1, MPI_LONG, from, 71, layout_.mpi().comm(), MPI_STATUS_IGNORE);
                 std::vector<std::uint8_t> bytes(static_cast<std::size_t>(n));
-                MPI_Recv(bytes.data(), static_cast<int>(n), MPI_BYTE, from, 72, layout_.mpi().comm(), MPI_STATUS_IGNORE);
+                MPI_Recv(bytes.data(), static_cast<int>(n), MPI_BYTE, from, 72,
+                         layout_.mpi().comm(), MPI_STATUS_IGNORE);
                 state = unpack(bytes);
             }
         }
@@ -683,7 +754,8 @@ void EnsembleStepper::do_rebuild(bool top_half) {
     try {
         for (std::size_t j = 0; j < local_.size(); ++j) local_[j]->restore_state(resume_states_[j]);
     } catch (const std::exception& e) {
-        fail(std::string("going back to the resume point after a failure: ") + e.what(), local_.front()->index());
+        fail(std::string("going back to the resume point after a failure: ") + e.what(),
+             local_.front()->index());
     }
     const double micro = micro_time_, steps = particle_steps_;  // the lost work stays counted
     restore_state(resume_stepper_);
@@ -722,18 +794,21 @@ void EnsembleStepper::do_rebuild(bool top_half) {
     if (replace) send_states(failed, donors);
     if (replace && layout_.is_root())
         for (long f : failed)  // a fresh lifting stream of its own, never used before
-            lifting_[static_cast<std::size_t>(f)] =
-                RandomStream(settings_.seed, static_cast<std::uint64_t>(f + R * failures_), "lifting");
+            lifting_[static_cast<std::size_t>(f)] = RandomStream(
+                settings_.seed, static_cast<std::uint64_t>(f + R * failures_), "lifting");
     // 3. Lifted at once to the ensemble's coarse state at the resume point, so that the copy
     //    leaves its donor's trajectory from the first step on.
     if (replace && lift_flag)
-        do_lift(resume_time_, top_half, layout_.is_root() ? &resume_x_ : nullptr, false, &lift_these);
+        do_lift(resume_time_, top_half, layout_.is_root() ? &resume_x_ : nullptr, false,
+                &lift_these);
     if (layout_.is_root()) {
         last_sample_ = resume_sample_;
         if (recorder_)
             for (std::size_t i = 0; i < failed.size(); ++i)
-                recorder_->failure({failed_time_, failed[i], failed_reasons_[static_cast<std::size_t>(failed[i])],
-                                    replace ? "replaced" : "dropped", donors[i], resume_time_, active_realizations()});
+                recorder_->failure({failed_time_, failed[i],
+                                    failed_reasons_[static_cast<std::size_t>(failed[i])],
+                                    replace ? "replaced" : "dropped", donors[i], resume_time_,
+                                    active_realizations()});
     }
     failed_pending_.clear();
     changed_ = false;

@@ -39,26 +39,26 @@
 #include <utility>
 #include <vector>
 
-#include "coarse/equation_free/coarse_stepper.hpp"
 #include "coarse/demixing/ensemble_observable.hpp"
 #include "coarse/demixing/probability_grid.hpp"
+#include "coarse/equation_free/coarse_stepper.hpp"
 #include "core/rng.hpp"
+#include "dem/beds/bed_observation.hpp"
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/failure_policy.hpp"
 #include "mpi_driver/ensemble/injected_failure.hpp"
-#include "mpi_driver/output/progress.hpp"
-#include "dem/beds/bed_observation.hpp"
 #include "mpi_driver/ensemble/realization.hpp"
+#include "mpi_driver/output/progress.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
 
 namespace efdem::mpi_driver {
 
 struct StepperSettings {
-    double sample_interval = 0.5;     ///< time between samples [sqrt(d_p/g)]
-    long steps_per_sample = 1;        ///< micro steps per sample
-    int quantiles = 19;               ///< m of the p-grid
-    std::uint64_t seed = 1;           ///< master seed (for the lifting streams)
+    double sample_interval = 0.5;  ///< time between samples [sqrt(d_p/g)]
+    long steps_per_sample = 1;     ///< micro steps per sample
+    int quantiles = 19;            ///< m of the p-grid
+    std::uint64_t seed = 1;        ///< master seed (for the lifting streams)
     InjectedFailure failure;
     FailurePolicy on_failure;  ///< what a realization's failure does (abort, drop, replace)
     /// Root: an observable evaluated at every sample only to be recorded (e.g. the compact
@@ -66,7 +66,8 @@ struct StepperSettings {
     coarse::EnsembleObservable* recorded = nullptr;
     /// mode = continuation: the scene key set_parameter() changes (continuation_parameters()).
     std::string parameter;
-    /// observe.bed: how the realizations measure the bed (their Observation::bed); none: not gathered.
+    /// observe.bed: how the realizations measure the bed (their Observation::bed); none: not
+    /// gathered.
     std::optional<dem::BedObservationSettings> bed;
     /// cpi.lift = members: lift(X) moves every realization by the same increment, to its own
     /// X_r + (X - mean_r X_r), so that each keeps its offset from the ensemble mean (the spread of
@@ -76,7 +77,7 @@ struct StepperSettings {
 };
 
 class EnsembleStepper final : public coarse::CoarseStepper {
-public:
+  public:
     /// `local`: this rank's k realizations; `observable`, `lifter` and `recorder` are used on
     /// the root only (recorder and progress may be null).
     EnsembleStepper(const EnsembleLayout& layout, std::vector<std::unique_ptr<Realization>> local,
@@ -180,10 +181,19 @@ public:
     const Overhead& overhead() const { return overhead_; }
     std::vector<std::unique_ptr<Realization>>& local() { return local_; }
 
-private:
+  private:
     enum class Command : int {
-        run = 1, lift = 2, finish = 3, checkpoint = 4, keep = 5, go_back = 6, confirm = 7, mark = 8,
-        checkpoint_mark = 9, rebuild = 10, set_parameter = 11,
+        run = 1,
+        lift = 2,
+        finish = 3,
+        checkpoint = 4,
+        keep = 5,
+        go_back = 6,
+        confirm = 7,
+        mark = 8,
+        checkpoint_mark = 9,
+        rebuild = 10,
+        set_parameter = 11,
         lift_members = 12  ///< a lift that moves each realization by the same increment
     };
     /// The root's command, its argument, and whether the top-half ICDF is gathered (the
@@ -216,14 +226,17 @@ private:
     /// workers are told by the command: it adds a gather).
     void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members,
                  const std::vector<char>* only = nullptr);
-    bool is_active(const Realization& r) const { return active_[static_cast<std::size_t>(r.index())] != 0; }
+    bool is_active(const Realization& r) const {
+        return active_[static_cast<std::size_t>(r.index())] != 0;
+    }
     void on_failures(const std::vector<Failure>& failures);
     /// Root: every realization's failure message (empty where none); collective.
     std::vector<std::string> gather_failure_messages(const std::vector<Failure>& failures) const;
     void do_rebuild(bool top_half);
     void send_states(const std::vector<long>& failed, const std::vector<long>& donors);
     void take_sample(bool top_half, coarse::BurstSamples* out);
-    std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header, bool at_resume_point);
+    std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header,
+                                        bool at_resume_point);
     [[noreturn]] void fail(const std::string& message, long realization) const;
     void do_keep();
     /// This rank's realizations' states; a failure (`when`: for the message) ends the job.
@@ -254,26 +267,27 @@ private:
     coarse::RepairHook member_repair_;
     SampleRecord last_sample_;
     Overhead overhead_;
-    bool provisional_ = false;               ///< between keep_state() and its end
-    std::vector<RealizationState> kept_;     ///< every rank: its realizations' kept states
+    bool provisional_ = false;            ///< between keep_state() and its end
+    std::vector<RealizationState> kept_;  ///< every rank: its realizations' kept states
     StepperState kept_stepper_;
     SampleRecord kept_sample_;
-    std::vector<SampleRecord> pending_;      ///< root: samples since keep_state()
-    int interrupted_ = 0;                    ///< every rank: the agreed stop signal
+    std::vector<SampleRecord> pending_;  ///< root: samples since keep_state()
+    int interrupted_ = 0;                ///< every rank: the agreed stop signal
     int finish_code_ = 0;
     bool has_resume_point_ = false;
     std::vector<RealizationState> resume_states_;  ///< every rank: at the resume point
-    StepperState resume_stepper_;            ///< every rank (lifting streams, warm starts: root)
-    DriverState resume_driver_;              ///< root
+    StepperState resume_stepper_;  ///< every rank (lifting streams, warm starts: root)
+    DriverState resume_driver_;    ///< root
     double resume_time_ = 0;
-    std::vector<SampleRecord> since_mark_;   ///< root: confirmed samples after the resume point
-    SampleRecord resume_sample_;             ///< root: the last sample at the resume point
-    Eigen::VectorXd last_x_, resume_x_;      ///< root: the last restricted coarse vector, and at the resume point
-    std::vector<char> active_;               ///< every rank: per realization, in the ensemble
-    long failures_ = 0;                      ///< every rank: failures survived
-    bool injected_fired_ = false;            ///< the injected failure happens once
-    bool changed_ = false;                   ///< every rank: failures await rebuild_after_failure()
-    std::vector<long> failed_pending_;       ///< every rank: which
+    std::vector<SampleRecord> since_mark_;  ///< root: confirmed samples after the resume point
+    SampleRecord resume_sample_;            ///< root: the last sample at the resume point
+    Eigen::VectorXd last_x_,
+        resume_x_;  ///< root: the last restricted coarse vector, and at the resume point
+    std::vector<char> active_;          ///< every rank: per realization, in the ensemble
+    long failures_ = 0;                 ///< every rank: failures survived
+    bool injected_fired_ = false;       ///< the injected failure happens once
+    bool changed_ = false;              ///< every rank: failures await rebuild_after_failure()
+    std::vector<long> failed_pending_;  ///< every rank: which
     std::vector<std::string> failed_reasons_;  ///< root: why (per realization)
     double failed_time_ = 0;
 };
@@ -282,13 +296,14 @@ private:
 /// dropped or replaced: the driver calls rebuild_after_failure() and continues the loop from
 /// the resume point.
 class EnsembleChanged : public std::runtime_error {
-public:
-    EnsembleChanged() : std::runtime_error("realizations failed; the coarse step is redone without them") {}
+  public:
+    EnsembleChanged()
+        : std::runtime_error("realizations failed; the coarse step is redone without them") {}
 };
 
 /// Every rank, when the ensemble agreed that a realization failed (its rank printed why).
 class RunFailed : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 

@@ -52,5 +52,4 @@ std::string MpiSession::launcher_mismatch() const {
     return {};
 }
 
-
 }  // namespace efdem::mpi_driver

@@ -17,7 +17,7 @@ namespace efdem::mpi_driver {
 
 /// A communicator with its rank and size, and the way a rank-local failure ends the job.
 class MpiComm {
-public:
+  public:
     explicit MpiComm(MPI_Comm comm);
     MPI_Comm comm() const { return comm_; }
     int rank() const { return rank_; }
@@ -26,14 +26,14 @@ public:
     /// Prints `message` (naming this rank) and aborts every rank with `exit_code`.
     [[noreturn]] void abort(const std::string& message, int exit_code) const;
 
-private:
+  private:
     MPI_Comm comm_;
     int rank_ = 0;
     int size_ = 1;
 };
 
 class MpiSession {
-public:
+  public:
     MpiSession(int* argc, char*** argv);
     ~MpiSession();
     MpiSession(const MpiSession&) = delete;
@@ -54,7 +54,7 @@ public:
         world_->abort(message, exit_code);
     }
 
-private:
+  private:
     std::optional<MpiComm> world_;
 };
 

@@ -29,8 +29,8 @@ struct Observation {
     /// Number-weighted mean particle height: the bed's expansion, which (unlike the mass-weighted
     /// centre of mass) demixing of equal spheres leaves unchanged.
     double mean_height = 0;
-    double z_min = 0;      ///< lowest particle centre
-    double z_max = 0;      ///< highest particle centre
+    double z_min = 0;  ///< lowest particle centre
+    double z_max = 0;  ///< highest particle centre
     /// The packed dem::BedObservation (observe.bed = true; empty otherwise).
     std::vector<double> bed;
 };
@@ -44,13 +44,13 @@ struct LiftPayload {
 /// A lift computed by the root for one realization.
 struct LiftOutcome {
     LiftPayload payload;
-    long changed = 0;           ///< labels (or entries) changed
-    double max_deviation = 0;   ///< max |achieved - target| over the p-grid [d_p]
-    std::string message;        ///< non-empty when the target was repaired, clipped or rejected
+    long changed = 0;          ///< labels (or entries) changed
+    double max_deviation = 0;  ///< max |achieved - target| over the p-grid [d_p]
+    std::string message;       ///< non-empty when the target was repaired, clipped or rejected
 };
 
 class Realization {
-public:
+  public:
     virtual ~Realization() = default;
     virtual long index() const = 0;  ///< global realization index
     virtual double time() const = 0;
@@ -87,7 +87,7 @@ public:
 /// Root side of lifting: a pure function of the target, the realization's report and its
 /// lifting stream, so the root can lift realizations it does not own.
 class Lifter {
-public:
+  public:
     virtual ~Lifter() = default;
     virtual LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
                              const coarse::ProbabilityGrid& grid, RandomStream& rng) const = 0;

@@ -1,9 +1,9 @@
 #include "mpi_driver/ensemble/stop_signal.hpp"
 
+#include <unistd.h>
 #include <csignal>
 #include <cstring>
 #include <ctime>
-#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -26,7 +26,8 @@ void on_stop_signal(int signal) {
                              1e-9 * static_cast<double>(now.tv_nsec - g_first_time.tv_nsec);
         if (since < kDuplicateWindow) return;
         // Second signal: end now. Only async-signal-safe calls here (write, _exit).
-        static const char message[] = "efdem: second stop signal: ending at once, without a checkpoint\n";
+        static const char message[] =
+            "efdem: second stop signal: ending at once, without a checkpoint\n";
         [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, message, sizeof message - 1);
         ::_exit(128 + signal);
     }
@@ -46,18 +47,25 @@ void install_stop_signal_handlers() {
     for (const int s : {SIGTERM, SIGINT, SIGUSR1}) sigaction(s, &action, nullptr);
 }
 
-int stop_signal_received() { return static_cast<int>(g_first_signal); }
+int stop_signal_received() {
+    return static_cast<int>(g_first_signal);
+}
 
 RunInterrupted::RunInterrupted(int signal, double time)
     : std::runtime_error(fmt::format("stopped by {} at t = {:.6g}", signal_name(signal), time)),
-      signal_(signal), time_(time) {}
+      signal_(signal),
+      time_(time) {}
 
 std::string signal_name(int signal) {
     switch (signal) {
-        case SIGTERM: return "SIGTERM";
-        case SIGINT: return "SIGINT";
-        case SIGUSR1: return "SIGUSR1";
-        default: return fmt::format("signal {}", signal);
+        case SIGTERM:
+            return "SIGTERM";
+        case SIGINT:
+            return "SIGINT";
+        case SIGUSR1:
+            return "SIGUSR1";
+        default:
+            return fmt::format("signal {}", signal);
     }
 }
 

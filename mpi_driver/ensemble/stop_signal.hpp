@@ -27,12 +27,12 @@ std::string signal_name(int signal);
 /// ensemble agreed to stop: the burst in progress is cut short, so the caller must not use it.
 /// The driver catches it, writes the checkpoint of the last safe point and ends the run.
 class RunInterrupted : public std::runtime_error {
-public:
+  public:
     RunInterrupted(int signal, double time);
     int signal() const { return signal_; }
     double time() const { return time_; }  ///< the sample at which the ensemble stopped
 
-private:
+  private:
     int signal_;
     double time_;
 };

@@ -4,8 +4,8 @@
 
 #include <cerrno>
 #include <cmath>
-#include <utility>
 #include <system_error>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/io_error.hpp"
@@ -37,10 +37,18 @@ std::string json(const std::string& text) {
     std::string out = "\"";
     for (const char c : text) {
         switch (c) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\t':
+                out += "\\t";
+                break;
             default:
                 if (static_cast<unsigned char>(c) < 0x20)
                     out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
@@ -52,7 +60,9 @@ std::string json(const std::string& text) {
 }
 
 /// A JSON number; NaN and infinities (which JSON lacks) as null.
-std::string json(double x) { return std::isfinite(x) ? fmt::format("{:.10g}", x) : "null"; }
+std::string json(double x) {
+    return std::isfinite(x) ? fmt::format("{:.10g}", x) : "null";
+}
 
 /// The columns of the coarse-step CSV, in order, with what each holds and its unit.
 constexpr std::pair<const char*, const char*> kStepColumns[] = {
@@ -69,7 +79,8 @@ constexpr std::pair<const char*, const char*> kStepColumns[] = {
     {"labels_changed", "species labels changed by lifting, summed over the realizations (count)"},
     {"stability_rate", "estimated decay rate lambda [1/sqrt(d_p/g)]"},
     {"stability_amplification", "amplification factor of the step at that rate [-]"},
-    {"max_slope_se", "largest standard error of the coarse slope [d_p/sqrt(d_p/g)]; NaN with R = 1"},
+    {"max_slope_se",
+     "largest standard error of the coarse slope [d_p/sqrt(d_p/g)]; NaN with R = 1"},
     {"error_statistical", "adaptive CPI: projection noise of the jump [d_p]; NaN when DT is fixed"},
     {"error_truncation", "adaptive CPI: truncation error estimate [d_p]; NaN when DT is fixed"},
     {"tolerance", "adaptive CPI: cpi.tolerance [d_p]; NaN when DT is fixed"},
@@ -89,7 +100,8 @@ CsvRecorder::CsvRecorder(const std::filesystem::path& dir, const std::string& pr
     if (resume) return;
     written(icdf_, icdf_path_, [&] {
         fmt::print(icdf_, "time");
-        for (Eigen::Index i = 0; i < prov.p_grid.size(); ++i) fmt::print(icdf_, ",Q({:.4g})", prov.p_grid[i]);
+        for (Eigen::Index i = 0; i < prov.p_grid.size(); ++i)
+            fmt::print(icdf_, ",Q({:.4g})", prov.p_grid[i]);
         fmt::print(icdf_, "\n");
     });
     if (steps_)
@@ -123,43 +135,52 @@ void CsvRecorder::coarse_step(const coarse::ProjectiveStepRecord& r, const LiftR
     const coarse::ControllerRecord& c = r.controller;
     written(steps_, steps_path_, [&] {
         fmt::print(steps_,
-                   "{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.6g},{},{},{:.6g},{:.6g},{:.6g},"
+                   "{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{:.6g},{},{},{:.6g},"
+                   "{:.6g},{:.6g},"
                    "{:.6g},{:.6g},{:.6g},{}\n",
                    r.t_start, r.burst_length, r.healing, r.window, r.dt_requested, r.dt, r.period,
-                   coarse::to_string(r.status), r.repair.max_adjustment, r.repair.n_clipped, changed,
-                   r.stability.rate, r.stability.amplification, r.max_slope_standard_error(), c.statistical,
-                   c.truncation, c.tolerance, c.active ? (c.accepted ? "1" : "0") : "");
+                   coarse::to_string(r.status), r.repair.max_adjustment, r.repair.n_clipped,
+                   changed, r.stability.rate, r.stability.amplification,
+                   r.max_slope_standard_error(), c.statistical, c.truncation, c.tolerance,
+                   c.active ? (c.accepted ? "1" : "0") : "");
     });
 }
 
 void CsvRecorder::finish(const RunSummary& s) {
-    write_meta(fmt::format(",\n  \"simulated_time\": {},\n  \"dem_time\": {},\n  \"wall_seconds\": {},\n"
-                           "  \"settling_wall_seconds\": {},\n  \"total_wall_seconds\": {},\n"
-                           "  \"particle_steps\": {}",
-                           json(s.simulated_time), json(s.dem_time), json(s.wall_seconds),
-                           json(s.settling_wall_seconds), json(s.total_wall_seconds), json(s.particle_steps)),
-               s.end_status);
+    write_meta(
+        fmt::format(",\n  \"simulated_time\": {},\n  \"dem_time\": {},\n  \"wall_seconds\": {},\n"
+                    "  \"settling_wall_seconds\": {},\n  \"total_wall_seconds\": {},\n"
+                    "  \"particle_steps\": {}",
+                    json(s.simulated_time), json(s.dem_time), json(s.wall_seconds),
+                    json(s.settling_wall_seconds), json(s.total_wall_seconds),
+                    json(s.particle_steps)),
+        s.end_status);
 }
 
 void CsvRecorder::write_meta(const std::string& end, const std::string& end_status) const {
     const RunProvenance& p = provenance_;
     std::string text = fmt::format(
-        "{{\n  \"format\": \"efdem CSV sidecar 1\",\n  \"efdem_version\": {},\n  \"git_hash\": {},\n"
+        "{{\n  \"format\": \"efdem CSV sidecar 1\",\n  \"efdem_version\": {},\n  \"git_hash\": "
+        "{},\n"
         "  \"scene_file\": {},\n  \"overrides\": {},\n  \"mode\": {},\n  \"ranks\": {},\n"
         "  \"realizations\": {},\n  \"seed\": {},\n  \"observed_species\": {},\n"
         "  \"units\": {{\"length\": \"d_p\", \"time\": \"sqrt(d_p/g)\"}},\n  \"files\": {{\n",
-        json(version()), json(git_hash()), json(p.scene_file), json(p.overrides), json(p.mode), p.ranks,
-        p.realizations, p.seed, json(p.observed_species));
+        json(version()), json(git_hash()), json(p.scene_file), json(p.overrides), json(p.mode),
+        p.ranks, p.realizations, p.seed, json(p.observed_species));
     text += fmt::format(
         "    {}: {{\n      \"rows\": \"one per ensemble sample\",\n      \"columns\": {{\n"
         "        \"time\": \"time of the sample [sqrt(d_p/g)]\",\n"
         "        \"Q(p)\": {}\n      }}\n    }}",
         json(icdf_path_.filename().string()),
-        json(fmt::format("ensemble-mean inverse CDF of the heights of the '{}' particles at probability p, over "
-                         "the realizations in the ensemble [d_p]", p.observed_species)));
+        json(fmt::format(
+            "ensemble-mean inverse CDF of the heights of the '{}' particles at probability p, over "
+            "the realizations in the ensemble [d_p]",
+            p.observed_species)));
     if (steps_) {
-        text += fmt::format(",\n    {}: {{\n      \"rows\": \"one per coarse projective step\",\n"
-                            "      \"columns\": {{\n", json(steps_path_.filename().string()));
+        text += fmt::format(
+            ",\n    {}: {{\n      \"rows\": \"one per coarse projective step\",\n"
+            "      \"columns\": {{\n",
+            json(steps_path_.filename().string()));
         const char* separator = "";
         for (const auto& [name, what] : kStepColumns) {
             text += fmt::format("{}        {}: {}", separator, json(name), json(what));

@@ -15,7 +15,7 @@
 namespace efdem::mpi_driver {
 
 class CsvRecorder final : public RunRecorder {
-public:
+  public:
     /// `resume`: append to the files a restart put back (no headers written); the sidecar is
     /// rewritten (end_status "running" again).
     CsvRecorder(const std::filesystem::path& directory, const std::string& prefix,
@@ -34,7 +34,7 @@ public:
     /// `<prefix>_mean_icdf.csv`, `<prefix>_cpi_steps.csv` in cpi mode, `<prefix>_csv_meta.json`.
     std::vector<std::filesystem::path> files() const override;
 
-private:
+  private:
     /// Writes the sidecar: the provenance, `end_status`, and `end` (JSON members after it).
     void write_meta(const std::string& end, const std::string& end_status) const;
 

@@ -1,7 +1,7 @@
 #include "mpi_driver/output/h5_file.hpp"
 
-#include <algorithm>
 #include <hdf5_hl.h>
+#include <algorithm>
 
 #include <fmt/format.h>
 
@@ -35,14 +35,16 @@ std::string hdf5_error_reason() {
             const auto at = desc.find("error message = '");
             if (f.system.empty() && at != std::string::npos) {
                 const auto start = at + 17, end = desc.find('\'', start);
-                f.system = desc.substr(start, end == std::string::npos ? std::string::npos : end - start);
+                f.system =
+                    desc.substr(start, end == std::string::npos ? std::string::npos : end - start);
             }
             return 0;
         },
         &found);
     H5Eclear2(H5E_DEFAULT);
     std::string reason = !found.system.empty() ? found.system : found.innermost;
-    if (reason.find("No space left") != std::string::npos || reason.find("quota") != std::string::npos)
+    if (reason.find("No space left") != std::string::npos ||
+        reason.find("quota") != std::string::npos)
         reason += " (no space left: the disk or the quota is full)";
     return reason;
 }
@@ -66,8 +68,11 @@ H5File H5File::create(const std::filesystem::path& path) {
 
 H5File H5File::open(const std::filesystem::path& path, bool writable) {
     silence_hdf5();
-    const hid_t f = H5Fopen(path.string().c_str(), writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (f < 0) throw RuntimeFailure(fmt::format("cannot open {} as an HDF5 file (missing, truncated or not HDF5)", path.string()));
+    const hid_t f =
+        H5Fopen(path.string().c_str(), writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        throw RuntimeFailure(fmt::format(
+            "cannot open {} as an HDF5 file (missing, truncated or not HDF5)", path.string()));
     return H5File(f, path.string());
 }
 
@@ -82,14 +87,16 @@ H5File::H5File(H5File&& other) noexcept : file_(other.file_), path_(std::move(ot
 void H5File::check(herr_t status, const std::string& what) const {
     if (status < 0) {
         const std::string why = hdf5_error_reason();
-        throw RuntimeFailure(fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
+        throw RuntimeFailure(
+            fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
     }
 }
 
 hid_t H5File::check_id(hid_t id, const std::string& what) const {
     if (id < 0) {
         const std::string why = hdf5_error_reason();
-        throw RuntimeFailure(fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
+        throw RuntimeFailure(
+            fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
     }
     return id;
 }
@@ -116,7 +123,8 @@ void with_attribute(const H5File& f, const std::string& object, const std::strin
 }
 }  // namespace
 
-void H5File::attribute(const std::string& object, const std::string& name, const std::string& value) {
+void H5File::attribute(const std::string& object, const std::string& name,
+                       const std::string& value) {
     const hid_t t = string_type();
     const char* p = value.c_str();
     with_attribute(*this, object, name, t, [&](hid_t a) { return H5Awrite(a, t, &p); });
@@ -142,8 +150,9 @@ void H5File::write_build_provenance() {
 void H5File::write_text(const std::string& name, const std::string& text) {
     const hid_t t = string_type();
     const hid_t space = H5Screate(H5S_SCALAR);
-    const hid_t d = check_id(H5Dcreate2(file_, name.c_str(), t, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                             "create dataset " + name);
+    const hid_t d =
+        check_id(H5Dcreate2(file_, name.c_str(), t, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                 "create dataset " + name);
     const char* p = text.c_str();
     const herr_t status = H5Dwrite(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p);
     H5Dclose(d);
@@ -156,8 +165,9 @@ namespace {
 void write_fixed(const H5File& f, const std::string& name, hid_t type, const void* data,
                  const std::vector<hsize_t>& shape) {
     const hid_t space = H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr);
-    const hid_t d = f.check_id(H5Dcreate2(f.id(), name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                               "create dataset " + name);
+    const hid_t d = f.check_id(
+        H5Dcreate2(f.id(), name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+        "create dataset " + name);
     hsize_t n = 1;
     for (hsize_t s : shape) n *= s;
     const herr_t status = n == 0 ? 0 : H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
@@ -168,7 +178,8 @@ void write_fixed(const H5File& f, const std::string& name, hid_t type, const voi
 
 /// Reads rows [first, first + count) of `name` (count clipped to the rows there are).
 template <class T>
-std::vector<T> read_rows(const H5File& f, const std::string& name, hid_t memtype, hsize_t first, hsize_t count) {
+std::vector<T> read_rows(const H5File& f, const std::string& name, hid_t memtype, hsize_t first,
+                         hsize_t count) {
     const hid_t d = f.check_id(H5Dopen2(f.id(), name.c_str(), H5P_DEFAULT), "open dataset " + name);
     const hid_t fspace = H5Dget_space(d);
     const int rank = H5Sget_simple_extent_ndims(fspace);
@@ -187,9 +198,12 @@ std::vector<T> read_rows(const H5File& f, const std::string& name, hid_t memtype
         for (hsize_t c : cnt) n *= c;
         out.resize(static_cast<std::size_t>(n));
         if (n > 0) {
-            if (rank > 0) H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, cnt.data(), nullptr);
-            const hid_t mspace = rank > 0 ? H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr)
-                                          : H5Screate(H5S_SCALAR);
+            if (rank > 0)
+                H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, cnt.data(),
+                                    nullptr);
+            const hid_t mspace =
+                rank > 0 ? H5Screate_simple(static_cast<int>(cnt.size()), cnt.data(), nullptr)
+                         : H5Screate(H5S_SCALAR);
             status = H5Dread(d, memtype, mspace, fspace, H5P_DEFAULT, out.data());
             H5Sclose(mspace);
         }
@@ -201,11 +215,13 @@ std::vector<T> read_rows(const H5File& f, const std::string& name, hid_t memtype
 }
 }  // namespace
 
-void H5File::write(const std::string& name, std::span<const double> data, std::vector<hsize_t> shape) {
+void H5File::write(const std::string& name, std::span<const double> data,
+                   std::vector<hsize_t> shape) {
     write_fixed(*this, name, H5T_NATIVE_DOUBLE, data.data(), shape);
 }
 
-void H5File::write(const std::string& name, std::span<const std::int64_t> data, std::vector<hsize_t> shape) {
+void H5File::write(const std::string& name, std::span<const std::int64_t> data,
+                   std::vector<hsize_t> shape) {
     write_fixed(*this, name, H5T_NATIVE_INT64, data.data(), shape);
 }
 
@@ -221,8 +237,9 @@ void H5File::write_texts(const std::string& name, const std::vector<std::string>
     H5Tclose(t);
 }
 
-void H5File::document(const std::string& name, const std::string& units, const std::string& description,
-                      const std::vector<std::string>& labels, const std::vector<std::string>& scales) {
+void H5File::document(const std::string& name, const std::string& units,
+                      const std::string& description, const std::vector<std::string>& labels,
+                      const std::vector<std::string>& scales) {
     attribute(name, "units", units);
     attribute(name, "description", description);
     if (labels.empty()) return;
@@ -244,7 +261,9 @@ void H5File::document(const std::string& name, const std::string& units, const s
     check(status, "dimension scales of " + name);
 }
 
-bool H5File::exists(const std::string& name) const { return H5Lexists(file_, name.c_str(), H5P_DEFAULT) > 0; }
+bool H5File::exists(const std::string& name) const {
+    return H5Lexists(file_, name.c_str(), H5P_DEFAULT) > 0;
+}
 
 bool H5File::has_attribute(const std::string& object, const std::string& name) const {
     return H5Aexists_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT) > 0;
@@ -252,8 +271,9 @@ bool H5File::has_attribute(const std::string& object, const std::string& name) c
 
 std::int64_t H5File::attribute_integer(const std::string& object, const std::string& name) const {
     std::int64_t v = 0;
-    const hid_t a = check_id(H5Aopen_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-                             "open attribute " + object + "@" + name);
+    const hid_t a =
+        check_id(H5Aopen_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+                 "open attribute " + object + "@" + name);
     const herr_t status = H5Aread(a, H5T_NATIVE_INT64, &v);
     H5Aclose(a);
     check(status, "read attribute " + object + "@" + name);
@@ -261,8 +281,9 @@ std::int64_t H5File::attribute_integer(const std::string& object, const std::str
 }
 
 std::string H5File::attribute_text(const std::string& object, const std::string& name) const {
-    const hid_t a = check_id(H5Aopen_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-                             "open attribute " + object + "@" + name);
+    const hid_t a =
+        check_id(H5Aopen_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+                 "open attribute " + object + "@" + name);
     const hid_t t = string_type();
     char* p = nullptr;
     const herr_t status = H5Aread(a, t, &p);
@@ -286,15 +307,18 @@ std::vector<hsize_t> H5File::shape(const std::string& name) const {
     return dims;
 }
 
-std::vector<double> H5File::read_doubles(const std::string& name, hsize_t first, hsize_t count) const {
+std::vector<double> H5File::read_doubles(const std::string& name, hsize_t first,
+                                         hsize_t count) const {
     return read_rows<double>(*this, name, H5T_NATIVE_DOUBLE, first, count);
 }
 
-std::vector<std::int64_t> H5File::read_integers(const std::string& name, hsize_t first, hsize_t count) const {
+std::vector<std::int64_t> H5File::read_integers(const std::string& name, hsize_t first,
+                                                hsize_t count) const {
     return read_rows<std::int64_t>(*this, name, H5T_NATIVE_INT64, first, count);
 }
 
-std::vector<std::uint8_t> H5File::read_bytes(const std::string& name, hsize_t first, hsize_t count) const {
+std::vector<std::uint8_t> H5File::read_bytes(const std::string& name, hsize_t first,
+                                             hsize_t count) const {
     return read_rows<std::uint8_t>(*this, name, H5T_NATIVE_UINT8, first, count);
 }
 
@@ -303,10 +327,12 @@ std::vector<std::string> H5File::members(const std::string& group) const {
     check(H5Gget_info_by_name(file_, group.c_str(), &info, H5P_DEFAULT), "read group " + group);
     std::vector<std::string> out;
     for (hsize_t k = 0; k < info.nlinks; ++k) {
-        const ssize_t n = H5Lget_name_by_idx(file_, group.c_str(), H5_INDEX_NAME, H5_ITER_INC, k, nullptr, 0, H5P_DEFAULT);
+        const ssize_t n = H5Lget_name_by_idx(file_, group.c_str(), H5_INDEX_NAME, H5_ITER_INC, k,
+                                             nullptr, 0, H5P_DEFAULT);
         check(n < 0 ? -1 : 0, "list group " + group);
         std::string name(static_cast<std::size_t>(n) + 1, '\0');
-        H5Lget_name_by_idx(file_, group.c_str(), H5_INDEX_NAME, H5_ITER_INC, k, name.data(), name.size(), H5P_DEFAULT);
+        H5Lget_name_by_idx(file_, group.c_str(), H5_INDEX_NAME, H5_ITER_INC, k, name.data(),
+                           name.size(), H5P_DEFAULT);
         name.resize(static_cast<std::size_t>(n));
         out.push_back(std::move(name));
     }
@@ -326,14 +352,16 @@ std::string H5File::read_text(const std::string& name) const {
     return out;
 }
 
-void H5File::flush() { check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "flush"); }
+void H5File::flush() {
+    check(H5Fflush(file_, H5F_SCOPE_GLOBAL), "flush");
+}
 
 // ---------------------------------------------------------------------------------------------
 
 H5Series::H5Series(H5File& file, const std::string& name, std::vector<hsize_t> row_shape, Type type)
     : file_(&file), name_(name), row_shape_(std::move(row_shape)) {
     for (hsize_t d : row_shape_) row_size_ *= d;
-    type_ = type == Type::real ? H5Tcopy(H5T_NATIVE_DOUBLE)
+    type_ = type == Type::real      ? H5Tcopy(H5T_NATIVE_DOUBLE)
             : type == Type::integer ? H5Tcopy(H5T_NATIVE_INT64)
                                     : string_type();
     std::vector<hsize_t> dims{0}, max{H5S_UNLIMITED}, chunk{64};
@@ -358,7 +386,7 @@ H5Series H5Series::open(H5File& file, const std::string& name, Type type) {
     s.file_ = &file;
     s.name_ = name;
     s.dset_ = file.check_id(H5Dopen2(file.id(), name.c_str(), H5P_DEFAULT), "open series " + name);
-    s.type_ = type == Type::real ? H5Tcopy(H5T_NATIVE_DOUBLE)
+    s.type_ = type == Type::real      ? H5Tcopy(H5T_NATIVE_DOUBLE)
               : type == Type::integer ? H5Tcopy(H5T_NATIVE_INT64)
                                       : string_type();
     const hid_t space = H5Dget_space(s.dset_);
@@ -378,8 +406,13 @@ H5Series::~H5Series() {
 }
 
 H5Series::H5Series(H5Series&& o) noexcept
-    : file_(o.file_), name_(std::move(o.name_)), row_shape_(std::move(o.row_shape_)),
-      row_size_(o.row_size_), dset_(o.dset_), type_(o.type_), rows_(o.rows_) {
+    : file_(o.file_),
+      name_(std::move(o.name_)),
+      row_shape_(std::move(o.row_shape_)),
+      row_size_(o.row_size_),
+      dset_(o.dset_),
+      type_(o.type_),
+      rows_(o.rows_) {
     o.dset_ = -1;
     o.type_ = -1;
 }

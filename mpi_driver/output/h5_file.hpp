@@ -19,7 +19,7 @@ class H5File;
 /// A dataset of shape (rows, row_shape...) that grows by one row per append; doubles, 64-bit
 /// integers or variable-length strings.
 class H5Series {
-public:
+  public:
     enum class Type { real, integer, text };
     H5Series(H5File& file, const std::string& name, std::vector<hsize_t> row_shape, Type type);
     /// Opens the existing series `name` of `file` to append to it (a restarted run).
@@ -37,7 +37,7 @@ public:
     void append_text(const std::string& text);
     hsize_t rows() const { return rows_; }
 
-private:
+  private:
     H5Series() = default;
     void extend_and_write(const void* data, hid_t memtype);
     H5File* file_;
@@ -50,7 +50,7 @@ private:
 };
 
 class H5File {
-public:
+  public:
     /// Creates (truncates) `path`.
     static H5File create(const std::filesystem::path& path);
     /// Opens an existing file (serial driver); RuntimeFailure naming the file if it cannot.
@@ -73,7 +73,8 @@ public:
     /// A scalar variable-length string dataset.
     void write_text(const std::string& name, const std::string& text);
     /// Fixed datasets of 64-bit integers and of bytes (row-major; any shape may have a zero).
-    void write(const std::string& name, std::span<const std::int64_t> data, std::vector<hsize_t> shape);
+    void write(const std::string& name, std::span<const std::int64_t> data,
+               std::vector<hsize_t> shape);
     void write_bytes(const std::string& name, std::span<const std::uint8_t> data);
     /// A 1D dataset of variable-length strings.
     void write_texts(const std::string& name, const std::vector<std::string>& texts);
@@ -92,9 +93,12 @@ public:
     /// Dimensions of a dataset.
     std::vector<hsize_t> shape(const std::string& name) const;
     /// Rows [first, first + count) of a dataset (all of it: first = 0, count = rows), flattened.
-    std::vector<double> read_doubles(const std::string& name, hsize_t first = 0, hsize_t count = ~hsize_t{0}) const;
-    std::vector<std::int64_t> read_integers(const std::string& name, hsize_t first = 0, hsize_t count = ~hsize_t{0}) const;
-    std::vector<std::uint8_t> read_bytes(const std::string& name, hsize_t first = 0, hsize_t count = ~hsize_t{0}) const;
+    std::vector<double> read_doubles(const std::string& name, hsize_t first = 0,
+                                     hsize_t count = ~hsize_t{0}) const;
+    std::vector<std::int64_t> read_integers(const std::string& name, hsize_t first = 0,
+                                            hsize_t count = ~hsize_t{0}) const;
+    std::vector<std::uint8_t> read_bytes(const std::string& name, hsize_t first = 0,
+                                         hsize_t count = ~hsize_t{0}) const;
     /// Names of the members of a group, in name order.
     std::vector<std::string> members(const std::string& group) const;
     std::string read_text(const std::string& name) const;
@@ -105,7 +109,7 @@ public:
     void check(herr_t status, const std::string& what) const;
     hid_t check_id(hid_t id, const std::string& what) const;
 
-private:
+  private:
     H5File(hid_t file, std::string path) : file_(file), path_(std::move(path)) {}
     hid_t file_ = -1;
     std::string path_;

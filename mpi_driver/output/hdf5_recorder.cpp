@@ -1,21 +1,20 @@
 #include "mpi_driver/output/hdf5_recorder.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <numeric>
-#include <chrono>
-#include <ctime>
-#include <fcntl.h>
 #include <system_error>
-#include <unistd.h>
 
 #include "core/error.hpp"
 #include "core/io_error.hpp"
 #include "mpi_driver/output/run_file_schema.hpp"
 
 #include <fmt/format.h>
-
 
 namespace efdem::mpi_driver {
 
@@ -32,7 +31,8 @@ std::filesystem::path make_reserve(const std::filesystem::path& run_file) {
     if (err != 0) {
         std::error_code ignored;
         std::filesystem::remove(p, ignored);
-        throw RuntimeFailure(io_failure_message(p, "the run file's 1 MiB reserve (space to finish it on a full disk)", err));
+        throw RuntimeFailure(io_failure_message(
+            p, "the run file's 1 MiB reserve (space to finish it on a full disk)", err));
     }
     return p;
 }
@@ -45,7 +45,9 @@ std::string now_utc() {
     std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
     return buf;
 }
-std::span<const double> as_span(const Eigen::VectorXd& v) { return {v.data(), static_cast<std::size_t>(v.size())}; }
+std::span<const double> as_span(const Eigen::VectorXd& v) {
+    return {v.data(), static_cast<std::size_t>(v.size())};
+}
 }  // namespace
 
 Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::string& prefix,
@@ -54,8 +56,10 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
       reserve_(make_reserve(path_)),
       file_(resume ? H5File::open(path_, true) : H5File::create(path_)),
       realizations_(p.realizations),
-      m_(p.p_grid.size()), dim_(coarse_dimension),
-      species_(p.species_names.size()), slabs_(static_cast<std::size_t>(p.profile_slabs)) {
+      m_(p.p_grid.size()),
+      dim_(coarse_dimension),
+      species_(p.species_names.size()),
+      slabs_(static_cast<std::size_t>(p.profile_slabs)) {
     if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
         file_.attribute("/", "ranks", std::int64_t{p.ranks});
         file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
@@ -103,7 +107,8 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
         file_.attribute("/bed", "mixing_layer", p.mixing_layer);
         file_.attribute("/bed", "mixing_species", p.observed_species);
         std::vector<double> z(slabs_);
-        for (std::size_t j = 0; j < slabs_; ++j) z[j] = (static_cast<double>(j) + 0.5) * p.profile_dz;
+        for (std::size_t j = 0; j < slabs_; ++j)
+            z[j] = (static_cast<double>(j) + 0.5) * p.profile_dz;
         file_.write("/bed/z", z, {static_cast<hsize_t>(slabs_)});
         document("/bed/z");
         file_.write_texts("/bed/species", p.species_names);
@@ -129,12 +134,15 @@ void Hdf5Recorder::document(const std::string& name) {
     file_.document(name, std::string(d.units), std::string(d.description), labels, scales);
 }
 
-H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type) {
+H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row_shape,
+                               H5Series::Type type) {
     auto it = series_.find(name);
     if (it == series_.end()) {
         const bool existing = file_.exists(name);  // a restarted run appends; documented when made
-        it = series_.emplace(name, existing ? H5Series::open(file_, name, type)
-                                            : H5Series(file_, name, std::move(row_shape), type)).first;
+        it = series_
+                 .emplace(name, existing ? H5Series::open(file_, name, type)
+                                         : H5Series(file_, name, std::move(row_shape), type))
+                 .first;
         if (!existing) document(name);
     }
     return it->second;
@@ -149,23 +157,29 @@ void Hdf5Recorder::bed_sample(const SampleRecord& s) {
         initial_height_ = s.bed.height;
         if (file_.exists("/bed/height") && file_.shape("/bed/height")[0] > 0) {
             const auto first = file_.read_doubles("/bed/height", 0, 1);
-            initial_height_ = Eigen::Map<const Eigen::VectorXd>(first.data(), static_cast<Eigen::Index>(first.size()));
+            initial_height_ = Eigen::Map<const Eigen::VectorXd>(
+                first.data(), static_cast<Eigen::Index>(first.size()));
         }
     }
     auto rows = [&](const std::string& group, const BedRecord& b, hsize_t members) {
-        const std::vector<hsize_t> per = members > 1 || group == "/bed" ? std::vector<hsize_t>{members} : std::vector<hsize_t>{};
+        const std::vector<hsize_t> per =
+            members > 1 || group == "/bed" ? std::vector<hsize_t>{members} : std::vector<hsize_t>{};
         series(group + "/pressure_drop", per, T::real).append(as_span(b.pressure_drop));
         series(group + "/pressure_drop_ratio", per, T::real).append(as_span(b.pressure_drop_ratio));
         series(group + "/height", per, T::real).append(as_span(b.height));
         series(group + "/mixing_index", per, T::real).append(as_span(b.mixing_index));
-        const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> sh = b.species_height, phi = b.solid_fraction;
+        const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>
+            sh = b.species_height,
+            phi = b.solid_fraction;
         auto with = [&](hsize_t last) {
             std::vector<hsize_t> shape = per;
             shape.push_back(last);
             return shape;
         };
-        series(group + "/species_height", with(k), T::real).append(std::span<const double>(sh.data(), static_cast<std::size_t>(sh.size())));
-        series(group + "/solid_fraction", with(n), T::real).append(std::span<const double>(phi.data(), static_cast<std::size_t>(phi.size())));
+        series(group + "/species_height", with(k), T::real)
+            .append(std::span<const double>(sh.data(), static_cast<std::size_t>(sh.size())));
+        series(group + "/solid_fraction", with(n), T::real)
+            .append(std::span<const double>(phi.data(), static_cast<std::size_t>(phi.size())));
     };
     rows("/bed", s.bed, r);
     rows("/bed/mean", s.bed_mean, 1);
@@ -179,7 +193,9 @@ void Hdf5Recorder::bed_sample(const SampleRecord& s) {
             h0 += initial_height_[i];
             used += 1;
         }
-    series("/bed/mean/expansion", {}, T::real).append(used > 0 ? s.bed_mean.height[0] / (h0 / used) : std::numeric_limits<double>::quiet_NaN());
+    series("/bed/mean/expansion", {}, T::real)
+        .append(used > 0 ? s.bed_mean.height[0] / (h0 / used)
+                         : std::numeric_limits<double>::quiet_NaN());
 }
 
 void Hdf5Recorder::sample(const SampleRecord& s) {
@@ -189,11 +205,14 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
     series("/samples/mean", {m}, T::real).append(as_span(s.mean));
     series("/samples/variance", {m}, T::real).append(as_span(s.variance));
     // Row-major R x m for the file.
-    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> icdf = s.realizations;
-    series("/samples/icdf", {r, m}, T::real).append(std::span<const double>(icdf.data(), static_cast<std::size_t>(icdf.size())));
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> icdf =
+        s.realizations;
+    series("/samples/icdf", {r, m}, T::real)
+        .append(std::span<const double>(icdf.data(), static_cast<std::size_t>(icdf.size())));
     series("/samples/com", {r}, T::real).append(as_span(s.com));
     series("/samples/realizations_used", {}, T::integer).append_integer(s.realizations_used);
-    if (s.top_mean.size() == m_) series("/samples/top_mean", {m}, T::real).append(as_span(s.top_mean));
+    if (s.top_mean.size() == m_)
+        series("/samples/top_mean", {m}, T::real).append(as_span(s.top_mean));
     if (s.compact.size() == 4) {
         series("/samples/compact", {4}, T::real).append(as_span(s.compact));
         series("/samples/compact_status", {}, T::integer).append_integer(s.compact_status);
@@ -205,8 +224,12 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
 void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const LiftRecord& lift) {
     using T = H5Series::Type;
     const auto d = static_cast<hsize_t>(dim_), r = static_cast<hsize_t>(realizations_);
-    auto scalar = [&](const char* name, double v) { series(fmt::format("/cpi/{}", name), {}, T::real).append(v); };
-    auto integer = [&](const char* name, std::int64_t v) { series(fmt::format("/cpi/{}", name), {}, T::integer).append_integer(v); };
+    auto scalar = [&](const char* name, double v) {
+        series(fmt::format("/cpi/{}", name), {}, T::real).append(v);
+    };
+    auto integer = [&](const char* name, std::int64_t v) {
+        series(fmt::format("/cpi/{}", name), {}, T::integer).append_integer(v);
+    };
     scalar("t_start", rec.t_start);
     scalar("burst_length", rec.burst_length);
     scalar("healing", rec.healing);
@@ -219,7 +242,10 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
     series("/cpi/status", {}, T::text).append_text(std::string(coarse::to_string(rec.status)));
     series("/cpi/message", {}, T::text).append_text(rec.message);
     auto vec = [&](const char* name, const Eigen::VectorXd& v) {
-        Eigen::VectorXd row = v.size() == dim_ ? v : Eigen::VectorXd::Constant(dim_, std::numeric_limits<double>::quiet_NaN());
+        Eigen::VectorXd row =
+            v.size() == dim_
+                ? v
+                : Eigen::VectorXd::Constant(dim_, std::numeric_limits<double>::quiet_NaN());
         series(fmt::format("/cpi/{}", name), {d}, T::real).append(as_span(row));
     };
     vec("slope", rec.slope);
@@ -240,22 +266,28 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
         integer("controller/accepted", c.accepted ? 1 : 0);
         integer("controller/steps", c.steps);
         const std::pair<const char*, double> reals[] = {
-            {"tolerance", c.tolerance},       {"error_statistical", c.statistical},
-            {"error_truncation", c.truncation}, {"predicted_truncation", c.predicted_truncation},
-            {"dt_tolerance", c.dt_tolerance}, {"dt_tolerance_2r", c.dt_tolerance_2r},
+            {"tolerance", c.tolerance},
+            {"error_statistical", c.statistical},
+            {"error_truncation", c.truncation},
+            {"predicted_truncation", c.predicted_truncation},
+            {"dt_tolerance", c.dt_tolerance},
+            {"dt_tolerance_2r", c.dt_tolerance_2r},
             {"dt_tolerance_4r", c.dt_tolerance_4r}};
-        for (const auto& [name, value] : reals) scalar(fmt::format("controller/{}", name).c_str(), value);
+        for (const auto& [name, value] : reals)
+            scalar(fmt::format("controller/{}", name).c_str(), value);
         series("/cpi/controller/limited_by", {}, T::text).append_text(c.limited_by);
         vec("controller/error_statistical_nodes", c.statistical_nodes);
         vec("controller/error_truncation_nodes", c.truncation_nodes);
     }
     std::vector<std::int64_t> changed(static_cast<std::size_t>(realizations_), 0);
-    std::vector<double> deviation(static_cast<std::size_t>(realizations_), std::numeric_limits<double>::quiet_NaN());
+    std::vector<double> deviation(static_cast<std::size_t>(realizations_),
+                                  std::numeric_limits<double>::quiet_NaN());
     std::string messages;
     for (std::size_t k = 0; k < lift.changed.size() && k < changed.size(); ++k) {
         changed[k] = lift.changed[k];
         deviation[k] = lift.max_deviation[k];
-        if (!lift.messages[k].empty()) messages += fmt::format("realization {}: {}\n", k, lift.messages[k]);
+        if (!lift.messages[k].empty())
+            messages += fmt::format("realization {}: {}\n", k, lift.messages[k]);
     }
     series("/cpi/lift_changed", {r}, T::integer).append(std::span<const std::int64_t>(changed));
     series("/cpi/lift_max_deviation", {r}, T::real).append(std::span<const double>(deviation));
@@ -297,14 +329,16 @@ void Hdf5Recorder::branch_point(const coarse::BranchPoint& p) {
     series("/branch/residual", {}, T::real).append(p.residual);
     series("/branch/noise", {}, T::real).append(p.noise);
     series("/branch/mean_height", {}, T::real).append(coarse::mean_height(p.x));
-    series("/branch/mean_height_error", {}, T::real).append(coarse::mean_height_error_bound(p.noise, p.x.size()));
+    series("/branch/mean_height_error", {}, T::real)
+        .append(coarse::mean_height_error_bound(p.noise, p.x.size()));
     series("/branch/newton_steps", {}, T::integer).append_integer(p.newton_iterations);
     series("/branch/arclength_step", {}, T::real).append(p.step);
     series("/branch/from_last_point", {}, T::integer).append_integer(p.from_fallback ? 1 : 0);
     series("/branch/leading_real", {}, T::real).append(p.has_leading ? p.leading.mu.real() : nan);
     series("/branch/leading_imag", {}, T::real).append(p.has_leading ? p.leading.mu.imag() : nan);
     series("/branch/leading_rate", {}, T::real).append(p.has_leading ? p.leading.rate : nan);
-    series("/branch/leading_residual", {}, T::real).append(p.has_leading ? p.leading.residual : nan);
+    series("/branch/leading_residual", {}, T::real)
+        .append(p.has_leading ? p.leading.residual : nan);
     series("/branch/leading_noise", {}, T::real).append(p.has_leading ? p.leading.noise : nan);
     series("/branch/dem_time", {}, T::real).append(p.micro_time);
     file_.flush();
@@ -337,12 +371,14 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         file_.attribute("/branch", "scale", o.parameter_scale);
         file_.attribute("/branch", "end_reason", o.branch.end_reason);
         std::vector<double> folds;
-        for (const coarse::FoldEstimate& f : o.branch.folds()) folds.push_back(f.parameter * o.parameter_scale);
+        for (const coarse::FoldEstimate& f : o.branch.folds())
+            folds.push_back(f.parameter * o.parameter_scale);
         if (!folds.empty()) {
             file_.write("/branch/fold_parameter", folds, {static_cast<hsize_t>(folds.size())});
             document("/branch/fold_parameter");
         }
-        if (o.branch.points.empty() && o.solve.best.size() == dim_) {  // the first point did not converge
+        if (o.branch.points.empty() &&
+            o.solve.best.size() == dim_) {  // the first point did not converge
             file_.attribute("/steady", "best_residual", o.solve.best_state_residual());
             vector("/steady/best", o.solve.best);
         }
@@ -353,10 +389,12 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
     file_.attribute("/steady", "reason", coarse::to_string(r.reason));
     file_.attribute("/steady", "message", r.message);
     file_.attribute("/steady", "iterations", std::int64_t{r.iterations});
-    file_.attribute("/steady", "best_residual", r.best_state_residual());  // in heights, as /steady/iterate/residual
+    file_.attribute("/steady", "best_residual",
+                    r.best_state_residual());  // in heights, as /steady/iterate/residual
     vector("/steady/x", r.x);
     vector("/steady/best", r.best);
-    if (r.best.size() == dim_) file_.attribute("/steady", "mean_height", coarse::mean_height(r.best));
+    if (r.best.size() == dim_)
+        file_.attribute("/steady", "mean_height", coarse::mean_height(r.best));
     auto reals = [&](const char* name, const std::vector<double>& v) {
         file_.write(name, v, {static_cast<hsize_t>(v.size())});
         document(name);
@@ -367,7 +405,8 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
     };
     if (!r.step_lengths.empty()) reals("/steady/step_length", r.step_lengths);
     if (!r.krylov_iterations.empty()) {
-        integers("/steady/krylov_products", std::vector<std::int64_t>(r.krylov_iterations.begin(), r.krylov_iterations.end()));
+        integers("/steady/krylov_products",
+                 std::vector<std::int64_t>(r.krylov_iterations.begin(), r.krylov_iterations.end()));
         std::vector<double> res;
         std::vector<std::int64_t> step;
         for (std::size_t k = 0; k < r.gmres_residuals.size(); ++k)

@@ -24,11 +24,12 @@ namespace efdem::mpi_driver {
 inline constexpr std::int64_t kRunFileFormatVersion = 2;
 
 class Hdf5Recorder final : public RunRecorder {
-public:
+  public:
     /// Writes `<directory>/<prefix>.h5`. `resume`: continue the existing file (put back by a
     /// restart) instead of creating one.
     Hdf5Recorder(const std::filesystem::path& directory, const std::string& prefix,
-                 const RunProvenance& provenance, Eigen::Index coarse_dimension, bool resume = false);
+                 const RunProvenance& provenance, Eigen::Index coarse_dimension,
+                 bool resume = false);
     void sample(const SampleRecord& s) override;
     void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) override;
     void finish(const RunSummary& summary) override;
@@ -38,7 +39,7 @@ public:
     void steady_outcome(const coarse::SteadyRunOutcome& outcome) override;
     std::vector<std::filesystem::path> files() const override { return {path_}; }
 
-private:
+  private:
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
     /// Writes `name`'s units, description and dimension scales (run_file_schema.hpp).
     void document(const std::string& name);

@@ -9,7 +9,7 @@
 namespace efdem::mpi_driver {
 
 class Progress {
-public:
+  public:
     /// `t_start`, `t_end`: the simulated span of the run; `min_seconds`: least wall time
     /// between two lines (0 prints every call).
     Progress(double t_start, double t_end, double min_seconds);
@@ -22,7 +22,7 @@ public:
     void set_expected_particle_steps(double total) { expected_particle_steps_ = total; }
     double elapsed_seconds() const;
 
-private:
+  private:
     using Clock = std::chrono::steady_clock;
     double t_start_, t_end_, min_seconds_;
     double expected_particle_steps_ = 0.0;

@@ -10,7 +10,7 @@
 namespace efdem::mpi_driver {
 
 class RecorderList final : public RunRecorder {
-public:
+  public:
     explicit RecorderList(std::vector<std::unique_ptr<RunRecorder>> recorders)
         : recorders_(std::move(recorders)) {}
     void sample(const SampleRecord& s) override {
@@ -41,7 +41,7 @@ public:
         return out;
     }
 
-private:
+  private:
     std::vector<std::unique_ptr<RunRecorder>> recorders_;
 };
 

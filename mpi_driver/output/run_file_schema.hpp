@@ -14,8 +14,9 @@
 namespace efdem::mpi_driver {
 
 struct DatasetDoc {
-    std::string_view path;         ///< e.g. "/samples/icdf"
-    std::string_view units;        ///< "d_p", "sqrt(d_p/g)", "rho_s g d_p", "1" (dimensionless or a count), "text"
+    std::string_view path;  ///< e.g. "/samples/icdf"
+    std::string_view
+        units;  ///< "d_p", "sqrt(d_p/g)", "rho_s g d_p", "1" (dimensionless or a count), "text"
     std::string_view description;
     /// One name per dimension, slowest first: "sample", "realization", "node", "step",
     /// "coarse_node", "species", "slab", "failure"; empty for a scalar dataset.

@@ -39,48 +39,49 @@ struct SampleRecord {
     /// the ensemble; empty otherwise.
     BedRecord bed;
     BedRecord bed_mean;
-    Eigen::VectorXd top_mean;      ///< ensemble-mean ICDF of the N/2 highest particles, when gathered
-    Eigen::VectorXd compact;       ///< (A, B, C, D) of the mean y(p), when used (else empty)
-    int compact_status = 0;        ///< 0 ok; otherwise the fit's status code
+    Eigen::VectorXd top_mean;  ///< ensemble-mean ICDF of the N/2 highest particles, when gathered
+    Eigen::VectorXd compact;   ///< (A, B, C, D) of the mean y(p), when used (else empty)
+    int compact_status = 0;    ///< 0 ok; otherwise the fit's status code
     /// Realizations in the means (R less those dropped after a failure; their rows are NaN).
     int realizations_used = 0;
 };
 
 /// A realization that failed and what the ensemble did about it (ensemble.on_failure).
 struct FailureRecord {
-    double time = 0;          ///< when it failed
+    double time = 0;  ///< when it failed
     long realization = -1;
-    std::string reason;       ///< the failure's message
-    std::string action;       ///< "dropped", "replaced", or "fatal" (the run ends)
-    long donor = -1;          ///< replaced: the realization whose state it was rebuilt from
-    double resumed_at = 0;    ///< cpi: where the interrupted coarse step was redone from
+    std::string reason;         ///< the failure's message
+    std::string action;         ///< "dropped", "replaced", or "fatal" (the run ends)
+    long donor = -1;            ///< replaced: the realization whose state it was rebuilt from
+    double resumed_at = 0;      ///< cpi: where the interrupted coarse step was redone from
     int realizations_left = 0;  ///< realizations in the ensemble after it
 };
 
 /// What lifting did to each realization at one coarse step.
 struct LiftRecord {
-    std::vector<long> changed;        ///< labels changed, per realization
+    std::vector<long> changed;          ///< labels changed, per realization
     std::vector<double> max_deviation;  ///< max |Q_L,lifted - target| per realization [d_p]
     std::vector<std::string> messages;  ///< non-empty where a target was repaired or clipped
 };
 
 /// Totals at the end of a run.
 struct RunSummary {
-    double simulated_time = 0;   ///< time covered by the ensemble
-    double dem_time = 0;         ///< time actually simulated by the DEM (per realization)
-    double wall_seconds = 0;     ///< wall time of the run loop (direct or cpi), not of the set-up
+    double simulated_time = 0;  ///< time covered by the ensemble
+    double dem_time = 0;        ///< time actually simulated by the DEM (per realization)
+    double wall_seconds = 0;    ///< wall time of the run loop (direct or cpi), not of the set-up
     /// Root wall time from building the realizations to every rank having built its own: the
     /// settling of the beds, nearly all of it (also on a restart, which builds them again).
     double settling_wall_seconds = 0;
     double total_wall_seconds = 0;  ///< root wall time from start-up to the end of the run
-    double particle_steps = 0;   ///< summed over all realizations
+    double particle_steps = 0;      ///< summed over all realizations
     long coarse_steps = 0;
-    std::string end_status;      ///< "completed", "interrupted: ...", "failed: ...", or why it stopped
-    int stop_signal = 0;         ///< the signal that stopped the run (0: none)
-    std::string checkpoint;      ///< a stopped run: the checkpoint written where it stopped (or empty)
+    std::string end_status;  ///< "completed", "interrupted: ...", "failed: ...", or why it stopped
+    int stop_signal = 0;     ///< the signal that stopped the run (0: none)
+    std::string checkpoint;  ///< a stopped run: the checkpoint written where it stopped (or empty)
     double checkpoint_time = 0;  ///< its time
-    double restrict_seconds = 0; ///< root wall time in restriction (observe, gather, average, record)
-    double lift_seconds = 0;     ///< root wall time in lifting (gather, compute, scatter, apply)
+    double restrict_seconds =
+        0;                    ///< root wall time in restriction (observe, gather, average, record)
+    double lift_seconds = 0;  ///< root wall time in lifting (gather, compute, scatter, apply)
     /// Adaptive CPI: what the controller did and what more realizations would buy (text lines;
     /// empty otherwise).
     std::string controller;
@@ -91,17 +92,17 @@ struct RunSummary {
 
 /// mode = steady | continuation: one iterate of a solve, as it comes.
 struct SteadyIterateRecord {
-    long solve = 0;       ///< 0: the steady solve or the first branch point; k: the k-th corrector
-    long iteration = 0;   ///< Newton step / fixed-point iteration within the solve (0: the start)
-    double residual = 0;  ///< |F| (continuation correctors: |G| of the extended system)
-    double noise = 0;     ///< the noise norm measured with it
-    Eigen::VectorXd x;    ///< the iterate's coarse vector
-    double parameter = 0; ///< continuation: the parameter (scene units); 0 otherwise
-    double dem_time = 0;  ///< micro time spent since the warm-up ended (per realization)
+    long solve = 0;        ///< 0: the steady solve or the first branch point; k: the k-th corrector
+    long iteration = 0;    ///< Newton step / fixed-point iteration within the solve (0: the start)
+    double residual = 0;   ///< |F| (continuation correctors: |G| of the extended system)
+    double noise = 0;      ///< the noise norm measured with it
+    Eigen::VectorXd x;     ///< the iterate's coarse vector
+    double parameter = 0;  ///< continuation: the parameter (scene units); 0 otherwise
+    double dem_time = 0;   ///< micro time spent since the warm-up ended (per realization)
 };
 
 class RunRecorder {
-public:
+  public:
     virtual ~RunRecorder() = default;
     virtual void sample(const SampleRecord& s) = 0;
     virtual void coarse_step(const coarse::ProjectiveStepRecord& step, const LiftRecord& lift) = 0;
@@ -122,8 +123,8 @@ public:
 struct RunProvenance {
     std::string scene_file;
     std::string scene_text;
-    std::string overrides;     ///< the command-line overrides, space-separated
-    std::string parameters;    ///< every parameter as "key = value   [origin]" lines
+    std::string overrides;   ///< the command-line overrides, space-separated
+    std::string parameters;  ///< every parameter as "key = value   [origin]" lines
     std::string mode;
     int ranks = 1;
     int realizations = 1;

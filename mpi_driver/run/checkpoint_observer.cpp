@@ -10,7 +10,8 @@ void CheckpointObserver::between_steps(const coarse::ProjectiveRun& run) {
     const long steps = run.state().coarse_steps;
     if (steps == last_ || steps % interval_ != 0) return;
     const auto path = stepper_.checkpoint(steps, run.state());
-    log::info("checkpoint {} (t = {:.6g}, after coarse step {})", path.string(), stepper_.time(), steps);
+    log::info("checkpoint {} (t = {:.6g}, after coarse step {})", path.string(), stepper_.time(),
+              steps);
     last_ = steps;
 }
 

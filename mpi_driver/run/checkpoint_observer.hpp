@@ -10,14 +10,14 @@
 namespace efdem::mpi_driver {
 
 class CheckpointObserver final : public coarse::ProjectiveRunObserver {
-public:
+  public:
     /// `interval` > 0 coarse steps; `last`: the coarse step the newest checkpoint was written
     /// after (that of the checkpoint a restarted run resumed from, so it is not written again).
     CheckpointObserver(EnsembleStepper& stepper, long interval, long last)
         : stepper_(stepper), interval_(interval), last_(last) {}
     void between_steps(const coarse::ProjectiveRun& run) override;
 
-private:
+  private:
     EnsembleStepper& stepper_;
     long interval_;
     long last_;

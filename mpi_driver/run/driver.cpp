@@ -4,10 +4,10 @@
 #include <cmath>
 #include <string>
 
+#include <fmt/format.h>
 #include "coarse/equation_free/projective_run.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include <fmt/format.h>
 
 #include "mpi_driver/ensemble/stop_signal.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
@@ -20,7 +20,8 @@ namespace efdem::mpi_driver {
 namespace {
 /// The coarse variable `observable`, as the run loop sees it: selecting it switches the
 /// stepper's restriction; ICDF targets are repaired into the heights the particles occupy.
-coarse::CoarseVariable coarse_variable(coarse::EnsembleObservable& observable, EnsembleStepper& stepper) {
+coarse::CoarseVariable coarse_variable(coarse::EnsembleObservable& observable,
+                                       EnsembleStepper& stepper) {
     coarse::CoarseVariable v;
     v.name = std::string(observable.name());
     v.description = std::string(observable.label());
@@ -33,18 +34,19 @@ coarse::CoarseVariable coarse_variable(coarse::EnsembleObservable& observable, E
     return v;
 }
 
-
 /// The end of a run stopped by a signal: the checkpoint written where it can be continued.
-void stopped(RunSummary& sum, const EnsembleStepper& stepper, const std::filesystem::path& checkpoint,
-             double checkpoint_time) {
+void stopped(RunSummary& sum, const EnsembleStepper& stepper,
+             const std::filesystem::path& checkpoint, double checkpoint_time) {
     sum.stop_signal = stepper.interrupted();
     sum.checkpoint = checkpoint.string();
     sum.checkpoint_time = checkpoint_time;
-    sum.end_status = checkpoint.empty()
-                         ? fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (this efdem has no HDF5)",
-                                       signal_name(sum.stop_signal), stepper.time())
-                         : fmt::format("interrupted: {} at t = {:.6g}; checkpoint {} (t = {:.6g})",
-                                       signal_name(sum.stop_signal), stepper.time(), sum.checkpoint, checkpoint_time);
+    sum.end_status =
+        checkpoint.empty()
+            ? fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (this efdem has no HDF5)",
+                          signal_name(sum.stop_signal), stepper.time())
+            : fmt::format("interrupted: {} at t = {:.6g}; checkpoint {} (t = {:.6g})",
+                          signal_name(sum.stop_signal), stepper.time(), sum.checkpoint,
+                          checkpoint_time);
 }
 }  // namespace
 
@@ -55,7 +57,8 @@ void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress
     sum.restrict_seconds = stepper.overhead().restrict_seconds;
 }
 
-RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress, const RunControl& control) {
+RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& progress,
+                      const RunControl& control) {
     DriverState state;
     state.t_origin = stepper.time();
     if (control.resume) state = *control.resume;
@@ -97,24 +100,32 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
     progress.update(stepper.time(), stepper.particle_steps(), "done", true);
     sum.simulated_time = s.duration;
     fill_totals(sum, stepper, progress);
-    sum.end_status = std::abs(stepper.time() - t_end) < 1e-6 * std::max(1.0, t_end) ? "completed" : "incomplete";
-    if (stepper.failures() > 0) sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
+    sum.end_status =
+        std::abs(stepper.time() - t_end) < 1e-6 * std::max(1.0, t_end) ? "completed" : "incomplete";
+    if (stepper.failures() > 0)
+        sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
     return sum;
 }
 
-RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::EnsembleObservable* fallback,
-                   RunRecorder* recorder, Progress& progress, const RunControl& control) {
-    if (s.cpi.projection == coarse::CoarseRunSettings::Projection::periods && stepper.realizations() > 1)
-        log::warn("cpi.projection = periods measures the wave period from the ensemble-mean centre of "
-                  "mass; the {} realizations' waves start in phase (they fluidize together) but lose phase "
-                  "over some 60-80 time units on the demo bed, and then the period of the mean cannot be "
-                  "measured (docs/accuracy_vs_cost.md). DT = k T is the single-realization method of the "
-                  "paper (Fig. 2b); for an ensemble use cpi.projection = adaptive with cpi.window of two "
-                  "periods", stepper.realizations());
+RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
+                   coarse::EnsembleObservable* fallback, RunRecorder* recorder, Progress& progress,
+                   const RunControl& control) {
+    if (s.cpi.projection == coarse::CoarseRunSettings::Projection::periods &&
+        stepper.realizations() > 1)
+        log::warn(
+            "cpi.projection = periods measures the wave period from the ensemble-mean centre of "
+            "mass; the {} realizations' waves start in phase (they fluidize together) but lose "
+            "phase "
+            "over some 60-80 time units on the demo bed, and then the period of the mean cannot be "
+            "measured (docs/accuracy_vs_cost.md). DT = k T is the single-realization method of the "
+            "paper (Fig. 2b); for an ensemble use cpi.projection = adaptive with cpi.window of two "
+            "periods",
+            stepper.realizations());
     coarse::EnsembleObservable& primary = stepper.observable();
     std::optional<coarse::CoarseVariable> fallback_variable;
     if (fallback) fallback_variable = coarse_variable(*fallback, stepper);
-    coarse::ProjectiveRun run(s.cpi, stepper, coarse_variable(primary, stepper), std::move(fallback_variable));
+    coarse::ProjectiveRun run(s.cpi, stepper, coarse_variable(primary, stepper),
+                              std::move(fallback_variable));
 
     StopObserver stop(stepper);
     run.add_observer(stop);  // first: the resume point is kept before a checkpoint is written
@@ -122,7 +133,8 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s, coarse::Ensem
     ProgressObserver progress_line(stepper, progress);
     std::optional<CheckpointObserver> checkpoints;
     if (control.checkpoint_interval > 0)
-        checkpoints.emplace(stepper, control.checkpoint_interval, control.resume ? control.resume->coarse_steps : 0);
+        checkpoints.emplace(stepper, control.checkpoint_interval,
+                            control.resume ? control.resume->coarse_steps : 0);
     if (checkpoints) run.add_observer(*checkpoints);
     run.add_observer(report);
     run.add_observer(progress_line);

@@ -32,7 +32,8 @@ struct RunControl {
     std::optional<DriverState> resume;
 };
 
-/// The totals every run mode reports: DEM time, run-loop wall time, particle-steps, restriction time.
+/// The totals every run mode reports: DEM time, run-loop wall time, particle-steps, restriction
+/// time.
 void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress& progress);
 
 RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& settings, Progress& progress,

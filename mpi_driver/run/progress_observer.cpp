@@ -6,7 +6,8 @@
 
 namespace efdem::mpi_driver {
 
-void ProgressObserver::step_done(const coarse::ProjectiveRun& run, const coarse::ProjectiveStepRecord& rec) {
+void ProgressObserver::step_done(const coarse::ProjectiveRun& run,
+                                 const coarse::ProjectiveStepRecord& rec) {
     if (stepper_.micro_time() > 0.0) {
         const double steps_per_time = stepper_.particle_steps() / stepper_.micro_time();
         const double dt_next = rec.dt > 0.0 ? rec.dt : rec.dt_requested;
@@ -16,8 +17,8 @@ void ProgressObserver::step_done(const coarse::ProjectiveRun& run, const coarse:
     // Adaptive CPI: what the controller just did, on the progress line.
     std::string note;
     if (const coarse::ControllerRecord& c = rec.controller; c.adaptive && rec.lifted)
-        note = fmt::format("DT {:.3g} {}: error {:.2f} of tolerance", rec.dt, c.accepted ? "kept" : "rejected",
-                           c.error() / c.tolerance);
+        note = fmt::format("DT {:.3g} {}: error {:.2f} of tolerance", rec.dt,
+                           c.accepted ? "kept" : "rejected", c.error() / c.tolerance);
     else if (c.adaptive && rec.status == coarse::StepStatus::burst_only && !c.limited_by.empty())
         note = "no jump: " + c.limited_by;
     progress_.update(stepper_.time(), stepper_.particle_steps(), note, true);

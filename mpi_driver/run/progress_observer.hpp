@@ -11,11 +11,13 @@
 namespace efdem::mpi_driver {
 
 class ProgressObserver final : public coarse::ProjectiveRunObserver {
-public:
-    ProgressObserver(const EnsembleStepper& stepper, Progress& progress) : stepper_(stepper), progress_(progress) {}
-    void step_done(const coarse::ProjectiveRun& run, const coarse::ProjectiveStepRecord& record) override;
+  public:
+    ProgressObserver(const EnsembleStepper& stepper, Progress& progress)
+        : stepper_(stepper), progress_(progress) {}
+    void step_done(const coarse::ProjectiveRun& run,
+                   const coarse::ProjectiveStepRecord& record) override;
 
-private:
+  private:
     const EnsembleStepper& stepper_;
     Progress& progress_;
 };

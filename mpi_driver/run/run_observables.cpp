@@ -9,7 +9,8 @@
 namespace efdem::mpi_driver {
 
 namespace {
-std::unique_ptr<coarse::EnsembleObservable> make(std::string_view name, const coarse::ProbabilityGrid& grid) {
+std::unique_ptr<coarse::EnsembleObservable> make(std::string_view name,
+                                                 const coarse::ProbabilityGrid& grid) {
     const auto* entry = coarse::observable_table().find(name);
     EFDEM_EXPECTS(entry != nullptr);  // names come from the table (RunSettings checked them)
     return entry->make(grid);

@@ -12,11 +12,16 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
     const SourceLocation where{"<command line>", 0};
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
-        if (arg == "--help" || arg == "-h") o.action = Action::help;
-        else if (arg == "--version") o.action = Action::version;
-        else if (arg == "--list-effects") o.action = Action::list_effects;
-        else if (arg == "--check") o.action = Action::check;
-        else if (arg == "--list-keys") o.action = Action::list_keys;
+        if (arg == "--help" || arg == "-h")
+            o.action = Action::help;
+        else if (arg == "--version")
+            o.action = Action::version;
+        else if (arg == "--list-effects")
+            o.action = Action::list_effects;
+        else if (arg == "--check")
+            o.action = Action::check;
+        else if (arg == "--list-keys")
+            o.action = Action::list_keys;
         else if (arg.rfind("--ranks=", 0) == 0) {
             const std::string v = arg.substr(8);
             std::size_t used = 0;
@@ -27,25 +32,33 @@ RunOptions RunOptions::parse(int argc, const char* const* argv) {
                 used = 0;
             }
             if (v.empty() || used != v.size() || n < 1 || n > 10000000)
-                throw InputError(where, "--ranks='" + v + "': expected a whole number of ranks >= 1 (the ranks the "
-                                            "checked run will have), e.g. --ranks=8");
+                throw InputError(where,
+                                 "--ranks='" + v +
+                                     "': expected a whole number of ranks >= 1 (the ranks the "
+                                     "checked run will have), e.g. --ranks=8");
             o.ranks = static_cast<int>(n);
-        }
-        else if (arg.rfind("--", 0) == 0)
+        } else if (arg.rfind("--", 0) == 0)
             throw InputError(where, "unknown option '" + arg + "'; see efdem --help");
         else if (arg.rfind("restart=", 0) == 0) {
             o.restart = arg.substr(8);
-            if (o.restart.empty()) throw InputError(where, "restart= needs a checkpoint file: restart=FILE");
-        } else if (arg.find('=') != std::string::npos) o.overrides.push_back(arg);
-        else if (o.scene.empty()) o.scene = arg;
+            if (o.restart.empty())
+                throw InputError(where, "restart= needs a checkpoint file: restart=FILE");
+        } else if (arg.find('=') != std::string::npos)
+            o.overrides.push_back(arg);
+        else if (o.scene.empty())
+            o.scene = arg;
         else
-            throw InputError(where, "a second scene file '" + arg + "' was given after '" + o.scene +
-                                        "'; give one scene and key=value overrides");
+            throw InputError(where, "a second scene file '" + arg + "' was given after '" +
+                                        o.scene + "'; give one scene and key=value overrides");
     }
-    if ((o.action == Action::run || o.action == Action::check || o.action == Action::list_keys) && o.scene.empty())
-        throw InputError(where, "no scene file given; usage: efdem [--check] SCENE [key=value ...]");
+    if ((o.action == Action::run || o.action == Action::check || o.action == Action::list_keys) &&
+        o.scene.empty())
+        throw InputError(where,
+                         "no scene file given; usage: efdem [--check] SCENE [key=value ...]");
     if (o.ranks > 0 && o.action != Action::check && o.action != Action::list_keys)
-        throw InputError(where, "--ranks=N only goes with --check or --list-keys (a run has the ranks mpirun gives it)");
+        throw InputError(where,
+                         "--ranks=N only goes with --check or --list-keys (a run has the ranks "
+                         "mpirun gives it)");
     return o;
 }
 

@@ -22,27 +22,36 @@ bool restricts_members(const std::string& name, int quantiles) {
 
 RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& scene) {
     RunSettings s;
-    const std::string mode = root.get_or_choice("mode", "direct", {"direct", "cpi", "steady", "continuation"});
-    s.mode = mode == "cpi" ? Mode::cpi : mode == "steady" ? Mode::steady : mode == "continuation" ? Mode::continuation : Mode::direct;
+    const std::string mode =
+        root.get_or_choice("mode", "direct", {"direct", "cpi", "steady", "continuation"});
+    s.mode = mode == "cpi"            ? Mode::cpi
+             : mode == "steady"       ? Mode::steady
+             : mode == "continuation" ? Mode::continuation
+                                      : Mode::direct;
     s.seed = root.get_or<std::uint64_t>("seed", 1);
     s.realizations_per_rank =
         root.scope("ensemble").get_or<int>("realizations_per_rank", 1, Bounds::closed(1, 4096));
 
     const Params observe = root.scope("observe");
     s.observe.interval = observe.get_or<double>("interval", 0.5, Bounds::open_closed(0.0, 1e6));
-    s.observe.steps_per_sample = whole_multiple(observe, "interval", s.observe.interval, scene.dt, "dt");
+    s.observe.steps_per_sample =
+        whole_multiple(observe, "interval", s.observe.interval, scene.dt, "dt");
     s.observe.quantiles = observe.get_or<int>("quantiles", 19, Bounds::closed(1, 999));
     s.observe.compact = observe.get_or<bool>("compact", false);
     std::vector<std::string> names;
-    for (std::size_t k = 0; k < scene.species.size(); ++k) names.push_back(scene.species[static_cast<dem::SpeciesId>(k)].name);
+    for (std::size_t k = 0; k < scene.species.size(); ++k)
+        names.push_back(scene.species[static_cast<dem::SpeciesId>(k)].name);
     const std::string observed = observe.get_or_choice("species", names.front(), names);
     s.observe.species = static_cast<dem::SpeciesId>(scene.species.find(observed));
     s.observe.other = s.observe.species == 0 ? 1 : 0;
     s.observe.bed = observe.get_or<bool>("bed", false);
     if (s.observe.bed) {  // read only when on, so that a scene without it has nothing to explain
-        s.observe.profile_dz = observe.get_or<double>("profile_dz", 1.0, Bounds::open_closed(0.0, 1e3));
-        s.observe.profile_height = observe.get_or<double>("profile_height", 0.0, Bounds::closed(0.0, 1e6));
-        s.observe.mixing_layer = observe.get_or<double>("mixing_layer", 2.0, Bounds::open_closed(0.0, 1e3));
+        s.observe.profile_dz =
+            observe.get_or<double>("profile_dz", 1.0, Bounds::open_closed(0.0, 1e3));
+        s.observe.profile_height =
+            observe.get_or<double>("profile_height", 0.0, Bounds::closed(0.0, 1e6));
+        s.observe.mixing_layer =
+            observe.get_or<double>("mixing_layer", 2.0, Bounds::open_closed(0.0, 1e3));
     }
 
     const Params run = root.scope("run");
@@ -63,27 +72,39 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval, s.is_cpi());
     s.lift_members = cpi.get_or_choice("lift", "mean", {"mean", "members"}) == "members";
     if (s.lift_members && s.is_cpi() && !restricts_members(s.observable, s.observe.quantiles))
-        cpi.fail("lift", "= members moves each realization from its own coarse state, and cpi.observable = " +
-                             s.observable + " cannot restrict a realization on its own",
-                 "mean, or members with cpi.observable = icdf");
+        cpi.fail(
+            "lift",
+            "= members moves each realization from its own coarse state, and cpi.observable = " +
+                s.observable + " cannot restrict a realization on its own",
+            "mean, or members with cpi.observable = icdf");
     if (s.is_steady()) {
         const auto* row = coarse::observable_table().find(s.observable);
-        const long dimension = row ? static_cast<long>(row->make(coarse::ProbabilityGrid(s.observe.quantiles))->dimension())
-                                   : s.observe.quantiles;
+        const long dimension =
+            row ? static_cast<long>(
+                      row->make(coarse::ProbabilityGrid(s.observe.quantiles))->dimension())
+                : s.observe.quantiles;
         s.steady = coarse::SteadyRunSettings::from_params(
-            root, s.observe.interval, dimension, s.mode == Mode::continuation, continuation_parameters(),
-            [&](const std::string& key) {
+            root, s.observe.interval, dimension, s.mode == Mode::continuation,
+            continuation_parameters(), [&](const std::string& key) {
                 const auto dot = key.find('.');
                 const std::string effect = key.substr(0, dot);
-                if (std::find(scene.effect_names.begin(), scene.effect_names.end(), effect) == scene.effect_names.end())
-                    root.scope("continuation").fail("parameter", fmt::format("names a key of {}, which the scene's effects do not list", effect),
-                                                    fmt::format("a key of a listed effect (add {} to effects)", effect));
+                if (std::find(scene.effect_names.begin(), scene.effect_names.end(), effect) ==
+                    scene.effect_names.end())
+                    root.scope("continuation")
+                        .fail(
+                            "parameter",
+                            fmt::format("names a key of {}, which the scene's effects do not list",
+                                        effect),
+                            fmt::format("a key of a listed effect (add {} to effects)", effect));
                 // Read with the bounds its effect reads it with (dem/gas/gas_drag.cpp).
-                return root.scope(effect).get<double>(key.substr(dot + 1), Bounds::closed(0.0, 1e3));
+                return root.scope(effect).get<double>(key.substr(dot + 1),
+                                                      Bounds::closed(0.0, 1e3));
             });
         if (s.steady.gap_coordinates && s.observable != "icdf")
-            root.scope("steady").fail("coordinates", "= gaps are coordinates of an ICDF, and cpi.observable is " + s.observable,
-                                      "heights, or gaps with cpi.observable = icdf");
+            root.scope("steady").fail(
+                "coordinates",
+                "= gaps are coordinates of an ICDF, and cpi.observable is " + s.observable,
+                "heights, or gaps with cpi.observable = icdf");
     }
     if (s.lifts()) {
         // After cpi.warmup and one burst something must be left to jump over: a run of exactly
@@ -92,18 +113,24 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         const double least = s.cpi.warmup + s.cpi.burst();
         if (s.is_cpi() && s.duration <= least + 1e-9 * least)
             run.fail("duration",
-                     fmt::format("leaves nothing to jump after cpi.warmup + one burst (cpi.healing + cpi.window) = "
-                                 "{:g}: the cpi run could not make a single projective jump", least),
-                     fmt::format("run.duration > {:g} (several bursts and jumps to gain anything), or mode = direct",
+                     fmt::format("leaves nothing to jump after cpi.warmup + one burst (cpi.healing "
+                                 "+ cpi.window) = "
+                                 "{:g}: the cpi run could not make a single projective jump",
+                                 least),
+                     fmt::format("run.duration > {:g} (several bursts and jumps to gain anything), "
+                                 "or mode = direct",
                                  least));
         if (scene.species.size() != 2)
-            root.fail("mode", fmt::format("{} lifts by swapping the labels of two species, but "
-                                          "species.names lists {}", s.mode_name(), scene.species.size()),
+            root.fail("mode",
+                      fmt::format("{} lifts by swapping the labels of two species, but "
+                                  "species.names lists {}",
+                                  s.mode_name(), scene.species.size()),
                       "direct, or exactly two species");
         for (std::size_t k = 1; k < scene.species.size(); ++k)
             if (scene.species[static_cast<dem::SpeciesId>(k)].diameter != scene.species[0].diameter)
-                root.scope("species").fail("diameter", "differs between species: swapping labels would "
-                                                       "create overlaps (physics.md §9)",
+                root.scope("species").fail("diameter",
+                                           "differs between species: swapping labels would "
+                                           "create overlaps (physics.md §9)",
                                            "equal diameters in cpi mode");
     }
 
@@ -114,46 +141,59 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         output.fail("prefix", "contains '/'", "a file stem; set output.directory for the folder");
     // File names are at most 255 bytes, and the longest name made from the prefix adds 21
     // (PREFIX_r0000_000000.vtp.tmp, PREFIX_ckpt_00000000.h5.tmp).
-    if (s.output.prefix.empty() || s.output.prefix.size() > 200 || s.output.prefix == "." || s.output.prefix == "..")
+    if (s.output.prefix.empty() || s.output.prefix.size() > 200 || s.output.prefix == "." ||
+        s.output.prefix == "..")
         output.fail("prefix", fmt::format("is {} characters long", s.output.prefix.size()),
                     "a file stem of 1 to 200 characters, not . or ..");
     if (s.output.directory.string().size() > 3000)
-        output.fail("directory", fmt::format("is {} characters long", s.output.directory.string().size()),
+        output.fail("directory",
+                    fmt::format("is {} characters long", s.output.directory.string().size()),
                     "a path of at most 3000 characters");
     s.output.vtk_interval = output.get_or<double>("vtk_interval", 0.0, Bounds::closed(0.0, 1e9));
     if (s.output.vtk_interval > 0)
-        whole_multiple(output, "vtk_interval", s.output.vtk_interval, s.observe.interval, "observe.interval");
-    s.output.thermo_interval = output.get_or<double>("thermo_interval", 0.0, Bounds::closed(0.0, 1e9));
+        whole_multiple(output, "vtk_interval", s.output.vtk_interval, s.observe.interval,
+                       "observe.interval");
+    s.output.thermo_interval =
+        output.get_or<double>("thermo_interval", 0.0, Bounds::closed(0.0, 1e9));
     if (s.output.thermo_interval > 0)
-        whole_multiple(output, "thermo_interval", s.output.thermo_interval, s.observe.interval, "observe.interval");
+        whole_multiple(output, "thermo_interval", s.output.thermo_interval, s.observe.interval,
+                       "observe.interval");
 
     s.output.overwrite = output.get_or<bool>("overwrite", false);
     s.checkpoint = CheckpointSettings::from_params(root, s.output.directory);
     if (s.is_steady() && s.checkpoint.enabled())
-        root.scope("checkpoint").fail("interval",
-                                      fmt::format("is not supported with mode = {}: a solve keeps micro states in "
-                                                  "memory that a checkpoint does not hold",
-                                                  s.mode_name()),
-                                      "0 (the default) with mode = steady or continuation");
+        root.scope("checkpoint")
+            .fail("interval",
+                  fmt::format("is not supported with mode = {}: a solve keeps micro states in "
+                              "memory that a checkpoint does not hold",
+                              s.mode_name()),
+                  "0 (the default) with mode = steady or continuation");
     const Params debug = root.scope("debug");
-    s.injected_failure.realization = debug.get_or<long>("fail_realization", -1, Bounds::closed(-1, 1e9));
+    s.injected_failure.realization =
+        debug.get_or<long>("fail_realization", -1, Bounds::closed(-1, 1e9));
     s.injected_failure.time = debug.get_or<double>("fail_time", 0.0, Bounds::closed(0.0, 1e9));
 
     const Params ensemble = root.scope("ensemble");
-    const std::string action = ensemble.get_or_choice("on_failure", "abort", {"abort", "drop", "replace"});
+    const std::string action =
+        ensemble.get_or_choice("on_failure", "abort", {"abort", "drop", "replace"});
     s.on_failure.action = action == "drop"      ? FailurePolicy::Action::drop
                           : action == "replace" ? FailurePolicy::Action::replace
                                                 : FailurePolicy::Action::abort;
     if (s.is_steady() && s.on_failure.action != FailurePolicy::Action::abort)
-        ensemble.fail("on_failure",
-                      fmt::format("is not supported with mode = {}: the derivatives compare evaluations of the same "
-                                  "ensemble, which a dropped or replaced realization would change", s.mode_name()),
-                      "abort with mode = steady or continuation");
+        ensemble.fail(
+            "on_failure",
+            fmt::format(
+                "is not supported with mode = {}: the derivatives compare evaluations of the same "
+                "ensemble, which a dropped or replaced realization would change",
+                s.mode_name()),
+            "abort with mode = steady or continuation");
     if (s.on_failure.action == FailurePolicy::Action::replace && !s.is_cpi())
-        ensemble.fail("on_failure",
-                      "= replace needs cpi mode: in a direct run a copy of a healthy realization would follow "
-                      "its donor's trajectory (the DEM is deterministic) and correlate the ensemble",
-                      "abort or drop in direct mode; abort, drop or replace in cpi mode");
+        ensemble.fail(
+            "on_failure",
+            "= replace needs cpi mode: in a direct run a copy of a healthy realization would "
+            "follow "
+            "its donor's trajectory (the DEM is deterministic) and correlate the ensemble",
+            "abort or drop in direct mode; abort, drop or replace in cpi mode");
     s.on_failure.max_failures = ensemble.get_or<long>("max_failures", -1, Bounds::closed(-1, 1e9));
     if (s.on_failure.action == FailurePolicy::Action::abort && ensemble.contains("max_failures"))
         ensemble.fail("max_failures", "is read only with ensemble.on_failure = drop or replace",
@@ -163,46 +203,61 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
 
 const char* RunSettings::mode_name() const {
     switch (mode) {
-        case Mode::direct: return "direct";
-        case Mode::cpi: return "cpi";
-        case Mode::steady: return "steady";
-        case Mode::continuation: return "continuation";
+        case Mode::direct:
+            return "direct";
+        case Mode::cpi:
+            return "cpi";
+        case Mode::steady:
+            return "steady";
+        case Mode::continuation:
+            return "continuation";
     }
     return "?";
 }
 
 void RunSettings::check_ensemble(const Params& root, int realizations) {
     // A run that measures the spread of the realizations' slopes needs two of them to the end.
-    const bool spread = is_cpi() && cpi.projection == coarse::CoarseRunSettings::Projection::adaptive;
+    const bool spread =
+        is_cpi() && cpi.projection == coarse::CoarseRunSettings::Projection::adaptive;
     on_failure.min_active = spread ? 2 : 1;
     if (on_failure.max_failures < 0) on_failure.max_failures = std::max(1, realizations / 4);
-    if (on_failure.action == FailurePolicy::Action::drop && on_failure.max_failures > realizations - on_failure.min_active)
+    if (on_failure.action == FailurePolicy::Action::drop &&
+        on_failure.max_failures > realizations - on_failure.min_active)
         on_failure.max_failures = std::max(0, realizations - on_failure.min_active);
     if (is_steady()) {
         if (realizations < 2)
             root.fail("mode",
-                      fmt::format("= {} stops its solve at the noise level of the ensemble, measured from the spread "
-                                  "of >= 2 realizations; this run has {} (ranks x ensemble.realizations_per_rank)",
+                      fmt::format("= {} stops its solve at the noise level of the ensemble, "
+                                  "measured from the spread "
+                                  "of >= 2 realizations; this run has {} (ranks x "
+                                  "ensemble.realizations_per_rank)",
                                   mode_name(), realizations),
-                      "steady or continuation with >= 2 realizations (more ranks or ensemble.realizations_per_rank)");
+                      "steady or continuation with >= 2 realizations (more ranks or "
+                      "ensemble.realizations_per_rank)");
         if (!restricts_members(observable, observe.quantiles))
-            root.scope("cpi").fail("observable",
-                                   fmt::format("cannot restrict a realization on its own, and mode = {} measures the "
-                                               "noise of F from the realizations' spread", mode_name()),
-                                   "icdf with mode = steady or continuation");
+            root.scope("cpi").fail(
+                "observable",
+                fmt::format("cannot restrict a realization on its own, and mode = {} measures the "
+                            "noise of F from the realizations' spread",
+                            mode_name()),
+                "icdf with mode = steady or continuation");
     }
     if (!spread) return;
     const Params c = root.scope("cpi");
     if (realizations < 2)
         c.fail("projection",
-               fmt::format("needs at least 2 realizations to measure the statistical error of the slope from their "
-                           "spread; this run has {} (ranks x ensemble.realizations_per_rank)", realizations),
+               fmt::format("needs at least 2 realizations to measure the statistical error of the "
+                           "slope from their "
+                           "spread; this run has {} (ranks x ensemble.realizations_per_rank)",
+                           realizations),
                "fixed or periods with one realization; adaptive with >= 2 (more ranks or "
                "ensemble.realizations_per_rank)");
     if (!restricts_members(observable, observe.quantiles))
-        c.fail("observable", "cannot restrict a realization on its own, and cpi.projection = adaptive needs every "
-                             "realization's own slope",
-               "icdf with cpi.projection = adaptive");
+        c.fail(
+            "observable",
+            "cannot restrict a realization on its own, and cpi.projection = adaptive needs every "
+            "realization's own slope",
+            "icdf with cpi.projection = adaptive");
 }
 
 }  // namespace efdem::mpi_driver

@@ -18,16 +18,20 @@ void SettlingProgressLine::operator()(const dem::SettlingProgress& p) {
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     if (p.stage == dem::SettlingProgress::Stage::done) {
         const bool settled = p.ke_per_particle < p.ke_threshold;
-        log::info("settling realization {}: {} at t = {:.4g} ({} steps), KE/particle {:.2e} {} {:.2e}, {}",
-                  p.realization, settled ? "settled" : "stopped (bed.settle.max_time)", p.time, p.steps,
-                  p.ke_per_particle, settled ? "<" : ">=", p.ke_threshold, format_duration(elapsed));
+        log::info(
+            "settling realization {}: {} at t = {:.4g} ({} steps), KE/particle {:.2e} {} {:.2e}, "
+            "{}",
+            p.realization, settled ? "settled" : "stopped (bed.settle.max_time)", p.time, p.steps,
+            p.ke_per_particle, settled ? "<" : ">=", p.ke_threshold, format_duration(elapsed));
         return;
     }
     if (std::chrono::duration<double>(now - last_).count() < min_seconds_) return;
     last_ = now;
-    log::info("settling realization {}: {}, t = {:.4g} / {:.4g}, {} steps, KE/particle {:.2e} (settled below {:.2e}), {}",
-              p.realization, dem::to_string(p.stage), p.time, p.stage_end, p.steps, p.ke_per_particle,
-              p.ke_threshold, format_duration(elapsed));
+    log::info(
+        "settling realization {}: {}, t = {:.4g} / {:.4g}, {} steps, KE/particle {:.2e} (settled "
+        "below {:.2e}), {}",
+        p.realization, dem::to_string(p.stage), p.time, p.stage_end, p.steps, p.ke_per_particle,
+        p.ke_threshold, format_duration(elapsed));
 }
 
 }  // namespace efdem::mpi_driver

@@ -15,19 +15,21 @@ namespace efdem::mpi_driver {
 namespace {
 /// What the observers saw, kept for the end of a run cut short (signal, failure).
 struct SolveTrace {
-    long solve = 0;             ///< the current solve
-    long last_iteration = -1;   ///< its last iterate seen
+    long solve = 0;                    ///< the current solve
+    long last_iteration = -1;          ///< its last iterate seen
     coarse::SteadySolveRecord latest;  ///< the current solve's record so far
-    coarse::Branch branch;      ///< continuation: the points so far
+    coarse::Branch branch;             ///< continuation: the points so far
 };
 }  // namespace
 
-RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder, Progress& progress) {
+RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder,
+                      Progress& progress) {
     const coarse::SteadyRunSettings& ss = s.steady;
     coarse::EnsembleObservable& observable = stepper.observable();
-    coarse::SteadyRun run(ss, stepper, observable.repair_hook([&stepper] { return stepper.height_range(); }),
-                          [&stepper](double value) { stepper.set_parameter(value); },
-                          ss.gap_coordinates ? coarse::icdf_gap_coordinates() : coarse::CoarseCoordinates{});
+    coarse::SteadyRun run(
+        ss, stepper, observable.repair_hook([&stepper] { return stepper.height_range(); }),
+        [&stepper](double value) { stepper.set_parameter(value); },
+        ss.gap_coordinates ? coarse::icdf_gap_coordinates() : coarse::CoarseCoordinates{});
     const double micro_start = stepper.micro_time();
     const double budget = s.duration;  // 0: none
     double parameter = ss.continuation ? ss.parameter_start : 0.0;
@@ -45,20 +47,27 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         it.noise = rec.state_noise.back();
         const Eigen::Index n = stepper.observable().dimension();
         it.x = rec.x.head(std::min<Eigen::Index>(n, rec.x.size()));
-        it.parameter = ss.continuation && rec.x.size() > n ? rec.x[n] * ss.parameter_scale : parameter;
+        it.parameter =
+            ss.continuation && rec.x.size() > n ? rec.x[n] * ss.parameter_scale : parameter;
         it.dem_time = stepper.micro_time() - micro_start - ss.warmup;
         if (recorder) recorder->steady_iterate(it);
         const double wall = progress.elapsed_seconds();
         const double rate = wall > 0 ? stepper.particle_steps() / wall : 0.0;
-        log::info("steady: solve {} iterate {}: |F| = {:.4e} (noise {:.3e}, {:.2f} x noise){}; DEM time {:.4g}{} in "
-                  "{} wall ({:.3g} particle-steps/s)",
-                  it.solve, it.iteration, it.residual, it.noise, it.noise > 0 ? it.residual / it.noise : 0.0,
-                  ss.continuation ? fmt::format(" at {} = {:.5g}", ss.parameter, it.parameter) : std::string{},
-                  it.dem_time, budget > 0 ? fmt::format(" of {:.4g}", budget) : std::string{},
-                  format_duration(wall), rate);
-        if (stepper.interrupted()) return fmt::format("stopped by {}", signal_name(stepper.interrupted()));
+        log::info(
+            "steady: solve {} iterate {}: |F| = {:.4e} (noise {:.3e}, {:.2f} x noise){}; DEM time "
+            "{:.4g}{} in "
+            "{} wall ({:.3g} particle-steps/s)",
+            it.solve, it.iteration, it.residual, it.noise,
+            it.noise > 0 ? it.residual / it.noise : 0.0,
+            ss.continuation ? fmt::format(" at {} = {:.5g}", ss.parameter, it.parameter)
+                            : std::string{},
+            it.dem_time, budget > 0 ? fmt::format(" of {:.4g}", budget) : std::string{},
+            format_duration(wall), rate);
+        if (stepper.interrupted())
+            return fmt::format("stopped by {}", signal_name(stepper.interrupted()));
         if (budget > 0 && it.dem_time >= budget)
-            return fmt::format("the DEM-time budget run.duration = {:g} is spent ({:.4g} used)", budget, it.dem_time);
+            return fmt::format("the DEM-time budget run.duration = {:g} is spent ({:.4g} used)",
+                               budget, it.dem_time);
         return {};
     });
     run.set_point_observer([&](const coarse::Branch& b) {
@@ -68,9 +77,10 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
     });
 
     const auto interrupted_status = [&stepper] {
-        return fmt::format("interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
-                           "continued; its best iterate is saved)",
-                           signal_name(stepper.interrupted()), stepper.time());
+        return fmt::format(
+            "interrupted: {} at t = {:.6g}; no checkpoint (a steady solve cannot be "
+            "continued; its best iterate is saved)",
+            signal_name(stepper.interrupted()), stepper.time());
     };
     RunSummary sum;
     coarse::SteadyRunOutcome out;
@@ -108,16 +118,22 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
             history += fmt::format("{}{:.3e}", k ? ", " : "", r.state_residuals[k]);
         log::error("{}", out.end_status);
         if (!out.continuation)
-            log::error("residual history |F| [d_p]: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is /steady/best in "
-                       "the run file. What to try: a longer steady.tau (slow modes then contract more per "
-                       "evaluation), more realizations (the noise falls as 1/sqrt(R)), a larger "
-                       "steady.difference_step when GMRES did not converge, steady.solver = anderson for a stable "
-                       "state",
-                       history, r.state_noise.empty() ? 0.0 : r.state_noise.back(), r.best_state_residual());
+            log::error(
+                "residual history |F| [d_p]: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is "
+                "/steady/best in "
+                "the run file. What to try: a longer steady.tau (slow modes then contract more per "
+                "evaluation), more realizations (the noise falls as 1/sqrt(R)), a larger "
+                "steady.difference_step when GMRES did not converge, steady.solver = anderson for "
+                "a stable "
+                "state",
+                history, r.state_noise.empty() ? 0.0 : r.state_noise.back(),
+                r.best_state_residual());
         else
-            log::error("no branch point converged; the first point's residual history |F| [d_p]: {}. What to try: a "
-                       "longer steady.tau, more realizations, a larger steady.difference_step",
-                       history);
+            log::error(
+                "no branch point converged; the first point's residual history |F| [d_p]: {}. What "
+                "to try: a "
+                "longer steady.tau, more realizations, a larger steady.difference_step",
+                history);
     }
     return sum;
 }

@@ -11,23 +11,29 @@ namespace efdem::mpi_driver {
 std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const LiftRecord& lift) {
     long changed = 0;
     for (long c : lift.changed) changed += c;
-    std::string s = fmt::format("coarse step {}: burst {:.4g}..{:.4g}", n, r.t_start, r.t_start + r.burst_length);
+    std::string s = fmt::format("coarse step {}: burst {:.4g}..{:.4g}", n, r.t_start,
+                                r.t_start + r.burst_length);
     if (std::isfinite(r.period)) s += fmt::format(", period T = {:.4g}", r.period);
     s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
     if (r.lifted) s += fmt::format(", {} labels changed", changed);
-    if (r.repair.changed()) s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
-    if (r.slope_standard_error.size() > 0) s += fmt::format(", slope s.e. max {:.3g}", r.max_slope_standard_error());
+    if (r.repair.changed())
+        s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
+    if (r.slope_standard_error.size() > 0)
+        s += fmt::format(", slope s.e. max {:.3g}", r.max_slope_standard_error());
     if (const coarse::ControllerRecord& c = r.controller; c.adaptive && r.lifted)
-        s += fmt::format(", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}), DT set by {}",
-                         c.error(), c.error() / c.tolerance, c.statistical, c.truncation, c.limited_by);
+        s += fmt::format(
+            ", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}), DT "
+            "set by {}",
+            c.error(), c.error() / c.tolerance, c.statistical, c.truncation, c.limited_by);
     else if (c.active && r.lifted)
-        s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})", c.error(),
-                         c.statistical, c.truncation);
+        s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})",
+                         c.error(), c.statistical, c.truncation);
     if (!r.message.empty()) s += " [" + r.message + "]";
     return s;
 }
 
-void StepReportObserver::step_done(const coarse::ProjectiveRun& run, const coarse::ProjectiveStepRecord& rec) {
+void StepReportObserver::step_done(const coarse::ProjectiveRun& run,
+                                   const coarse::ProjectiveStepRecord& rec) {
     const LiftRecord lift = rec.lifted ? stepper_.last_lift() : LiftRecord{};
     if (recorder_) recorder_->coarse_step(rec, lift);
     log::info("{}", describe_step(run.state().coarse_steps, rec, lift));

@@ -10,18 +10,20 @@
 namespace efdem::mpi_driver {
 
 class StepReportObserver final : public coarse::ProjectiveRunObserver {
-public:
+  public:
     /// `recorder` may be null (log line only).
     StepReportObserver(const EnsembleStepper& stepper, RunRecorder* recorder)
         : stepper_(stepper), recorder_(recorder) {}
-    void step_done(const coarse::ProjectiveRun& run, const coarse::ProjectiveStepRecord& record) override;
+    void step_done(const coarse::ProjectiveRun& run,
+                   const coarse::ProjectiveStepRecord& record) override;
 
-private:
+  private:
     const EnsembleStepper& stepper_;
     RunRecorder* recorder_;
 };
 
 /// "coarse step n: burst t0..t1, DT = ..., projected, k labels changed, ..." (the log line).
-std::string describe_step(long n, const coarse::ProjectiveStepRecord& record, const LiftRecord& lift);
+std::string describe_step(long n, const coarse::ProjectiveStepRecord& record,
+                          const LiftRecord& lift);
 
 }  // namespace efdem::mpi_driver

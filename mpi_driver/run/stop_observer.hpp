@@ -11,11 +11,11 @@
 namespace efdem::mpi_driver {
 
 class StopObserver final : public coarse::ProjectiveRunObserver {
-public:
+  public:
     explicit StopObserver(EnsembleStepper& stepper) : stepper_(stepper) {}
     void between_steps(const coarse::ProjectiveRun& run) override;
 
-private:
+  private:
     EnsembleStepper& stepper_;
 };
 

@@ -71,9 +71,14 @@ class SdeEnsembleStepper final : public coarse::CoarseStepper {
     using Drift = std::function<Eigen::VectorXd(const Eigen::VectorXd&, double)>;
     SdeEnsembleStepper(Drift drift, double sigma, int members, double dt, int steps_per_sample,
                        const Eigen::VectorXd& x0, std::uint64_t seed)
-        : f_(std::move(drift)), sigma_(sigma), dt_(dt), per_sample_(steps_per_sample), y_(members, x0.size()) {
+        : f_(std::move(drift)),
+          sigma_(sigma),
+          dt_(dt),
+          per_sample_(steps_per_sample),
+          y_(members, x0.size()) {
         y_.rowwise() = x0.transpose();
-        for (int r = 0; r < members; ++r) rng_.emplace_back(seed * 1000 + static_cast<std::uint64_t>(r));
+        for (int r = 0; r < members; ++r)
+            rng_.emplace_back(seed * 1000 + static_cast<std::uint64_t>(r));
     }
     void set_parameter(double lambda) { lambda_ = lambda; }
 

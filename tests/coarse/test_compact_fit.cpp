@@ -132,8 +132,7 @@ TEST_CASE("the fit reports every failure instead of returning wrong parameters",
         tight.max_evaluations = 2;
         const CompactParameters truth{-8, 6, 2, -3};
         const CompactFit fit =
-            fit_compact(y_of_p(truth, kGrid), kGrid, CompactParameters{-8.5, 6.3, 1.7, -3},
-                        tight);
+            fit_compact(y_of_p(truth, kGrid), kGrid, CompactParameters{-8.5, 6.3, 1.7, -3}, tight);
         CHECK(fit.status == CompactFitStatus::ill_conditioned);
         CHECK(fit.usable());
         CHECK(fit.d_held);

@@ -39,7 +39,8 @@ Eigen::VectorXd rates19() {
 
 /// Runs `integrator` on `stepper` until `t_end`; returns the records.
 template <class Stepper>
-std::vector<ProjectiveStepRecord> run_to(MultistepProjectiveIntegrator& integrator, Stepper& stepper, double t_end) {
+std::vector<ProjectiveStepRecord> run_to(MultistepProjectiveIntegrator& integrator,
+                                         Stepper& stepper, double t_end) {
     integrator.set_end_time(t_end);
     std::vector<ProjectiveStepRecord> out;
     const double burst = integrator.settings().healing + integrator.settings().window;
@@ -84,7 +85,8 @@ double global_error(int steps, double dt) {
 }  // namespace
 
 TEST_CASE("projection weights integrate the slope model exactly", "[unit][coarse][multistep]") {
-    const Eigen::VectorXd s0 = Eigen::VectorXd::Constant(1, 1.0), s1 = Eigen::VectorXd::Constant(1, 2.0);
+    const Eigen::VectorXd s0 = Eigen::VectorXd::Constant(1, 1.0),
+                          s1 = Eigen::VectorXd::Constant(1, 2.0);
     const std::vector<SlopeNode> one{node(5.0, s1)};
     CHECK(projection_weights(one, 10.0, 4.0) == std::vector<double>{4.0});
     // Line through (0, 1) and (5, 2): s(t) = 1 + t/5; integral over [10, 14] = 4 + (196 - 100)/10.
@@ -93,10 +95,12 @@ TEST_CASE("projection weights integrate the slope model exactly", "[unit][coarse
     CHECK(w[0] + w[1] == Approx(4.0).epsilon(1e-14));
     CHECK(projected_increment(two, w)[0] == Approx(4.0 + 9.6).epsilon(1e-13));
     // omega = (t - 0)(t - 5) over [10, 14]: [t^3/3 - 5 t^2/2] = 1232/3 - 240 = 520/3... exactly:
-    CHECK(omega_integral(two, 10.0, 4.0) == Approx((14.0 * 14 * 14 - 1000.0) / 3.0 - 2.5 * (196.0 - 100.0)).epsilon(1e-13));
+    CHECK(omega_integral(two, 10.0, 4.0) ==
+          Approx((14.0 * 14 * 14 - 1000.0) / 3.0 - 2.5 * (196.0 - 100.0)).epsilon(1e-13));
     // Noise: W0^2 se0^2 + W1^2 se1^2.
     const std::vector<SlopeNode> noisy{node(0.0, s0, 0.1), node(5.0, s1, 0.2)};
-    CHECK(statistical_error(noisy, w)[0] == Approx(std::hypot(w[0] * 0.1, w[1] * 0.2)).epsilon(1e-14));
+    CHECK(statistical_error(noisy, w)[0] ==
+          Approx(std::hypot(w[0] * 0.1, w[1] * 0.2)).epsilon(1e-14));
 }
 
 TEST_CASE("the divided difference's norm removes the slopes' noise", "[unit][coarse][multistep]") {
@@ -128,7 +132,8 @@ TEST_CASE("the divided difference's norm removes the slopes' noise", "[unit][coa
     CHECK(mean_norm2 < 0.5 * level);  // the positive part of a zero-mean excess: ~0.23 level
 }
 
-TEST_CASE("largest_dt_within returns the DT whose error is the target", "[unit][coarse][multistep]") {
+TEST_CASE("largest_dt_within returns the DT whose error is the target",
+          "[unit][coarse][multistep]") {
     JumpErrorModel m{{node(0.0, Eigen::VectorXd::Constant(3, 1.0), 0.01)}, 5.0, 1e-3, 1.0};
     const double dt = largest_dt_within(m, 0.5, 1000.0);
     CHECK(jump_error(m, dt).total() == Approx(0.5).epsilon(1e-5));
@@ -146,7 +151,8 @@ TEST_CASE("projective forward Euler is first order and Adams-Bashforth 2 second 
     // by ~ k DT, i.e. by up to 20 %: ranges [1.7, 2.3] and [3.3, 4.7].
     const double e1[] = {global_error(1, 4.0), global_error(1, 2.0), global_error(1, 1.0)};
     const double e2[] = {global_error(2, 4.0), global_error(2, 2.0), global_error(2, 1.0)};
-    INFO("euler " << e1[0] << " " << e1[1] << " " << e1[2] << "; ab2 " << e2[0] << " " << e2[1] << " " << e2[2]);
+    INFO("euler " << e1[0] << " " << e1[1] << " " << e1[2] << "; ab2 " << e2[0] << " " << e2[1]
+                  << " " << e2[2]);
     for (int i = 0; i < 2; ++i) {
         CHECK(e1[i] / e1[i + 1] > 1.7);
         CHECK(e1[i] / e1[i + 1] < 2.3);
@@ -156,7 +162,8 @@ TEST_CASE("projective forward Euler is first order and Adams-Bashforth 2 second 
     CHECK(e2[2] < 0.1 * e1[2]);
 }
 
-TEST_CASE("the Adams-Bashforth 2 amplification factor is what the integrator does", "[unit][coarse][multistep]") {
+TEST_CASE("the Adams-Bashforth 2 amplification factor is what the integrator does",
+          "[unit][coarse][multistep]") {
     // One exactly integrated mode x' = lambda x, sampled every 0.01 (the formula's window is
     // continuous: the discrete least-squares slope differs by O(h/W) ~ 0.1 %). The growth per
     // cycle over 30 cycles against the dominant root |mu|: within 1 %.
@@ -187,7 +194,8 @@ TEST_CASE("the Adams-Bashforth 2 amplification factor is what the integrator doe
     CHECK(cpi_amplification(cycle, -0.001) == Approx(std::exp(-0.1)).epsilon(2e-3));
 }
 
-TEST_CASE("adaptive jumps on a noisy SDE add the error the controller predicts", "[unit][coarse][multistep]") {
+TEST_CASE("adaptive jumps on a noisy SDE add the error the controller predicts",
+          "[unit][coarse][multistep]") {
     // 8 OU members in 19 components (rates 0.002..0.01, sigma 0.005) around an exponentially
     // decaying mean: DT ~ 10, statistical and truncation parts of similar size. Every jump's true
     // error is X_proj - e^(-k DT) X_end (the exact mean flow from where it started). Its RMS
@@ -228,7 +236,8 @@ TEST_CASE("adaptive jumps on a noisy SDE add the error the controller predicts",
     CHECK(static_cast<double>(within) >= 0.85 * static_cast<double>(kept));
 }
 
-TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone", "[unit][coarse][multistep]") {
+TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone",
+          "[unit][coarse][multistep]") {
     // A fast mode (k = 0.3) with no noise, a first jump allowed up to 40: its curvature makes
     // the first jump far too long; the burst after it shows it, the step is redone shorter.
     Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.3);
@@ -256,7 +265,8 @@ TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone", "[u
         }
 }
 
-TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the shorter DT", "[unit][coarse][multistep]") {
+TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the shorter DT",
+          "[unit][coarse][multistep]") {
     Eigen::VectorXd k(19);
     for (int i = 0; i < 19; ++i) k[i] = 0.002 + 0.008 * i / 18.0;
     auto run = [&](ForcedDecision::Kind kind, double& work) {
@@ -277,11 +287,12 @@ TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the sh
     double work_reject = 0, work_shrink = 0;
     const Eigen::VectorXd a = run(ForcedDecision::Kind::reject, work_reject);
     const Eigen::VectorXd b = run(ForcedDecision::Kind::shrink, work_shrink);
-    CHECK((a.array() == b.array()).all());   // bit for bit
+    CHECK((a.array() == b.array()).all());            // bit for bit
     CHECK(work_reject == Approx(work_shrink + 6.0));  // the discarded burst was paid for
 }
 
-TEST_CASE("an adaptive run resumed from the saved integrator state continues bit for bit", "[unit][coarse][multistep]") {
+TEST_CASE("an adaptive run resumed from the saved integrator state continues bit for bit",
+          "[unit][coarse][multistep]") {
     // Saved after six steps, and right after the first burst with healing = window (the history
     // then holds the curvature-only node of the first burst's earlier window).
     const Eigen::VectorXd k = rates19();
@@ -317,7 +328,8 @@ TEST_CASE("an adaptive run resumed from the saved integrator state continues bit
     }
 }
 
-TEST_CASE("phase_drift and wave_coherence judge the phase signal from the members", "[unit][coarse][multistep]") {
+TEST_CASE("phase_drift and wave_coherence judge the phase signal from the members",
+          "[unit][coarse][multistep]") {
     // Four members' phase signals member(t, r), sampled every 0.25 over t = 0.25..20.
     auto samples = [](auto member) {
         BurstSamples b;
@@ -333,7 +345,9 @@ TEST_CASE("phase_drift and wave_coherence judge the phase signal from the member
     };
     // A wave of period 9 and amplitude 0.1 on a drift of 0.05 per time unit.
     auto burst = [&](const double phases[4], double drift) {
-        return samples([&](double t, int r) { return drift * t + 0.1 * std::sin(2 * M_PI * t / 9.0 + phases[r]); });
+        return samples([&](double t, int r) {
+            return drift * t + 0.1 * std::sin(2 * M_PI * t / 9.0 + phases[r]);
+        });
     };
     const double together[4] = {0, 0, 0, 0}, spread[4] = {0, M_PI / 2, M_PI, 3 * M_PI / 2};
     const WaveCoherence in = wave_coherence(burst(together, 0.0), 0.0);
@@ -351,7 +365,8 @@ TEST_CASE("phase_drift and wave_coherence judge the phase signal from the member
     // RMS of the relaxation, ~0.03), so it cannot fake a period.
     std::mt19937_64 gen(7);
     std::normal_distribution<double> noise(0.0, 0.01);
-    const BurstSamples relax = samples([&](double t, int) { return 0.5 * std::exp(-t / 3.0) + noise(gen); });
+    const BurstSamples relax =
+        samples([&](double t, int) { return 0.5 * std::exp(-t / 3.0) + noise(gen); });
     const WaveCoherence shared = wave_coherence(relax, 0.0);
     REQUIRE(shared.measured);
     CHECK(shared.ratio > shared.threshold);
@@ -361,12 +376,14 @@ TEST_CASE("phase_drift and wave_coherence judge the phase signal from the member
     // A common swing of period 15 seen over 20 time units: one cycle, two of it do not fit, so
     // it is no evidence of a wave (the tall bed at U_s = 0.19 held a jump on such a swing).
     const double slow_period = 15.0;
-    const BurstSamples swing =
-        samples([&](double t, int) { return 0.1 * std::sin(2 * M_PI * (t - 2.0) / slow_period) + noise(gen); });
+    const BurstSamples swing = samples([&](double t, int) {
+        return 0.1 * std::sin(2 * M_PI * (t - 2.0) / slow_period) + noise(gen);
+    });
     PeriodSettings one;
     one.min_periods = 1;
     const PeriodEstimate seen = estimate_period(swing.t, swing.phase_signal, one);
-    REQUIRE(seen.n_periods == 1);  // the detector sees the one cycle (upward crossings near 2 and 17) ...
+    REQUIRE(seen.n_periods ==
+            1);  // the detector sees the one cycle (upward crossings near 2 and 17) ...
     CHECK(seen.period == Approx(slow_period).epsilon(0.1));
     const WaveCoherence once = wave_coherence(swing, 0.0);  // ... which the guard does not count
     REQUIRE(once.measured);
@@ -422,7 +439,8 @@ TEST_CASE("with healing >= window the first burst's two windows give the first j
         CHECK(rms(jump.x_projected - exact) < 1.5 * 0.05);
         if (steps == 2) CHECK(integrator.step(toy).controller.steps == 2);
     }
-    // healing < window: the first burst holds one window only, the first jump is capped at one burst.
+    // healing < window: the first burst holds one window only, the first jump is capped at one
+    // burst.
     test::OuEnsembleStepper toy(k, 0.005, 8, 0.1, Eigen::VectorXd::Constant(19, 3.0), 7);
     MultistepProjectiveIntegrator capped(settings(3.0, 1));
     capped.set_end_time(200.0);
@@ -432,16 +450,18 @@ TEST_CASE("with healing >= window the first burst's two windows give the first j
     CHECK(jump.controller.limited_by == "first jump (no curvature measured yet)");
 }
 
-TEST_CASE("an adaptive jump limited by stability records the monitor's decay rate and amplification",
-          "[unit][coarse][multistep]") {
+TEST_CASE(
+    "an adaptive jump limited by stability records the monitor's decay rate and amplification",
+    "[unit][coarse][multistep]") {
     // One fast mode (k = 0.1 in every component, no noise): the monitor measures lambda = -0.1
     // from the window's halves (exact for an exponential sampled evenly). With a tolerance that
     // never binds, DT starts at dt_max = 200 and is halved until the forward Euler cycle
-    // e^(lambda 8) (1 + lambda DT) is at most 1 in modulus, i.e. DT <= 32.3: 200 -> 100 -> 50 -> 25.
-    // The record must carry that assessment (it was NaN for adaptive runs before).
+    // e^(lambda 8) (1 + lambda DT) is at most 1 in modulus, i.e. DT <= 32.3: 200 -> 100 -> 50
+    // -> 25. The record must carry that assessment (it was NaN for adaptive runs before).
     const Eigen::VectorXd k = Eigen::VectorXd::Constant(19, 0.1);
     test::OuEnsembleStepper toy(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(19, 3.0), 3);
-    MultistepSettings s = adaptive_settings(4.0, 4.0, {.tolerance = 1e3, .dt_min = 0.5, .dt_max = 200.0});
+    MultistepSettings s =
+        adaptive_settings(4.0, 4.0, {.tolerance = 1e3, .dt_min = 0.5, .dt_max = 200.0});
     s.steps = 1;  // forward Euler: the amplification above
     MultistepProjectiveIntegrator integrator(s);
     integrator.set_end_time(1000.0);
@@ -462,7 +482,8 @@ TEST_CASE("a first burst that would leave less than one burst runs on to the end
     // expansion, the first burst (22) ended at 84 and the run stopped there, 16 short of its
     // end. Bursts of 4 + 4 from t = 0 with the end at 14: the first burst runs to 14.
     test::OuEnsembleStepper toy(rates19(), 0.0, 2, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
-    MultistepProjectiveIntegrator integrator(adaptive_settings(4.0, 4.0, {.tolerance = 0.05, .dt_min = 1.0, .dt_max = 60.0}));
+    MultistepProjectiveIntegrator integrator(
+        adaptive_settings(4.0, 4.0, {.tolerance = 0.05, .dt_min = 1.0, .dt_max = 60.0}));
     integrator.set_end_time(14.0);
     const ProjectiveStepRecord first = integrator.step(toy);
     CHECK(first.status == StepStatus::burst_only);

@@ -275,8 +275,8 @@ TEST_CASE("with an end time the jumps are shortened so that the run ends there e
     // burst: it is shortened to 75, and the last cycle is a burst only (205 to 225).
     // Times are sums of multiples of h and of the DT values: equal to 1e-9.
     const auto run_to = [](double t_end) {
-        LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5,
-                             Eigen::VectorXd::Ones(1), 10.0);
+        LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5, Eigen::VectorXd::Ones(1),
+                             10.0);
         ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
         pfe.set_end_time(t_end);
         std::vector<ProjectiveStepRecord> recs;
@@ -305,8 +305,8 @@ TEST_CASE("with an end time the jumps are shortened so that the run ends there e
     }
     {
         // No end time: the full DT every cycle (210 for a run asked to stop at 200).
-        LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5,
-                             Eigen::VectorXd::Ones(1), 10.0);
+        LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5, Eigen::VectorXd::Ones(1),
+                             10.0);
         ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
         pfe.step(toy);
         pfe.step(toy);
@@ -330,16 +330,15 @@ double unbiased_std_over_sqrt_r(const Eigen::VectorXd& d) {
 }
 }  // namespace
 
-TEST_CASE("PFE records the slope's standard error from the members' own slopes",
-          "[unit][coarse]") {
+TEST_CASE("PFE records the slope's standard error from the members' own slopes", "[unit][coarse]") {
     // Members share a trend and an oscillation (which biases every member's least-squares slope
     // alike) and differ by their own trends d_r: the s.e. is std_r(d_r)/sqrt(R) up to round-off
     // of slopes O(0.1) (1e-9 relative leaves room for the sums over 100 samples).
     const Eigen::MatrixXd d = member_trends();
-    MemberTrendStepper toy(SineTrendStepper(Eigen::Vector3d(3.0, -1.0, 20.0),
-                                            Eigen::Vector3d(0.05, -0.2, 0.01),
-                                            Eigen::Vector3d(0.0, 1.0, 2.0), 0.5, 10.0, 0.1),
-                           d);
+    MemberTrendStepper toy(
+        SineTrendStepper(Eigen::Vector3d(3.0, -1.0, 20.0), Eigen::Vector3d(0.05, -0.2, 0.01),
+                         Eigen::Vector3d(0.0, 1.0, 2.0), 0.5, 10.0, 0.1),
+        d);
     ProjectiveForwardEuler pfe({.healing = 5, .window = 10, .dt = 20});
     for (int step = 0; step < 2; ++step) {  // and again after a lift
         const ProjectiveStepRecord rec = pfe.step(toy);
@@ -354,7 +353,8 @@ TEST_CASE("PFE records the slope's standard error from the members' own slopes",
     }
     // A stepper without members: no s.e., and the slope is what it was.
     LinearToyStepper plain(Eigen::MatrixXd::Constant(1, 1, 0.99), 0.1, Eigen::VectorXd::Ones(1));
-    const ProjectiveStepRecord rec = ProjectiveForwardEuler({.healing = 1, .window = 1, .dt = 2}).step(plain);
+    const ProjectiveStepRecord rec =
+        ProjectiveForwardEuler({.healing = 1, .window = 1, .dt = 2}).step(plain);
     REQUIRE(rec.status == StepStatus::projected);
     CHECK(rec.slope_standard_error.size() == 0);
     CHECK(std::isnan(rec.max_slope_standard_error()));

@@ -79,7 +79,8 @@ struct Recorder final : ProjectiveRunObserver {
 /// fallback variable switches to the exact samples. Copyable, like LinearToyStepper.
 class FailingPrimaryStepper final : public CoarseStepper {
   public:
-    FailingPrimaryStepper(test::LinearToyStepper toy, double t_fail) : toy_(std::move(toy)), t_fail_(t_fail) {}
+    FailingPrimaryStepper(test::LinearToyStepper toy, double t_fail)
+        : toy_(std::move(toy)), t_fail_(t_fail) {}
     double time() const override { return toy_.time(); }
     void run(double duration, BurstSamples& out) override {
         const std::size_t first = out.size();
@@ -88,7 +89,9 @@ class FailingPrimaryStepper final : public CoarseStepper {
         for (std::size_t k = first; k < out.size(); ++k)
             if (out.t[k] >= t_fail_) out.x[k].setConstant(std::numeric_limits<double>::quiet_NaN());
     }
-    void lift(const Eigen::VectorXd& target, double new_time) override { toy_.lift(target, new_time); }
+    void lift(const Eigen::VectorXd& target, double new_time) override {
+        toy_.lift(target, new_time);
+    }
     const Eigen::VectorXd& state() const { return toy_.state(); }
     bool use_primary = true;
     int selects = 0;
@@ -99,7 +102,8 @@ class FailingPrimaryStepper final : public CoarseStepper {
 };
 }  // namespace
 
-TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the warm-up first", "[unit][coarse][run]") {
+TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the warm-up first",
+          "[unit][coarse][run]") {
     auto toy = slow_toy();
     ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
     Recorder<test::LinearToyStepper> seen;
@@ -122,7 +126,8 @@ TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the war
     CHECK(run.end_time() == 100.0);
 }
 
-TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step, and says so", "[unit][coarse][run]") {
+TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step, and says so",
+          "[unit][coarse][run]") {
     auto toy = slow_toy();
     ProjectiveRun run(fixed_settings(10.0), toy, variable("x"));
     const ProjectiveRunOutcome out = run.run(11.0);  // 1 time unit left after warm-up < burst 2
@@ -130,23 +135,29 @@ TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step, 
     CHECK(out.jumps == 0);
     CHECK(toy.time() == Approx(10.0).margin(1e-9));
     CHECK(out.end_status ==
-          "completed (no projective jump: the 1 time units after the warm-up were less than one burst (2); all 10 "
+          "completed (no projective jump: the 1 time units after the warm-up were less than one "
+          "burst (2); all 10 "
           "time units were direct simulation)");
 }
 
-TEST_CASE("a run of exactly warm-up plus one burst makes one burst and no jump, and says so", "[unit][coarse][run]") {
+TEST_CASE("a run of exactly warm-up plus one burst makes one burst and no jump, and says so",
+          "[unit][coarse][run]") {
     auto toy = slow_toy();
     ProjectiveRun run(fixed_settings(10.0), toy, variable("x"));
     const ProjectiveRunOutcome out = run.run(12.0);  // warm-up 10, burst 2, nothing left to jump
     CHECK(out.coarse_steps == 1);
     CHECK(out.jumps == 0);
     CHECK(toy.lifts == 0);
-    CHECK(out.end_status.rfind("completed (no projective jump: 1 coarse step(s), each a burst only;", 0) == 0);
+    CHECK(out.end_status.rfind(
+              "completed (no projective jump: 1 coarse step(s), each a burst only;", 0) == 0);
 }
 
-TEST_CASE("a run that jumps ends plain 'completed'; a resumed run does not judge the jumps it did not see",
-          "[unit][coarse][run]") {
-    // Warm-up to 2, two cycles of burst 2 + jump 8 to 22, a last burst to 24 with nothing left to jump.
+TEST_CASE(
+    "a run that jumps ends plain 'completed'; a resumed run does not judge the jumps it did not "
+    "see",
+    "[unit][coarse][run]") {
+    // Warm-up to 2, two cycles of burst 2 + jump 8 to 22, a last burst to 24 with nothing left to
+    // jump.
     auto toy = slow_toy();
     ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
     Recorder<test::LinearToyStepper> seen;
@@ -166,7 +177,8 @@ TEST_CASE("a run that jumps ends plain 'completed'; a resumed run does not judge
     CHECK(out.end_status == "completed");
 }
 
-TEST_CASE("the planned micro time of a run follows the shortened last jumps", "[unit][coarse][run]") {
+TEST_CASE("the planned micro time of a run follows the shortened last jumps",
+          "[unit][coarse][run]") {
     // Bursts of 20, DT 80: from 10 to 200 two bursts (jumps 80, 70); to 225 three (80, 75,
     // burst only); to 210 two (80, 80). DT = 0 is a direct run in bursts: all of the time left.
     // Less than a burst left: nothing. Sums of a few multiples of 20: exact to 1e-9.
@@ -177,7 +189,8 @@ TEST_CASE("the planned micro time of a run follows the shortened last jumps", "[
     CHECK(planned_micro_time(190, 200, 20, 80) == 0.0);
 }
 
-TEST_CASE("a failing coarse variable falls back once and the run completes on the fallback", "[unit][coarse][run]") {
+TEST_CASE("a failing coarse variable falls back once and the run completes on the fallback",
+          "[unit][coarse][run]") {
     FailingPrimaryStepper stepper(slow_toy(), 25.0);
     int primary_repairs = 0, fallback_repairs = 0;
     CoarseVariable fallback = variable("b", &fallback_repairs);
@@ -235,7 +248,8 @@ TEST_CASE("without a fallback, three steps without a jump stop the run", "[unit]
 TEST_CASE("StabilityPolicy::stop ends the run at the first flagged step", "[unit][coarse][run]") {
     // A fast mode lambda = -2 seen in the window: |G| of forward Euler with DT = 8 is about
     // |1 - 16| >> 1, so the monitor flags the first step and the stop policy takes no jump.
-    test::LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, std::exp(-2.0 * kH)), kH, Eigen::VectorXd::Constant(1, 5.0));
+    test::LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, std::exp(-2.0 * kH)), kH,
+                               Eigen::VectorXd::Constant(1, 5.0));
     CoarseRunSettings s = fixed_settings();
     s.fixed.healing = 0.0;
     s.fixed.window = 2.0;
@@ -306,9 +320,11 @@ TEST_CASE("a run resumed from before its warm-up does the warm-up and equals the
     CHECK(r.end_rest.state() == r.end_whole.state());
 }
 
-TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings", "[unit][coarse][run]") {
+TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings",
+          "[unit][coarse][run]") {
     ParamTable table = ParamTable::from_text(
-        "cpi.projection = periods\ncpi.healing = 4\ncpi.window = 6\ncpi.periods = 3\ncpi.stability = halve\n",
+        "cpi.projection = periods\ncpi.healing = 4\ncpi.window = 6\ncpi.periods = 3\ncpi.stability "
+        "= halve\n",
         "scene.cfg", "/scenes");
     const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.5);
     CHECK(s.projection == CoarseRunSettings::Projection::periods);
@@ -322,14 +338,18 @@ TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings",
     CHECK(s.make_integrator({})->name() == "period_projective_euler");
 
     ParamTable bad = ParamTable::from_text("cpi.window = 1\n", "scene.cfg", "/scenes");
-    const std::string e = test::input_error([&] { CoarseRunSettings::from_params(bad.root().scope("cpi"), 0.5); }).what();
+    const std::string e = test::input_error([&] {
+                              CoarseRunSettings::from_params(bad.root().scope("cpi"), 0.5);
+                          }).what();
     CHECK_THAT(e, Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.window") &&
                       Catch::Contains("holds 2 samples; a slope needs at least 3"));
 }
 
-TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive would ignore", "[unit][coarse][run]") {
+TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive would ignore",
+          "[unit][coarse][run]") {
     ParamTable table = ParamTable::from_text(
-        "cpi.projection = adaptive\ncpi.integrator = adams_bashforth2\ncpi.healing = 4\ncpi.window = 6\n"
+        "cpi.projection = adaptive\ncpi.integrator = adams_bashforth2\ncpi.healing = 4\ncpi.window "
+        "= 6\n"
         "cpi.tolerance = 0.05\ncpi.dt_max = 60\n",
         "scene.cfg", "/scenes");
     const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.5);
@@ -344,7 +364,8 @@ TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive w
     CHECK(s.make_integrator({})->name() == "adaptive_adams_bashforth2");
 
     // Fixed DT with Adams-Bashforth 2: the multistep integrator without the controller.
-    ParamTable ab2 = ParamTable::from_text("cpi.integrator = adams_bashforth2\ncpi.dt = 40\n", "scene.cfg", "/scenes");
+    ParamTable ab2 = ParamTable::from_text("cpi.integrator = adams_bashforth2\ncpi.dt = 40\n",
+                                           "scene.cfg", "/scenes");
     const CoarseRunSettings f = CoarseRunSettings::from_params(ab2.root().scope("cpi"), 0.5);
     CHECK(!f.multistep.adaptive);
     CHECK(f.multistep.dt == 40.0);
@@ -352,29 +373,38 @@ TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive w
 
     auto refused = [](const std::string& text) {
         ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
-        return std::string(test::input_error([&] { CoarseRunSettings::from_params(t.root().scope("cpi"), 0.5); }).what());
+        return std::string(test::input_error([&] {
+                               CoarseRunSettings::from_params(t.root().scope("cpi"), 0.5);
+                           }).what());
     };
     // Each message names the key, the file and line, and what is allowed.
     CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0\n"),
                Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.tolerance"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = -1\n"), Catch::Contains("cpi.tolerance"));
-    CHECK_THAT(refused("cpi.projection = adaptive\n"), Catch::Contains("cpi.tolerance"));  // required
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 50\ncpi.dt_max = 20\n"),
-               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.dt_min") && Catch::Contains("cpi.dt_max = 20"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = -1\n"),
+               Catch::Contains("cpi.tolerance"));
+    CHECK_THAT(refused("cpi.projection = adaptive\n"),
+               Catch::Contains("cpi.tolerance"));  // required
+    CHECK_THAT(
+        refused(
+            "cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 50\ncpi.dt_max = 20\n"),
+        Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.dt_min") &&
+            Catch::Contains("cpi.dt_max = 20"));
     CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.periods = 2\n"),
                Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.periods") &&
                    Catch::Contains("not read with cpi.projection = adaptive"));
     CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt = 500\n"),
                Catch::Contains("cpi.dt") && Catch::Contains("caps the first jump"));
-    CHECK_THAT(refused("cpi.projection = fixed\ncpi.tolerance = 0.1\n"),
-               Catch::Contains("cpi.tolerance") && Catch::Contains("only with cpi.projection = adaptive"));
+    CHECK_THAT(
+        refused("cpi.projection = fixed\ncpi.tolerance = 0.1\n"),
+        Catch::Contains("cpi.tolerance") && Catch::Contains("only with cpi.projection = adaptive"));
     CHECK_THAT(refused("cpi.projection = periods\ncpi.integrator = adams_bashforth2\n"),
                Catch::Contains("cpi.integrator") && Catch::Contains("periods"));
     CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 0.3\n"),
                Catch::Contains("cpi.dt_min"));  // not a whole multiple of the sampling interval
 }
 
-TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drifting", "[unit][coarse][run]") {
+TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drifting",
+          "[unit][coarse][run]") {
     // Component 0 (the phase signal) relaxes fast, X0 = 3 e^(-0.5 t); the others slowly. The
     // allowed drift is tolerance / burst = 0.05 / 6: the exact drift 1.5 e^(-0.5 t) falls below it
     // at t = 10.4 (2 s.e. of 8 members' slopes with sigma = 0.005 is ~1e-3, smaller). The
@@ -388,9 +418,11 @@ TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drift
         void warmup_done(const ProjectiveRun&) override { t = stepper->time(); }
     };
     for (const std::string until : {"steady", "time"}) {
-        ParamTable table = ParamTable::from_text("cpi.projection = adaptive\ncpi.tolerance = 0.05\ncpi.healing = 2\n"
-                                                 "cpi.window = 4\ncpi.warmup = 1\ncpi.warmup_until = " + until + "\n",
-                                                 "scene.cfg", "/scenes");
+        ParamTable table = ParamTable::from_text(
+            "cpi.projection = adaptive\ncpi.tolerance = 0.05\ncpi.healing = 2\n"
+            "cpi.window = 4\ncpi.warmup = 1\ncpi.warmup_until = " +
+                until + "\n",
+            "scene.cfg", "/scenes");
         const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.1);
         test::OuEnsembleStepper toy(k, 0.005, 8, 0.1, Eigen::VectorXd::Constant(5, 3.0), 2);
         ProjectiveRun run(s, toy, variable("ou"));
@@ -411,12 +443,15 @@ TEST_CASE("a burst that ends the run up to round-off leaves no jump", "[unit][co
     // Seen before: the last burst of 16 time units ended at 16 - 3.5e-12 and the jump
     // "DT = 3.5e-12" was projected and lifted. Within the time tolerance nothing is left.
     CHECK(end_of_run_jump_limit(16.0 - 3.5e-12, 16.0, 1.5, 1.5) == 0.0);
-    CHECK(end_of_run_jump_limit(14.0, 16.0, 1.5, 1.5) == Approx(0.5));  // shortened to leave a burst
+    CHECK(end_of_run_jump_limit(14.0, 16.0, 1.5, 1.5) ==
+          Approx(0.5));  // shortened to leave a burst
     CHECK(end_of_run_jump_limit(13.0, 16.0, 3.0, 1.5) == Approx(3.0));  // the jump ends the run
-    CHECK(end_of_run_jump_limit(12.0, 16.0, 3.0, 1.5) == Approx(2.5));  // leaves room for a last burst
+    CHECK(end_of_run_jump_limit(12.0, 16.0, 3.0, 1.5) ==
+          Approx(2.5));  // leaves room for a last burst
 }
 
-TEST_CASE("a direct run reads the cpi block without checking it against the sampling grid", "[unit][coarse][run]") {
+TEST_CASE("a direct run reads the cpi block without checking it against the sampling grid",
+          "[unit][coarse][run]") {
     // LAMMPS' dt = 1.8e-4 makes observe.interval = 0.09: the defaults (healing 10, window 10)
     // are not multiples of it. A cpi run refuses that, naming the key; a direct run does not use
     // them and must not.

@@ -227,9 +227,10 @@ TEST_CASE("members' slopes: their mean is the ensemble slope, their spread / sqr
     CHECK(mean_se2 == Approx(expected_se2).epsilon(0.03));
 }
 
-TEST_CASE("with noise correlated in time the members' s.e. is the slope's real error; the "
-          "white-noise formula on the mean's residuals is several times too small",
-          "[unit][coarse]") {
+TEST_CASE(
+    "with noise correlated in time the members' s.e. is the slope's real error; the "
+    "white-noise formula on the mean's residuals is several times too small",
+    "[unit][coarse]") {
     // AR(1) noise with rho = 0.9 (correlation time ~10 samples) over a 41-sample window.
     constexpr int kMembers = 8, kDim = 4, kTrials = 2000;
     constexpr double kSigma = 0.3, kRho = 0.9;
@@ -272,7 +273,7 @@ TEST_CASE("the members' s.e. needs two members, members for every sample, and a 
     const NoisyMembers one = noisy_members(rng, 1, 3, t, 0.0, 0.3, 0.0);
     CHECK(member_least_squares_slopes(one.t, one.members, 0.0).rows() == 1);
     CHECK(member_slope_standard_error(one.t, one.members, 0.0).size() == 0);  // R = 1: no spread
-    CHECK(member_slope_standard_error(t, {}, 0.0).size() == 0);              // no members
+    CHECK(member_slope_standard_error(t, {}, 0.0).size() == 0);               // no members
     const NoisyMembers two = noisy_members(rng, 2, 3, t, 0.0, 0.3, 0.0);
     CHECK(member_slope_standard_error(two.t, two.members, 0.0).size() == 3);
     CHECK(member_slope_standard_error(two.t, two.members, t.back()).size() == 0);  // 1 sample

@@ -17,7 +17,8 @@ using namespace efdem;
 using namespace efdem::coarse;
 
 namespace {
-/// x' = -0.1 (x - x*) in two components, exactly per interval 0.5: Phi_tau(X) = x* + e^{-0.1 tau}(X - x*).
+/// x' = -0.1 (x - x*) in two components, exactly per interval 0.5: Phi_tau(X) = x* + e^{-0.1 tau}(X
+/// - x*).
 test::AffineToyStepper decaying(const Eigen::Vector2d& x_star) {
     return {std::exp(-0.1 * 0.5) * Eigen::Matrix2d::Identity(), x_star, 0.5};
 }
@@ -35,7 +36,8 @@ SteadyRunSettings newton_settings() {
 }
 }  // namespace
 
-TEST_CASE("SteadyRun: warm-up, Newton solve and spectrum; every iterate observed", "[unit][steady]") {
+TEST_CASE("SteadyRun: warm-up, Newton solve and spectrum; every iterate observed",
+          "[unit][steady]") {
     const Eigen::Vector2d x_star(3.0, 5.0);
     test::AffineToyStepper toy = decaying(x_star);
     toy.lift(Eigen::Vector2d(0.0, 0.0), 0.0);
@@ -57,7 +59,8 @@ TEST_CASE("SteadyRun: warm-up, Newton solve and spectrum; every iterate observed
     REQUIRE(out.spectrum.leading.size() == 2);
     // Both eigenvalues are e^{-0.1 tau}; the rate log|mu|/tau recovers -0.1 (1e-7: the
     // differences' round-off eps |X| / h ~ 1e-9, divided by mu tau).
-    for (const CoarseEigenvalue& e : out.spectrum.leading) CHECK(e.rate == Approx(-0.1).margin(1e-6));
+    for (const CoarseEigenvalue& e : out.spectrum.leading)
+        CHECK(e.rate == Approx(-0.1).margin(1e-6));
     CHECK(out.micro_time == Approx(out.tau * static_cast<double>(out.evaluations)).epsilon(1e-14));
 }
 
@@ -119,9 +122,11 @@ TEST_CASE("SteadyRun: continuation in a scaled parameter reports the branch in t
           "[unit][steady]") {
     // x' = lambda - x (one member, no noise): the steady state is x = lambda, stable with
     // mu = e^{-tau}. Continued from 0.2 to 0.6 in lambda / 0.1.
-    test::SdeEnsembleStepper toy([](const Eigen::VectorXd& x, double lambda) -> Eigen::VectorXd {
-        return Eigen::VectorXd::Constant(x.size(), lambda) - x;
-    }, 0.0, 1, 0.01, 10, Eigen::VectorXd::Zero(1), 1);
+    test::SdeEnsembleStepper toy(
+        [](const Eigen::VectorXd& x, double lambda) -> Eigen::VectorXd {
+            return Eigen::VectorXd::Constant(x.size(), lambda) - x;
+        },
+        0.0, 1, 0.01, 10, Eigen::VectorXd::Zero(1), 1);
     SteadyRunSettings s = newton_settings();
     s.continuation = true;
     s.map.tau = 1.0;
@@ -148,7 +153,8 @@ TEST_CASE("SteadyRun: continuation in a scaled parameter reports the branch in t
     long points_seen = 0;
     run.set_point_observer([&](const Branch& b) {
         ++points_seen;
-        CHECK(b.points.back().parameter == Approx(b.points.back().x[0]).margin(1e-7));  // scene units
+        CHECK(b.points.back().parameter ==
+              Approx(b.points.back().x[0]).margin(1e-7));  // scene units
     });
     const SteadyRunOutcome out = run.run();
     INFO(out.branch.end_reason);
@@ -158,8 +164,10 @@ TEST_CASE("SteadyRun: continuation in a scaled parameter reports the branch in t
     REQUIRE(out.branch.points.size() == 5);
     CHECK(points_seen == static_cast<long>(out.branch.points.size()));
     for (std::size_t k = 0; k < out.branch.points.size(); ++k)
-        CHECK(out.branch.points[k].parameter == Approx(0.2 + 0.1 * static_cast<double>(k)).margin(1e-9));
-    CHECK(out.branch.end_reason.find("reached the end of the parameter range [0.2, 0.6] at 0.6") != std::string::npos);
+        CHECK(out.branch.points[k].parameter ==
+              Approx(0.2 + 0.1 * static_cast<double>(k)).margin(1e-9));
+    CHECK(out.branch.end_reason.find("reached the end of the parameter range [0.2, 0.6] at 0.6") !=
+          std::string::npos);
     for (const BranchPoint& p : out.branch.points) {
         // The corrector stops at |G| <= 1e-10 with a well-conditioned extended Jacobian.
         CHECK(p.x[0] == Approx(p.parameter).margin(1e-7));
@@ -170,8 +178,9 @@ TEST_CASE("SteadyRun: continuation in a scaled parameter reports the branch in t
     CHECK(set_to > 0.55);  // the hook saw scene units, not lambda / 0.1
 }
 
-TEST_CASE("gap coordinates: every lifted point is an increasing ICDF, the answer is reported in heights",
-          "[unit][steady]") {
+TEST_CASE(
+    "gap coordinates: every lifted point is an increasing ICDF, the answer is reported in heights",
+    "[unit][steady]") {
     const CoarseCoordinates gaps = icdf_gap_coordinates();
     const Eigen::Vector3d x(1.0, 1.5, 4.0);
     // u = (1, log 0.5, log 2.5); back to x to round-off.
@@ -206,7 +215,8 @@ TEST_CASE("gap coordinates: every lifted point is an increasing ICDF, the answer
     double worst = 0.0, first_ratio = 0.0;
     run.set_iterate_observer([&](const SteadySolveRecord& rec) {
         const double expected = contraction * (rec.x - Eigen::VectorXd(x_star)).norm();
-        worst = std::max(worst, std::abs(rec.state_residuals.back() - expected) / (expected + 1e-12));
+        worst =
+            std::max(worst, std::abs(rec.state_residuals.back() - expected) / (expected + 1e-12));
         if (observed++ == 0) first_ratio = rec.residuals.back() / rec.state_residuals.back();
         return std::string{};
     });
@@ -250,7 +260,8 @@ TEST_CASE("SteadyRun: without steady.difference_step, h is 6 x the noise at the 
     s.eigenvalues = 0;
     double expected2 = 0;
     for (int i = 0; i < 3; ++i)
-        expected2 += kSigma * kSigma * (1.0 - std::exp(-2.0 * k[i] * kWarmup)) / (2.0 * k[i]) / kMembers;
+        expected2 +=
+            kSigma * kSigma * (1.0 - std::exp(-2.0 * k[i] * kWarmup)) / (2.0 * k[i]) / kMembers;
     const double expected = std::sqrt(expected2);  // 0.0164
 
     SECTION("derived from the members' spread") {
@@ -269,7 +280,8 @@ TEST_CASE("SteadyRun: without steady.difference_step, h is 6 x the noise at the 
         double se2 = 0;
         for (Eigen::Index i = 0; i < m.cols(); ++i)
             se2 += (m.col(i).array() - mean[i]).square().sum() / (kMembers - 1) / kMembers;
-        CHECK(out.difference_step == Approx(s.difference_noise_multiple * std::sqrt(se2)).epsilon(1e-12));
+        CHECK(out.difference_step ==
+              Approx(s.difference_noise_multiple * std::sqrt(se2)).epsilon(1e-12));
     }
     SECTION("more than the map's curvature allows: capped at a quarter of |X|, with a warning") {
         s.difference_noise_multiple = 1e4;  // ~160, against |X| = |(1, -2, 3)| = 3.7

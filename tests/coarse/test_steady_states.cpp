@@ -67,8 +67,9 @@ CoarseMapSettings deterministic_map() {
 
 }  // namespace
 
-TEST_CASE("Newton-GMRES finds the fixed point of a linear stepper; Arnoldi recovers exp(lambda tau)",
-          "[unit][steady]") {
+TEST_CASE(
+    "Newton-GMRES finds the fixed point of a linear stepper; Arnoldi recovers exp(lambda tau)",
+    "[unit][steady]") {
     const LinearCase c;
     test::AffineToyStepper toy = c.stepper();
     CoarseMap map(toy, deterministic_map());
@@ -87,8 +88,9 @@ TEST_CASE("Newton-GMRES finds the fixed point of a linear stepper; Arnoldi recov
     // Each evaluation is one burst of tau: the record's micro time is exact.
     CHECK(rec.micro_time == Approx(kTau * static_cast<double>(rec.evaluations)).epsilon(1e-14));
     WARN("linear toy, Newton-GMRES: " << rec.iterations << " Newton steps, " << rec.evaluations
-                                      << " evaluations (" << rec.micro_time << " micro time), |x - x*| = "
-                                      << (rec.x - c.x_star).norm() << " (bound " << bound << ")");
+                                      << " evaluations (" << rec.micro_time
+                                      << " micro time), |x - x*| = " << (rec.x - c.x_star).norm()
+                                      << " (bound " << bound << ")");
 
     SpectrumSettings ss;
     ss.eigenvalues = 3;
@@ -104,29 +106,35 @@ TEST_CASE("Newton-GMRES finds the fixed point of a linear stepper; Arnoldi recov
         // rate = log|mu| / tau: an error 1e-7 in mu is 1e-7 / (mu tau) <= 4e-7 in the rate.
         CHECK(e.rate == Approx(c.lambda[k]).margin(1e-6));
     }
-    WARN("linear toy spectrum: mu = " << spec.leading[0].mu.real() << ", " << spec.leading[1].mu.real() << ", "
-                                      << spec.leading[2].mu.real() << " (exact " << std::exp(c.lambda[0] * kTau)
-                                      << ", " << std::exp(c.lambda[1] * kTau) << ", " << std::exp(c.lambda[2] * kTau)
-                                      << ") from " << spec.products << " products");
+    WARN("linear toy spectrum: mu = "
+         << spec.leading[0].mu.real() << ", " << spec.leading[1].mu.real() << ", "
+         << spec.leading[2].mu.real() << " (exact " << std::exp(c.lambda[0] * kTau) << ", "
+         << std::exp(c.lambda[1] * kTau) << ", " << std::exp(c.lambda[2] * kTau) << ") from "
+         << spec.products << " products");
 }
 
-TEST_CASE("GMRES solves a small nonsymmetric system and records a decreasing residual per product", "[unit][steady]") {
+TEST_CASE("GMRES solves a small nonsymmetric system and records a decreasing residual per product",
+          "[unit][steady]") {
     Eigen::Matrix3d a;
     a << 4, 1, 0, -1, 3, 2, 0.5, 0, 2;
     const Eigen::Vector3d b(1, 2, 3);
     GmresSettings gs;
     gs.relative_tolerance = 1e-12;
-    const GmresResult r = gmres([&a](const Eigen::VectorXd& x) -> Eigen::VectorXd { return a * x; }, b, gs);
+    const GmresResult r =
+        gmres([&a](const Eigen::VectorXd& x) -> Eigen::VectorXd { return a * x; }, b, gs);
     // In exact arithmetic GMRES is exact after n = 3 products; double round-off with a
     // condition number ~5 leaves ~1e-15 relative.
     CHECK(r.iterations == 3);
     CHECK((a * r.x - b).norm() <= 1e-12 * b.norm());
     REQUIRE(r.residuals.size() == 4);
-    for (std::size_t k = 1; k < r.residuals.size(); ++k) CHECK(r.residuals[k] <= r.residuals[k - 1]);
+    for (std::size_t k = 1; k < r.residuals.size(); ++k)
+        CHECK(r.residuals[k] <= r.residuals[k - 1]);
 }
 
-TEST_CASE("fixed-point iteration converges on the linear toy; Anderson beats damped; compared with Newton",
-          "[unit][steady]") {
+TEST_CASE(
+    "fixed-point iteration converges on the linear toy; Anderson beats damped; compared with "
+    "Newton",
+    "[unit][steady]") {
     const LinearCase c;
     auto solve = [&](int depth) {
         test::AffineToyStepper toy = c.stepper();
@@ -147,7 +155,8 @@ TEST_CASE("fixed-point iteration converges on the linear toy; Anderson beats dam
     // slowest mode's mu = exp(-0.05 tau) = 0.9048, with an error (0.67/0.905)^k < 1e-6 after
     // the ~230 iterations it needs.
     const std::size_t n = damped.residuals.size();
-    CHECK(damped.residuals[n - 1] / damped.residuals[n - 2] == Approx(std::exp(c.lambda[0] * kTau)).margin(1e-6));
+    CHECK(damped.residuals[n - 1] / damped.residuals[n - 2] ==
+          Approx(std::exp(c.lambda[0] * kTau)).margin(1e-6));
     // Anderson(3) on a 4-dimensional affine map is a Krylov method (GMRES-equivalent for
     // depth >= n; Walker & Ni 2011): it needs a few dozen evaluations against ~230.
     CHECK(anderson.evaluations * 4 < damped.evaluations);
@@ -158,11 +167,11 @@ TEST_CASE("fixed-point iteration converges on the linear toy; Anderson beats dam
     ns.stop.tolerance = 1e-10;
     FixedPointSystem system(map, 4);
     const SteadySolveRecord newton = NewtonKrylov(ns).solve(system, Eigen::Vector4d::Zero());
-    WARN("linear toy to |F| <= 1e-10 from 0: Newton-GMRES " << newton.iterations << " steps, " << newton.evaluations
-                                                            << " bursts, micro time " << newton.micro_time
-                                                            << "; Anderson(3) " << anderson.iterations << " iterations, "
-                                                            << anderson.micro_time << "; damped (beta = 1) "
-                                                            << damped.iterations << " iterations, " << damped.micro_time);
+    WARN("linear toy to |F| <= 1e-10 from 0: Newton-GMRES "
+         << newton.iterations << " steps, " << newton.evaluations << " bursts, micro time "
+         << newton.micro_time << "; Anderson(3) " << anderson.iterations << " iterations, "
+         << anderson.micro_time << "; damped (beta = 1) " << damped.iterations << " iterations, "
+         << damped.micro_time);
 }
 
 namespace {
@@ -185,8 +194,9 @@ double fold_leading_rate(double x) {
 
 }  // namespace
 
-TEST_CASE("pseudo-arclength continuation turns round a fold, where the leading eigenvalue crosses 1",
-          "[unit][steady]") {
+TEST_CASE(
+    "pseudo-arclength continuation turns round a fold, where the leading eigenvalue crosses 1",
+    "[unit][steady]") {
     // Deterministic: one member, RK4 with dt = 0.01 (the eigenvalues of the map are
     // exp(s tau) to ~1e-10).
     test::SdeEnsembleStepper toy(fold_drift, 0.0, 1, 0.01, 10, Eigen::Vector2d(-1, -1), 1);
@@ -200,7 +210,8 @@ TEST_CASE("pseudo-arclength continuation turns round a fold, where the leading e
     cs.parameter_min = -0.7;
     cs.max_points = 60;
     // From near the stable state at lambda = -0.7 (x = -1), lambda increasing.
-    const Branch b = PseudoArclengthContinuation(map, cs).run(Eigen::Vector2d(-1.05, -0.95), -0.7, +1.0);
+    const Branch b =
+        PseudoArclengthContinuation(map, cs).run(Eigen::Vector2d(-1.05, -0.95), -0.7, +1.0);
     INFO(b.end_reason);
     REQUIRE(b.points.size() >= 8);
     // Back on the stable side, the predictor heading below -0.7 is shortened to land there,
@@ -219,7 +230,8 @@ TEST_CASE("pseudo-arclength continuation turns round a fold, where the leading e
     const std::size_t at = folds.front().at;
     // lambda increases up to the fold, then decreases.
     for (std::size_t k = 1; k <= at; ++k) CHECK(b.points[k].parameter > b.points[k - 1].parameter);
-    for (std::size_t k = at + 1; k < b.points.size(); ++k) CHECK(b.points[k].parameter < b.points[k - 1].parameter);
+    for (std::size_t k = at + 1; k < b.points.size(); ++k)
+        CHECK(b.points[k].parameter < b.points[k - 1].parameter);
     // The vertex of the parabola through three points at most 0.2 apart in s: lambda(s) is a
     // parabola in x, and x(s) is straight up to O(s^2) near the fold (y = x there), so the
     // cubic error term is small against ds^3 = 8e-3 (measured 3.5e-6); 1e-4 is 0.4% of lambda.
@@ -238,9 +250,10 @@ TEST_CASE("pseudo-arclength continuation turns round a fold, where the leading e
     }
     CHECK(std::abs(b.points[at - 1].leading.mu) < 1.0);
     CHECK(std::abs(b.points[at + 1].leading.mu) > 1.0);
-    WARN("fold continuation: " << b.points.size() << " points, fold at lambda = " << folds.front().parameter
-                               << " (exact " << kFoldLambda << "), " << b.evaluations << " evaluations, micro time "
-                               << b.micro_time << "; " << b.end_reason);
+    WARN("fold continuation: " << b.points.size() << " points, fold at lambda = "
+                               << folds.front().parameter << " (exact " << kFoldLambda << "), "
+                               << b.evaluations << " evaluations, micro time " << b.micro_time
+                               << "; " << b.end_reason);
 }
 
 namespace {
@@ -308,8 +321,10 @@ CoarseMapSettings noisy_map(bool crn, double h) {
 
 }  // namespace
 
-TEST_CASE("on a noisy ensemble Newton-GMRES stops at the noise level, within the noise band of the fixed point",
-          "[unit][steady]") {
+TEST_CASE(
+    "on a noisy ensemble Newton-GMRES stops at the noise level, within the noise band of the fixed "
+    "point",
+    "[unit][steady]") {
     const NoisyCase c;
     test::SdeEnsembleStepper toy = c.stepper(7);
     CoarseMap map(toy, noisy_map(true, 1e-2));
@@ -330,12 +345,13 @@ TEST_CASE("on a noisy ensemble Newton-GMRES stops at the noise level, within the
     // The band is narrow against where the solve started, so landing in it is the solver's
     // doing (|x0 - c| = 1.12; the band is ~0.11 for 64 members).
     CHECK(band < 0.2 * (x0 - c.c).norm());
-    WARN("noisy toy: " << rec.iterations << " Newton steps, " << rec.evaluations << " bursts, |F| = "
-                       << rec.residuals.back() << ", noise " << noise << ", |x - c| = " << (rec.x - c.c).norm()
-                       << " within the band " << band);
+    WARN("noisy toy: " << rec.iterations << " Newton steps, " << rec.evaluations
+                       << " bursts, |F| = " << rec.residuals.back() << ", noise " << noise
+                       << ", |x - c| = " << (rec.x - c.c).norm() << " within the band " << band);
 }
 
-TEST_CASE("common random numbers make the ensemble's directional derivatives accurate", "[unit][steady]") {
+TEST_CASE("common random numbers make the ensemble's directional derivatives accurate",
+          "[unit][steady]") {
     const NoisyCase c;
     const Eigen::Vector3d x = c.c + Eigen::Vector3d(0.3, -0.2, 0.1);
     const Eigen::Vector3d v = Eigen::Vector3d(1.0, 1.0, 1.0).normalized();
@@ -373,14 +389,15 @@ TEST_CASE("common random numbers make the ensemble's directional derivatives acc
     // ~10% of k per member, averaged over 64): ~0.01. A ratio above 20 leaves a factor ~10.
     CHECK(without > 0.5);
     CHECK(without > 20.0 * with);
-    WARN("spread of J v over 12 micro states: with CRN " << with << " (reported " << with_reported << "), without "
-                                                          << without << " (reported " << without_reported << "; ratio "
-                                                          << without / with << ")");
+    WARN("spread of J v over 12 micro states: with CRN "
+         << with << " (reported " << with_reported << "), without " << without << " (reported "
+         << without_reported << "; ratio " << without / with << ")");
 }
 
-
-TEST_CASE("a fallback first guess is tried only when the first guess is noisy and far, and the closer one starts",
-          "[unit][steady]") {
+TEST_CASE(
+    "a fallback first guess is tried only when the first guess is noisy and far, and the closer "
+    "one starts",
+    "[unit][steady]") {
     const NoisyCase c;
     test::SdeEnsembleStepper toy = c.stepper(5);
     CoarseMap map(toy, noisy_map(true, 1e-2));
@@ -416,7 +433,8 @@ TEST_CASE("a fallback first guess is tried only when the first guess is noisy an
         CHECK(system.begun[2] == Eigen::VectorXd(near));
         // A fresh evaluation at the same point: the same |F| up to the noise (4 x its norm
         // bounds the difference of two independent errors, as in the stopping rule).
-        CHECK(rec.residuals.front() == Approx(rec.first_guess_residual).margin(4.0 * rec.noise.front()));
+        CHECK(rec.residuals.front() ==
+              Approx(rec.first_guess_residual).margin(4.0 * rec.noise.front()));
         CHECK(rec.converged());
     }
     SECTION("a first guess within the ratio: the fallback is never evaluated") {
@@ -431,21 +449,26 @@ TEST_CASE("a fallback first guess is tried only when the first guess is noisy an
     }
 }
 
-TEST_CASE("a noise-free map never evaluates the fallback: its predictor is as good as the branch is smooth",
-          "[unit][steady]") {
+TEST_CASE(
+    "a noise-free map never evaluates the fallback: its predictor is as good as the branch is "
+    "smooth",
+    "[unit][steady]") {
     const LinearCase c;
     test::AffineToyStepper toy = c.stepper();
     CoarseMap map(toy, deterministic_map());
     FixedPointSystem fixed(map, 4);
     CallLog system(fixed);
     const FallbackGuess fallback{c.x_star, 0.0};  // even with ratio 0 and the exact answer
-    const SteadySolveRecord rec = NewtonKrylov{NewtonKrylovSettings{}}.solve(system, Eigen::Vector4d::Zero(), &fallback);
+    const SteadySolveRecord rec =
+        NewtonKrylov{NewtonKrylovSettings{}}.solve(system, Eigen::Vector4d::Zero(), &fallback);
     CHECK(std::isnan(rec.fallback_residual));
     CHECK(system.calls.substr(0, 2) == "bj");
 }
 
-TEST_CASE("a predictor that overshoots a sharp turn of the branch hands over to the last point held at the new parameter",
-          "[unit][steady]") {
+TEST_CASE(
+    "a predictor that overshoots a sharp turn of the branch hands over to the last point held at "
+    "the new parameter",
+    "[unit][steady]") {
     // x' = -2 (x - tanh((lambda - 0.15)/0.03)) in two components: the steady state jumps from
     // -1 to +1 within ~0.1 of lambda. Past the jump the secant through the two points on its
     // flanks extrapolates the jump (|F| ~ 2 at the predictor) while the last point is already
@@ -471,7 +494,8 @@ TEST_CASE("a predictor that overshoots a sharp turn of the branch hands over to 
     int held = 0;
     for (std::size_t k = 0; k < b.points.size(); ++k) {
         const BranchPoint& p = b.points[k];
-        INFO("point " << k << " at lambda = " << p.parameter << (p.from_fallback ? " (from the last point)" : ""));
+        INFO("point " << k << " at lambda = " << p.parameter
+                      << (p.from_fallback ? " (from the last point)" : ""));
         // Every point is steady to its noise band: F = (e^{-2 tau} - 1)(x - x*) + noise, |F| <=
         // 2 noise at the stop and |noise| <= 2 noise, so |x - x*| <= 4 noise / (1 - e^{-4})
         // (noise ~ 1e-4 for sigma = 1e-3 over 16 members).
@@ -484,8 +508,10 @@ TEST_CASE("a predictor that overshoots a sharp turn of the branch hands over to 
             // (GMRES meets the linear constraint row to its forcing x |G|: 1e-6 is ample).
             const BranchPoint& q = b.points[k - 1];
             const BranchPoint& o = b.points[k - 2];
-            const double chord = std::sqrt((q.x - o.x).squaredNorm() + std::pow(q.parameter - o.parameter, 2));
-            const double predicted = std::min(q.parameter + p.step * (q.parameter - o.parameter) / chord, 0.6);
+            const double chord =
+                std::sqrt((q.x - o.x).squaredNorm() + std::pow(q.parameter - o.parameter, 2));
+            const double predicted =
+                std::min(q.parameter + p.step * (q.parameter - o.parameter) / chord, 0.6);
             CHECK(p.parameter == Approx(predicted).margin(1e-6));
         }
     }
@@ -494,28 +520,32 @@ TEST_CASE("a predictor that overshoots a sharp turn of the branch hands over to 
     // The same branch without the fallback (same seed) ran through the turn in more, shorter
     // steps after failed correctors: measured 373 evaluations against 285.
     test::SdeEnsembleStepper again(drift, 1e-3, 16, 0.01, 10, Eigen::Vector2d(-1, -1), 9);
-    CoarseMap map_again(again, noisy_map(true, 1e-2), [&again](double lambda) { again.set_parameter(lambda); });
+    CoarseMap map_again(again, noisy_map(true, 1e-2),
+                        [&again](double lambda) { again.set_parameter(lambda); });
     cs.fallback_ratio = 1e6;
-    const Branch without = PseudoArclengthContinuation(map_again, cs).run(Eigen::Vector2d(-1, -1), 0.0, +1.0);
+    const Branch without =
+        PseudoArclengthContinuation(map_again, cs).run(Eigen::Vector2d(-1, -1), 0.0, +1.0);
     CHECK(b.evaluations < without.evaluations);
-    WARN("sharp turn: " << b.points.size() << " points, " << held << " from the last point, " << b.evaluations
-                        << " evaluations (without the fallback: " << without.points.size() << " points, "
-                        << without.evaluations << " evaluations); " << b.end_reason);
+    WARN("sharp turn: " << b.points.size() << " points, " << held << " from the last point, "
+                        << b.evaluations
+                        << " evaluations (without the fallback: " << without.points.size()
+                        << " points, " << without.evaluations << " evaluations); " << b.end_reason);
 }
 
-TEST_CASE("a fallback with its own system: the solve goes on in it from the fallback's kept state", "[unit][steady]") {
+TEST_CASE("a fallback with its own system: the solve goes on in it from the fallback's kept state",
+          "[unit][steady]") {
     const NoisyCase c;
     test::SdeEnsembleStepper toy = c.stepper(5);
     CoarseMap map(toy, noisy_map(true, 1e-2));
     FixedPointSystem fixed(map, 3);
     CallLog first(fixed), second(fixed);
     FallbackGuess fallback{c.c + Eigen::Vector3d::Constant(0.3), 2.0, &second};
-    const SteadySolveRecord rec =
-        NewtonKrylov{NewtonKrylovSettings{}}.solve(first, c.c + Eigen::Vector3d::Constant(1.0), &fallback);
+    const SteadySolveRecord rec = NewtonKrylov{NewtonKrylovSettings{}}.solve(
+        first, c.c + Eigen::Vector3d::Constant(1.0), &fallback);
     INFO(rec.message);
     CHECK(rec.from_fallback);
-    CHECK(first.calls == "be");                   // evaluated once, then left
-    CHECK(second.calls.substr(0, 2) == "bj");     // the fallback's state serves the first products
+    CHECK(first.calls == "be");                // evaluated once, then left
+    CHECK(second.calls.substr(0, 2) == "bj");  // the fallback's state serves the first products
     CHECK(rec.converged());
 }
 
@@ -532,7 +562,8 @@ struct WatchedFold {
 };
 }  // namespace
 
-TEST_CASE("an arclength corrector never runs the micro model at a parameter outside its bounds", "[unit][steady]") {
+TEST_CASE("an arclength corrector never runs the micro model at a parameter outside its bounds",
+          "[unit][steady]") {
     WatchedFold fold;
     CoarseMap& map = fold.map;
     double& highest = fold.highest;
@@ -553,7 +584,8 @@ TEST_CASE("an arclength corrector never runs the micro model at a parameter outs
     system.end();
 }
 
-TEST_CASE("a difference whose forward point leaves the parameter bounds is taken backwards", "[unit][steady]") {
+TEST_CASE("a difference whose forward point leaves the parameter bounds is taken backwards",
+          "[unit][steady]") {
     WatchedFold fold;
     CoarseMap& map = fold.map;
     double& highest = fold.highest;

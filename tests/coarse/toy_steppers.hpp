@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
 #include <optional>
 #include <random>
-#include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
 
@@ -140,8 +140,8 @@ class MemberTrendStepper final : public coarse::CoarseStepper {
  */
 class OuEnsembleStepper final : public coarse::CoarseStepper {
   public:
-    OuEnsembleStepper(Eigen::VectorXd rates, double sigma, int members, double h, const Eigen::VectorXd& x0,
-                      std::uint64_t seed)
+    OuEnsembleStepper(Eigen::VectorXd rates, double sigma, int members, double h,
+                      const Eigen::VectorXd& x0, std::uint64_t seed)
         : k_(std::move(rates)), sigma_(sigma), h_(h), y_(members, k_.size()) {
         for (int r = 0; r < members; ++r) {
             y_.row(r) = x0.transpose();
@@ -152,12 +152,14 @@ class OuEnsembleStepper final : public coarse::CoarseStepper {
     void run(double duration, coarse::BurstSamples& out) override {
         const long n = std::lround(duration / h_);
         const Eigen::ArrayXd decay = (-k_.array() * h_).exp();
-        const Eigen::ArrayXd amp = sigma_ * ((1.0 - (-2.0 * k_.array() * h_).exp()) / (2.0 * k_.array())).sqrt();
+        const Eigen::ArrayXd amp =
+            sigma_ * ((1.0 - (-2.0 * k_.array() * h_).exp()) / (2.0 * k_.array())).sqrt();
         std::normal_distribution<double> normal;
         for (long s = 0; s < n; ++s) {
             for (Eigen::Index r = 0; r < y_.rows(); ++r)
                 for (Eigen::Index i = 0; i < y_.cols(); ++i)
-                    y_(r, i) = decay[i] * y_(r, i) + amp[i] * normal(rng_[static_cast<std::size_t>(r)]);
+                    y_(r, i) =
+                        decay[i] * y_(r, i) + amp[i] * normal(rng_[static_cast<std::size_t>(r)]);
             ++steps_;
             t_ = t_lift_ + static_cast<double>(steps_) * h_;
             out.t.push_back(t_);

@@ -10,11 +10,13 @@
 
 using efdem::Bounds;
 using efdem::InputError;
-using efdem::test::input_error;
 using efdem::ParamTable;
+using efdem::test::input_error;
 
 namespace {
-ParamTable scene(const char* text) { return ParamTable::from_text(text, "bed.cfg", "/scenes"); }
+ParamTable scene(const char* text) {
+    return ParamTable::from_text(text, "bed.cfg", "/scenes");
+}
 
 }  // namespace
 
@@ -76,7 +78,8 @@ TEST_CASE("optional keys record the default that was used", "[unit][params]") {
 TEST_CASE("error: a non-numeric value names file, line, key, value and what is allowed",
           "[unit][params]") {
     auto t = scene("dt = 1e-4\npair_contact.kn = abc\n");
-    const auto e = input_error([&] { t.scope("pair_contact").get<double>("kn", Bounds::positive()); });
+    const auto e =
+        input_error([&] { t.scope("pair_contact").get<double>("kn", Bounds::positive()); });
     CHECK(e.where().file == "bed.cfg");
     CHECK(e.where().line == 2);
     CHECK(e.key() == "pair_contact.kn");
@@ -91,7 +94,8 @@ TEST_CASE("error: a non-numeric value names file, line, key, value and what is a
 TEST_CASE("error: out-of-range, non-finite, wrong arity and non-integer values", "[unit][params]") {
     auto t = scene("a = -5\nb = nan\nc = 1 2\nd = 2.5\ne = maybe\ng = 0 0\n");
     auto p = t.root();
-    CHECK(input_error([&] { p.get<double>("a", Bounds::positive()); }).problem() == "is out of range");
+    CHECK(input_error([&] { p.get<double>("a", Bounds::positive()); }).problem() ==
+          "is out of range");
     CHECK(input_error([&] { p.get<double>("b"); }).problem() == "is not a finite number");
     CHECK(input_error([&] { p.get<double>("c"); }).problem() == "expected one value, got 2");
     CHECK(input_error([&] { p.get<int>("d"); }).problem() == "is not an integer");
@@ -103,8 +107,7 @@ TEST_CASE("error: a missing required key suggests a misspelt one", "[unit][param
     auto t = scene("dt = 1e-4\npair_contact.kN = 2e5\n");
     const auto e = input_error([&] { t.scope("pair_contact").get<double>("kn"); });
     CHECK(e.key() == "pair_contact.kn");
-    CHECK(e.problem() ==
-          "is required but missing; did you mean 'pair_contact.kN' at bed.cfg:2?");
+    CHECK(e.problem() == "is required but missing; did you mean 'pair_contact.kN' at bed.cfg:2?");
 }
 
 TEST_CASE("error: an unused key is named, with the closest key that was read", "[unit][params]") {
@@ -137,7 +140,8 @@ TEST_CASE("error: a word not in the allowed list lists the allowed words", "[uni
 }
 
 TEST_CASE("error: syntax errors, bad key names and duplicates", "[unit][params]") {
-    CHECK(input_error([] { scene("dt 1e-4\n"); }).problem() == "expected 'key = value', got 'dt 1e-4'");
+    CHECK(input_error([] { scene("dt 1e-4\n"); }).problem() ==
+          "expected 'key = value', got 'dt 1e-4'");
     CHECK(input_error([] { scene("1dt = 3\n"); }).problem() == "is not a valid key name");
     CHECK(input_error([] { scene("dt =\n"); }).problem() == "has no value");
     CHECK(input_error([] { scene("name = \"open\n"); }).problem() == "has an unterminated quote");
@@ -147,7 +151,9 @@ TEST_CASE("error: syntax errors, bad key names and duplicates", "[unit][params]"
     CHECK(input_error([] {
               auto t = scene("dt = 1\n");
               t.add_override("justaword");
-          }).where().file == "<command line>");
+          })
+              .where()
+              .file == "<command line>");
 }
 
 TEST_CASE("a missing scene file is an input error naming the file", "[unit][params]") {

@@ -34,8 +34,7 @@ TEST_CASE("the first draws of a stream are pinned (portable across standard libr
     CHECK(s.normal() == Approx(-0.018802784249117226).epsilon(1e-14));
 }
 
-TEST_CASE("streams of different purposes, realizations or seeds are uncorrelated",
-          "[unit][rng]") {
+TEST_CASE("streams of different purposes, realizations or seeds are uncorrelated", "[unit][rng]") {
     // For n independent uniforms the sample correlation has standard deviation 1/sqrt(n);
     // 5 sigma (0.025 for n = 40000) is a bound a correct generator fails with p ~ 6e-7.
     const int n = 40000;
@@ -43,7 +42,11 @@ TEST_CASE("streams of different purposes, realizations or seeds are uncorrelated
         double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
         for (int i = 0; i < n; ++i) {
             const double x = a.uniform(), y = b.uniform();
-            sa += x; sb += y; saa += x * x; sbb += y * y; sab += x * y;
+            sa += x;
+            sb += y;
+            saa += x * x;
+            sbb += y * y;
+            sab += x * y;
         }
         const double cov = sab / n - (sa / n) * (sb / n);
         return cov / std::sqrt((saa / n - sa * sa / n / n) * (sbb / n - sb * sb / n / n));

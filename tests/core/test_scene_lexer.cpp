@@ -24,8 +24,9 @@ efdem::InputError scene_line_error(std::string_view text) {
     return input_error([&] { parse_assignment(text, {"bed.cfg", 7}, AssignmentForm::scene_line); });
 }
 efdem::InputError command_line_error(std::string_view text) {
-    return input_error(
-        [&] { parse_assignment(text, {"<command line>", 0}, AssignmentForm::command_line); });
+    return input_error([&] {
+        parse_assignment(text, {"<command line>", 0}, AssignmentForm::command_line);
+    });
 }
 }  // namespace
 

@@ -74,8 +74,9 @@ TEST_CASE("the bed time series is CSV as pandas reads it: column names first, on
         series.write(s);
     }
     const test::CsvTable t = test::read_csv_table(file);
-    CHECK(t.header == std::vector<std::string>{"step", "time", "pressure_drop", "weight_per_area", "bed_height",
-                                               "z_com", "z_com_light", "z_com_heavy", "ke_per_particle"});
+    CHECK(t.header == std::vector<std::string>{"step", "time", "pressure_drop", "weight_per_area",
+                                               "bed_height", "z_com", "z_com_light", "z_com_heavy",
+                                               "ke_per_particle"});
     REQUIRE(t.rows.size() == 2);
     CHECK(t.ragged_rows() == 0);
     const auto& last = t.rows.back();
@@ -102,7 +103,8 @@ TEST_CASE("the Lacey mixing index: 0 for species in separate layers, 1 for a ran
     RandomStream rng(7, 0, "test");
     Tag tag = 1;
     for (int k = 0; k < 4000; ++k)
-        p.add(tag++, {0.5, 0.5, 0.5 + k / 400}, {}, static_cast<SpeciesId>(rng.uniform() < 0.5 ? 0 : 1), species);
+        p.add(tag++, {0.5, 0.5, 0.5 + k / 400}, {},
+              static_cast<SpeciesId>(rng.uniform() < 0.5 ? 0 : 1), species);
     CHECK(std::abs(lacey_mixing_index(p, 0, 1.0) - 1.0) < 0.005);
     // Undefined: one species only, or one occupied layer.
     CHECK(std::isnan(lacey_mixing_index(lattice(1), 0, 1.0)));

@@ -15,7 +15,8 @@ using namespace efdem;
 using namespace efdem::dem;
 
 namespace {
-const std::filesystem::path kBed = std::filesystem::path(EFDEM_TEST_DATA_DIR) / "packed_bed_12500.data.gz";
+const std::filesystem::path kBed =
+    std::filesystem::path(EFDEM_TEST_DATA_DIR) / "packed_bed_12500.data.gz";
 
 std::filesystem::path write_text(const std::string& name, const std::string& text) {
     const auto path = std::filesystem::temp_directory_path() / name;
@@ -60,7 +61,8 @@ TEST_CASE("the reference bed loads: 12,500 spheres, 6,250 of each species, the r
 TEST_CASE("broken LAMMPS data files are input errors naming the file and the line", "[unit][io]") {
     const auto species = test::binary_species();
     const std::string header =
-        "title\n\n3 atoms\n2 atom types\n\n0 4 xlo xhi\n0 4 ylo yhi\n0 10 zlo zhi\n\nAtoms # sphere\n\n";
+        "title\n\n3 atoms\n2 atom types\n\n0 4 xlo xhi\n0 4 ylo yhi\n0 10 zlo zhi\n\nAtoms # "
+        "sphere\n\n";
     auto error_of = [&](const std::filesystem::path& path, const Domain& d) -> InputError {
         try {
             read_lammps_data(path, species, d);
@@ -72,10 +74,12 @@ TEST_CASE("broken LAMMPS data files are input errors naming the file and the lin
     };
     const Domain d{4, 4};
     SECTION("missing file") {
-        CHECK(error_of("/nonexistent/bed.data", d).problem().find("not found") != std::string::npos);
+        CHECK(error_of("/nonexistent/bed.data", d).problem().find("not found") !=
+              std::string::npos);
     }
     SECTION("truncated: fewer atoms than announced") {
-        const auto f = write_text("efdem_trunc.data", header + "1 1 1 1 0.5 0.5 0.5\n2 2 1 2 1.5 0.5 0.5\n");
+        const auto f =
+            write_text("efdem_trunc.data", header + "1 1 1 1 0.5 0.5 0.5\n2 2 1 2 1.5 0.5 0.5\n");
         CHECK(error_of(f, d).problem().find("announces 3 atoms") != std::string::npos);
     }
     SECTION("a non-number") {
@@ -93,7 +97,9 @@ TEST_CASE("broken LAMMPS data files are input errors naming the file and the lin
         CHECK(error_of(f, d).problem().find("species 'heavy'") != std::string::npos);
     }
     SECTION("box that does not match the domain") {
-        const auto f = write_text("efdem_box.data", header + "1 1 1 1 0.5 0.5 0.5\n2 1 1 1 1.5 0.5 0.5\n3 1 1 1 2.5 0.5 0.5\n");
+        const auto f =
+            write_text("efdem_box.data",
+                       header + "1 1 1 1 0.5 0.5 0.5\n2 1 1 1 1.5 0.5 0.5\n3 1 1 1 2.5 0.5 0.5\n");
         const auto e = error_of(f, Domain{5, 4});
         INFO(e.what());
         CHECK(e.problem().find("domain.lx = 5") != std::string::npos);

@@ -41,7 +41,8 @@ PairSet listed(const NeighborList& list, const Particles& p, const Domain& d) {
             // The stored image must be the nearest one.
             const Vec3 dx = p.x()[i] - p.x()[j] - list.shifts()[NeighborList::code(e)];
             REQUIRE(norm2(dx) == Approx(norm2(d.minimum_image(p.x()[i] - p.x()[j]))));
-            const auto key = std::make_pair(std::min(p.tag()[i], p.tag()[j]), std::max(p.tag()[i], p.tag()[j]));
+            const auto key =
+                std::make_pair(std::min(p.tag()[i], p.tag()[j]), std::max(p.tag()[i], p.tag()[j]));
             REQUIRE(out.insert(key).second);  // each pair listed once
         }
     return out;
@@ -97,7 +98,8 @@ TEST_CASE("the spatial sort is a permutation that keeps every particle's data to
     for (std::size_t k = 0; k < p.size(); ++k) REQUIRE(perm[k] == k);
 }
 
-TEST_CASE("rebuild_from_reference reproduces the list of the last build exactly", "[unit][neighbor]") {
+TEST_CASE("rebuild_from_reference reproduces the list of the last build exactly",
+          "[unit][neighbor]") {
     Particles p = random_particles(800, 9, 9, 9, 5);
     const Domain d{9, 9};
     NeighborList a(1.2, 0.1);
@@ -105,8 +107,10 @@ TEST_CASE("rebuild_from_reference reproduces the list of the last build exactly"
     a.build(p, d, perm);
     NeighborList b(1.2, 0.1);
     b.rebuild_from_reference(p, d, a.reference_positions());
-    REQUIRE(std::equal(a.offsets().begin(), a.offsets().end(), b.offsets().begin(), b.offsets().end()));
-    REQUIRE(std::equal(a.entries().begin(), a.entries().end(), b.entries().begin(), b.entries().end()));
+    REQUIRE(
+        std::equal(a.offsets().begin(), a.offsets().end(), b.offsets().begin(), b.offsets().end()));
+    REQUIRE(
+        std::equal(a.entries().begin(), a.entries().end(), b.entries().begin(), b.entries().end()));
 }
 
 TEST_CASE("contact history survives rebuilds and sorting, attached to the same particle pair",
@@ -126,13 +130,17 @@ TEST_CASE("contact history survives rebuilds and sorting, attached to the same p
                       static_cast<SpeciesId>(rng.below(2)), species);
     test::EffectList fx;
     fx.pair(test::paper_contact(), species);
-    System sys = test::make_system(species, {0.98 * nside, 0.98 * nside}, std::move(p), std::move(fx), 1e-4);
+    System sys =
+        test::make_system(species, {0.98 * nside, 0.98 * nside}, std::move(p), std::move(fx), 1e-4);
     sys.run(200);  // springs build up
     auto springs = [&] {
         std::map<std::pair<Tag, Tag>, Vec3> out;
-        for (const auto& r : sys.contact_history()->export_pairs(*sys.neighbor_list(), sys.particles())) {
-            if (r.tag_i < r.tag_j) out[{r.tag_i, r.tag_j}] = r.xi;
-            else out[{r.tag_j, r.tag_i}] = -r.xi;
+        for (const auto& r :
+             sys.contact_history()->export_pairs(*sys.neighbor_list(), sys.particles())) {
+            if (r.tag_i < r.tag_j)
+                out[{r.tag_i, r.tag_j}] = r.xi;
+            else
+                out[{r.tag_j, r.tag_i}] = -r.xi;
         }
         return out;
     };

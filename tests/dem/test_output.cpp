@@ -33,7 +33,6 @@ System three_particles() {
     return test::make_system(species, {5, 5}, std::move(p), std::move(fx), 1e-4);
 }
 
-
 /// The values of array `name` of a .vtp file written with raw appended data and UInt64 block
 /// headers, read the way a VTK reader does: the DataArray's offset counts from the byte after
 /// the '_' that opens the appended data; there a UInt64 byte count precedes the values.
@@ -72,7 +71,8 @@ TEST_CASE("the VTK series writes one .vtp per snapshot and a .pvd that lists the
     CHECK(pvd.find("timestep=\"0.001\" part=\"0\" file=\"bed_000001.vtp\"") != std::string::npos);
     const std::string vtp = slurp(dir / "bed_000001.vtp");
     const char* order = std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian";
-    CHECK(vtp.find(fmt::format("byte_order=\"{}\" header_type=\"UInt64\"", order)) != std::string::npos);
+    CHECK(vtp.find(fmt::format("byte_order=\"{}\" header_type=\"UInt64\"", order)) !=
+          std::string::npos);
     CHECK(vtp.find("NumberOfPoints=\"3\" NumberOfVerts=\"3\"") != std::string::npos);
     CHECK(vtp.find("format=\"ascii\"") == std::string::npos);
     CHECK(vtp.substr(vtp.size() - 30).find("</AppendedData>\n</VTKFile>\n") != std::string::npos);
@@ -81,8 +81,10 @@ TEST_CASE("the VTK series writes one .vtp per snapshot and a .pvd that lists the
     const Particles& p = s.particles();
     const auto tags = appended_array<std::int64_t>(vtp, "tag");
     CHECK(std::vector<std::int64_t>(p.tag().begin(), p.tag().end()) == tags);
-    CHECK(std::is_permutation(tags.begin(), tags.end(), std::vector<std::int64_t>{7, 8, 9}.begin()));
-    CHECK(appended_array<std::int32_t>(vtp, "species") == std::vector<std::int32_t>(p.species().begin(), p.species().end()));
+    CHECK(
+        std::is_permutation(tags.begin(), tags.end(), std::vector<std::int64_t>{7, 8, 9}.begin()));
+    CHECK(appended_array<std::int32_t>(vtp, "species") ==
+          std::vector<std::int32_t>(p.species().begin(), p.species().end()));
     CHECK(appended_array<std::int64_t>(vtp, "connectivity") == std::vector<std::int64_t>{0, 1, 2});
     CHECK(appended_array<std::int64_t>(vtp, "offsets") == std::vector<std::int64_t>{1, 2, 3});
     const auto names = appended_array<char>(vtp, "species_names");
@@ -105,7 +107,8 @@ TEST_CASE("the VTK series writes one .vtp per snapshot and a .pvd that lists the
         CHECK(appended_array<double>(vtp, name).size() == (std::string(name) == "mass" ? 3u : 9u));
 }
 
-TEST_CASE("the thermo log is CSV as pandas reads it: column names first, one row per call", "[unit][io]") {
+TEST_CASE("the thermo log is CSV as pandas reads it: column names first, one row per call",
+          "[unit][io]") {
     const auto file = std::filesystem::temp_directory_path() / "efdem_thermo_test.csv";
     System s = three_particles();
     {
@@ -115,9 +118,9 @@ TEST_CASE("the thermo log is CSV as pandas reads it: column names first, one row
         log.write(s);
     }
     const test::CsvTable t = test::read_csv_table(file);
-    CHECK(t.header == std::vector<std::string>{"step", "time", "ke_trans_per_particle", "ke_rot_per_particle",
-                                               "contacts_per_particle", "wall_contacts", "max_overlap",
-                                               "neighbor_builds"});
+    CHECK(t.header == std::vector<std::string>{"step", "time", "ke_trans_per_particle",
+                                               "ke_rot_per_particle", "contacts_per_particle",
+                                               "wall_contacts", "max_overlap", "neighbor_builds"});
     REQUIRE(t.rows.size() == 2);
     CHECK(t.ragged_rows() == 0);
     CHECK(t.rows.back()[0] == "100");
@@ -126,7 +129,8 @@ TEST_CASE("the thermo log is CSV as pandas reads it: column names first, one row
     CHECK_THROWS_AS(ThermoLog("/nonexistent_dir/x.csv"), RuntimeFailure);
 }
 
-TEST_CASE("a full disk under the thermo log is a runtime failure that says no space left", "[unit][output]") {
+TEST_CASE("a full disk under the thermo log is a runtime failure that says no space left",
+          "[unit][output]") {
     // /dev/full accepts the open and fails every write with ENOSPC: what a full disk does to a
     // log that is flushed after every line.
     if (!std::filesystem::exists("/dev/full")) {
@@ -137,12 +141,14 @@ TEST_CASE("a full disk under the thermo log is a runtime failure that says no sp
         ThermoLog log("/dev/full");
         FAIL("expected a RuntimeFailure");
     } catch (const RuntimeFailure& e) {
-        CHECK_THAT(std::string(e.what()), Catch::Contains("cannot write the thermo log /dev/full") &&
-                                              Catch::Contains("no space left: the disk or the quota is full"));
+        CHECK_THAT(std::string(e.what()),
+                   Catch::Contains("cannot write the thermo log /dev/full") &&
+                       Catch::Contains("no space left: the disk or the quota is full"));
     }
 }
 
-TEST_CASE("a VTK frame that cannot be written leaves neither the frame nor its .tmp", "[unit][output]") {
+TEST_CASE("a VTK frame that cannot be written leaves neither the frame nor its .tmp",
+          "[unit][output]") {
     // The frame is written to NAME.tmp and renamed: writing into a directory that does not exist
     // fails before anything is left under NAME.
     const auto dir = std::filesystem::temp_directory_path() / "efdem_vtk_missing_dir_test";

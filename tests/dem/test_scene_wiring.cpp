@@ -16,7 +16,9 @@ using efdem::test::input_error;
 namespace {
 const std::string kBase = test::kSmallBinaryScene;
 
-System build(ParamTable& t) { return build_system(t.root(), {1, 0}); }
+System build(ParamTable& t) {
+    return build_system(t.root(), {1, 0});
+}
 
 }  // namespace
 
@@ -33,7 +35,8 @@ TEST_CASE("a frictionless scene allocates no contact history; no contact effect,
         CHECK(s.slab_fields() == nullptr);  // no effect reads slab fields
     }
     SECTION("tangential = history: history allocated") {
-        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        auto t =
+            test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
         System s = build(t);
         CHECK(s.contact_history() != nullptr);
     }
@@ -49,7 +52,8 @@ TEST_CASE("a frictionless scene allocates no contact history; no contact effect,
 }
 
 TEST_CASE("effects are applied in the listed order and each is built once", "[unit][effects]") {
-    auto t = test::scene_table(std::string(kBase) + "effects = wall_contact gravity pair_contact\n");
+    auto t =
+        test::scene_table(std::string(kBase) + "effects = wall_contact gravity pair_contact\n");
     System s = build(t);
     REQUIRE(s.effects().size() == 3);
     CHECK(s.effects()[0]->name() == "wall_contact");
@@ -70,9 +74,8 @@ TEST_CASE("keys of an effect that is not listed are reported with a hint", "[uni
     auto t = test::scene_table(std::string(kBase) + "effects = gravity\nwall_contact.kn = 1e5\n");
     System s = build(t);
     const auto e = input_error([&] {
-        t.check_all_used([&](const ParamEntry& entry) {
-            return unused_key_hint(entry, {"gravity"});
-        });
+        t.check_all_used(
+            [&](const ParamEntry& entry) { return unused_key_hint(entry, {"gravity"}); });
     });
     // pair_contact.* comes first in the file.
     CHECK(e.key() == "pair_contact.kn");
@@ -82,7 +85,8 @@ TEST_CASE("keys of an effect that is not listed are reported with a hint", "[uni
 TEST_CASE("dt > t_c/5 is refused with the computed limit; t_c/20 < dt warns", "[unit][effects]") {
     // Shortest contact: light-light, t_c = 3.596e-3 (physics.md §5.2): limit 7.19e-4.
     SECTION("refused") {
-        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        auto t =
+            test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
         t.add_override("dt=8e-4");
         const auto e = input_error([&] { build(t); });
         INFO(e.what());
@@ -92,7 +96,8 @@ TEST_CASE("dt > t_c/5 is refused with the computed limit; t_c/20 < dt warns", "[
         CHECK(e.allowed().find("dt <= 0.0007193") != std::string::npos);
     }
     SECTION("warning band") {
-        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        auto t =
+            test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
         t.add_override("dt=3e-4");
         const DemScene scene = DemScene::from_params(t.root());
         const auto effects = make_effects(scene, t.root());
@@ -100,7 +105,8 @@ TEST_CASE("dt > t_c/5 is refused with the computed limit; t_c/20 < dt warns", "[
         CHECK(w.find("t_c/12.0") != std::string::npos);
     }
     SECTION("stiff contacts scale the limit") {
-        auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
+        auto t =
+            test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n");
         t.add_override("pair_contact.kn=2e7");  // t_c shrinks by 10: 3.596e-4
         const auto e = input_error([&] { build(t); });
         INFO(e.what());
@@ -110,8 +116,9 @@ TEST_CASE("dt > t_c/5 is refused with the computed limit; t_c/20 < dt warns", "[
 
 TEST_CASE("wall_contact falls back to pair_contact's keys, and can override them",
           "[unit][effects]") {
-    auto t = test::scene_table(std::string(kBase) + "effects = gravity pair_contact wall_contact\n"
-                                                    "wall_contact.restitution = 0.5\n");
+    auto t = test::scene_table(std::string(kBase) +
+                               "effects = gravity pair_contact wall_contact\n"
+                               "wall_contact.restitution = 0.5\n");
     System s = build(t);
     const auto* wall = dynamic_cast<const WallContact*>(s.find_effect("wall_contact"));
     REQUIRE(wall != nullptr);
@@ -122,8 +129,9 @@ TEST_CASE("wall_contact falls back to pair_contact's keys, and can override them
 }
 
 TEST_CASE("hertz with LAMMPS' single gamma_n is refused", "[unit][effects]") {
-    auto t = test::scene_table(std::string(kBase) + "effects = pair_contact\npair_contact.normal = hertz\n"
-                                                    "pair_contact.damping = gamma\n");
+    auto t = test::scene_table(std::string(kBase) +
+                               "effects = pair_contact\npair_contact.normal = hertz\n"
+                               "pair_contact.damping = gamma\n");
     const auto e = input_error([&] { build(t); });
     CHECK(e.key() == "pair_contact.damping");
 }

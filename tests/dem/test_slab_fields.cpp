@@ -139,8 +139,8 @@ TEST_CASE("a particle far above the bed adds empty slabs and nothing else", "[un
     // traps would turn into SIGFPE: a NaN is an input here, not something the kernel made.
     p.x()[50].z = std::numeric_limits<double>::quiet_NaN();
     const test::FpTrapsOff traps_off;
-    CHECK_THROWS_WITH(s.update(p, Domain{4, 4}), Catch::Contains("particle 99") &&
-                                                     Catch::Contains("NaN"));
+    CHECK_THROWS_WITH(s.update(p, Domain{4, 4}),
+                      Catch::Contains("particle 99") && Catch::Contains("NaN"));
 }
 
 TEST_CASE("the two-slab kernel and the general split give the same fields to the bit",
@@ -152,9 +152,9 @@ TEST_CASE("the two-slab kernel and the general split give the same fields to the
     const double l = 5;
     Particles p = test::random_particles(300, l, -0.3, 12, 11);
     const auto species = test::binary_species();
-    p.add(500, {1, 1, 0.5}, {0, 0, 1}, 0, species);   // top exactly on the plane z = 1
-    p.add(501, {2, 2, -3}, {0, 0, 1}, 1, species);    // entirely below the floor
-    p.add(502, {3, 3, 4.5}, {1, 0, 0}, 0, species);   // bottom exactly on the plane z = 4
+    p.add(500, {1, 1, 0.5}, {0, 0, 1}, 0, species);  // top exactly on the plane z = 1
+    p.add(501, {2, 2, -3}, {0, 0, 1}, 1, species);   // entirely below the floor
+    p.add(502, {3, 3, 4.5}, {1, 0, 0}, 0, species);  // bottom exactly on the plane z = 4
     const Domain d{l, l};
     SlabFields fast(1.0, 1.0), general(1.0, 1.0 + 1e-9);
     REQUIRE(fast.max_slabs_per_particle() == 2);

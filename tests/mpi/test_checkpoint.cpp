@@ -9,8 +9,8 @@
 #include "core/param_table.hpp"
 #include "dem/realization_builder.hpp"
 #include "mpi_driver/checkpoint/checkpoint_format.hpp"
-#include "mpi_driver/ensemble/dem_realization.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
+#include "mpi_driver/ensemble/dem_realization.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;
@@ -43,7 +43,8 @@ bool same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
 }
 }  // namespace
 
-TEST_CASE("a saved realization restored into a fresh one continues bit for bit", "[mpi][checkpoint]") {
+TEST_CASE("a saved realization restored into a fresh one continues bit for bit",
+          "[mpi][checkpoint]") {
     DemRealization original = build(2);
     original.advance(6000);  // falling, colliding, neighbour list rebuilt, springs loaded
     const RealizationState saved = original.save_state();
@@ -90,9 +91,11 @@ TEST_CASE("the checksum of a realization sees one flipped bit", "[mpi][checkpoin
     CHECK(from_stored(to_stored(before)) == before);
 }
 
-TEST_CASE("a restart may change run length, output and layout keys, not physics", "[mpi][checkpoint]") {
-    for (const char* key : {"run.duration", "output.prefix", "checkpoint.interval", "restart.allow_physics_change",
-                            "debug.checkpoint_delay", "watchdog.max_overlap", "ensemble.realizations_per_rank"})
+TEST_CASE("a restart may change run length, output and layout keys, not physics",
+          "[mpi][checkpoint]") {
+    for (const char* key :
+         {"run.duration", "output.prefix", "checkpoint.interval", "restart.allow_physics_change",
+          "debug.checkpoint_delay", "watchdog.max_overlap", "ensemble.realizations_per_rank"})
         CHECK(may_change_on_restart(key));
     for (const char* key : {"dt", "seed", "pair_contact.kn", "cpi.dt", "mode", "observe.interval"})
         CHECK_FALSE(may_change_on_restart(key));
@@ -100,17 +103,21 @@ TEST_CASE("a restart may change run length, output and layout keys, not physics"
     CheckpointHeader h;
     h.realizations = 4;
     h.parameters = "dt = 1e-4\npair_contact.kn = 2e5\nrun.duration = 6\n";
-    CHECK(check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 2e5\nrun.duration = 60\n", 4, false).empty());
-    CHECK_THROWS_WITH(check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 3e5\nrun.duration = 6\n", 4, false),
-                      Catch::Contains("c.h5: checkpoint was written by a scene with different physics: "
-                                      "pair_contact.kn = 3e5 (checkpoint: 2e5)"));
+    CHECK(
+        check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 2e5\nrun.duration = 60\n", 4, false)
+            .empty());
+    CHECK_THROWS_WITH(
+        check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 3e5\nrun.duration = 6\n", 4, false),
+        Catch::Contains("c.h5: checkpoint was written by a scene with different physics: "
+                        "pair_contact.kn = 3e5 (checkpoint: 2e5)"));
     CHECK_THAT(check_restart("c.h5", h, "dt = 1e-4\npair_contact.kn = 3e5\n", 4, true),
                Catch::Contains("pair_contact.kn = 3e5 (checkpoint: 2e5)"));
     CHECK_THROWS_WITH(check_restart("c.h5", h, h.parameters, 2, false),
                       Catch::Contains("holds 4 realizations but this run has 2"));
 }
 
-TEST_CASE("checkpoint file names sort in writing order and exclude .tmp files", "[mpi][checkpoint]") {
+TEST_CASE("checkpoint file names sort in writing order and exclude .tmp files",
+          "[mpi][checkpoint]") {
     CHECK(checkpoint_file_name("run", 12) == "run_ckpt_00000012.h5");
     CHECK(is_checkpoint_file_name("run_ckpt_00000012.h5", "run"));
     CHECK_FALSE(is_checkpoint_file_name("run_ckpt_00000012.h5.tmp", "run"));

@@ -31,7 +31,8 @@ dem::System random_column(long realization) {
     dem::Particles p;
     for (int i = 0; i < 2 * kLight; ++i)
         p.add(i + 1, {rng.uniform(0, 5), rng.uniform(0, 5), rng.uniform(0.5, 20.5)},
-              {rng.normal(), rng.normal(), rng.normal()}, labels[static_cast<std::size_t>(i)], species);
+              {rng.normal(), rng.normal(), rng.normal()}, labels[static_cast<std::size_t>(i)],
+              species);
     dem::SystemOptions o;
     o.realization = realization;
     return dem::System(species, dem::Domain{5, 5}, std::move(p), {}, o);
@@ -46,15 +47,18 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
     std::vector<std::unique_ptr<Realization>> local;
     std::vector<DemRealization*> dem;
     for (int j = 0; j < layout.per_rank(); ++j) {
-        auto r = std::make_unique<DemRealization>(random_column(layout.first_index() + j), 0, 1, RealizationOutput{});
+        auto r = std::make_unique<DemRealization>(random_column(layout.first_index() + j), 0, 1,
+                                                  RealizationOutput{});
         dem.push_back(r.get());
         local.push_back(std::move(r));
     }
     // Record what lifting must not touch.
     std::vector<std::vector<Vec3>> x_before, v_before;
     for (auto* d : dem) {
-        x_before.emplace_back(d->system().particles().x().begin(), d->system().particles().x().end());
-        v_before.emplace_back(d->system().particles().v().begin(), d->system().particles().v().end());
+        x_before.emplace_back(d->system().particles().x().begin(),
+                              d->system().particles().x().end());
+        v_before.emplace_back(d->system().particles().v().begin(),
+                              d->system().particles().v().end());
     }
     StepperSettings ss;
     ss.sample_interval = 0.01;
@@ -102,7 +106,8 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
         }
         // Realization 0's light median is now the target's 11 (to that resolution), measured
         // independently of the lifting's own report.
-        const Eigen::VectorXd achieved = coarse::species_icdf(dem.front()->system().particles(), 0, grid);
+        const Eigen::VectorXd achieved =
+            coarse::species_icdf(dem.front()->system().particles(), 0, grid);
         CHECK(achieved[9] == Approx(11.0).margin(0.15));
         CHECK(std::abs(before[9] - 11.0) > 0.2);  // and it was not there before
     }

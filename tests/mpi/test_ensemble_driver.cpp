@@ -8,9 +8,9 @@
 
 #include "coarse/demixing/ensemble_observable.hpp"
 #include "coarse/equation_free/projective_forward_euler.hpp"
-#include "mpi_driver/run/driver.hpp"
 #include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/run/driver.hpp"
 #include "tests/mpi/toy_realization.hpp"
 
 using namespace efdem;
@@ -37,7 +37,8 @@ TEST_CASE("gather_rows orders realizations by global index and averages like a s
     const MpiComm world(MPI_COMM_WORLD);
     const EnsembleLayout layout(world, per_rank(world));
     std::vector<Eigen::VectorXd> local;
-    for (int j = 0; j < layout.per_rank(); ++j) local.push_back(row_of(layout.first_index() + j, 5));
+    for (int j = 0; j < layout.per_rank(); ++j)
+        local.push_back(row_of(layout.first_index() + j, 5));
     const Eigen::MatrixXd all = layout.gather_rows(local);
     if (!world.is_root()) {
         CHECK(all.size() == 0);
@@ -65,7 +66,8 @@ TEST_CASE("arrays of different lengths are gathered and scattered to the right r
     // Realization r's array: length r % 3 + 2, entries 10 r + i + shift.
     auto array_of = [](long r, int shift = 0) {
         std::vector<std::uint8_t> a;
-        for (long i = 0; i < r % 3 + 2; ++i) a.push_back(static_cast<std::uint8_t>(10 * r + i + shift));
+        for (long i = 0; i < r % 3 + 2; ++i)
+            a.push_back(static_cast<std::uint8_t>(10 * r + i + shift));
         return a;
     };
     std::vector<std::vector<std::uint8_t>> local;
@@ -85,7 +87,8 @@ TEST_CASE("arrays of different lengths are gathered and scattered to the right r
         for (int r = 0; r < kRealizations; ++r) to_send.push_back(array_of(r, 1));
     const auto mine = layout.scatter_arrays(to_send, lengths);
     REQUIRE(static_cast<int>(mine.size()) == layout.per_rank());
-    for (int j = 0; j < layout.per_rank(); ++j) CHECK(mine[j] == array_of(layout.first_index() + j, 1));
+    for (int j = 0; j < layout.per_rank(); ++j)
+        CHECK(mine[j] == array_of(layout.first_index() + j, 1));
 }
 
 namespace {
@@ -95,15 +98,18 @@ Eigen::MatrixXd toy_matrix() {
     a << -0.1, 0.0, 0.0, 1.0, -20.0, 0.0, 0.0, 0.5, -0.5;
     return a;
 }
-Eigen::VectorXd toy_start(long r) { return Eigen::Vector3d(1.0 + 0.1 * static_cast<double>(r), 0.0, 0.5); }
+Eigen::VectorXd toy_start(long r) {
+    return Eigen::Vector3d(1.0 + 0.1 * static_cast<double>(r), 0.0, 0.5);
+}
 constexpr double kH = 0.01;
 
 /// The serial reference: the same R toy realizations in one process, restricted by the same
 /// ensemble mean and lifted by setting every state to the target.
 class SerialToyStepper final : public coarse::CoarseStepper {
-public:
+  public:
     SerialToyStepper() {
-        for (long r = 0; r < kRealizations; ++r) toys_.emplace_back(r, toy_matrix(), toy_start(r), kH);
+        for (long r = 0; r < kRealizations; ++r)
+            toys_.emplace_back(r, toy_matrix(), toy_start(r), kH);
     }
     double time() const override { return toys_.front().time(); }
     void run(double duration, coarse::BurstSamples& out) override {
@@ -127,7 +133,7 @@ public:
         }
     }
 
-private:
+  private:
     std::vector<test::ToyRealization> toys_;
 };
 
@@ -135,13 +141,15 @@ private:
 /// the toy's state as a 3-node "ICDF", exact lifting); `lift_members`: cpi.lift = members.
 struct ToyEnsemble {
     ToyEnsemble(const MpiComm& world, bool lift_members)
-        : layout(world, per_rank(world)), stepper(layout, realizations(layout), settings(lift_members), observable,
-                                                  lifter, nullptr, nullptr) {}
+        : layout(world, per_rank(world)),
+          stepper(layout, realizations(layout), settings(lift_members), observable, lifter, nullptr,
+                  nullptr) {}
     static std::vector<std::unique_ptr<Realization>> realizations(const EnsembleLayout& layout) {
         std::vector<std::unique_ptr<Realization>> local;
         for (int j = 0; j < layout.per_rank(); ++j) {
             const long r = layout.first_index() + j;
-            local.push_back(std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH));
+            local.push_back(
+                std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH));
         }
         return local;
     }
@@ -190,13 +198,15 @@ TEST_CASE("CPI of a linear toy model through EnsembleStepper equals the serial i
         // The members arrive in realization order whatever the layout (the serial stepper
         // lists them in that order), and so give the same slope s.e.
         REQUIRE(a.burst.members.size() == a.burst.t.size());
-        for (std::size_t k = 0; k < a.burst.t.size(); ++k) CHECK(a.burst.members[k] == b.burst.members[k]);
+        for (std::size_t k = 0; k < a.burst.t.size(); ++k)
+            CHECK(a.burst.members[k] == b.burst.members[k]);
         CHECK(a.slope_standard_error == b.slope_standard_error);
         REQUIRE(a.slope_standard_error.size() == 3);
         if (step == 0) {
             // Before the first lift the realizations differ (x0 = 1 + 0.1 r, decaying alike):
             // row r is realization r, and the slopes spread.
-            for (long r = 1; r < kRealizations; ++r) CHECK(a.burst.members[0](r, 0) > a.burst.members[0](r - 1, 0));
+            for (long r = 1; r < kRealizations; ++r)
+                CHECK(a.burst.members[0](r, 0) > a.burst.members[0](r - 1, 0));
             CHECK(a.slope_standard_error[0] > 0.0);
         }
     }
@@ -241,7 +251,8 @@ TEST_CASE("cpi.lift = members moves every realization by the same increment, kee
     // exactly as states): realization 3 stays 0.3 above realization 0 in component 0, decayed.
     const double gap = own(3, 0) - own(0, 0);
     CHECK(gap > 0.25);
-    CHECK(after.members[0](3, 0) - after.members[0](0, 0) == Approx(gap * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) *
-                                                                      (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) *
-                                                                      (1.0 - 0.1 * kH)).epsilon(1e-12));
+    CHECK(after.members[0](3, 0) - after.members[0](0, 0) ==
+          Approx(gap * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) *
+                 (1.0 - 0.1 * kH))
+              .epsilon(1e-12));
 }

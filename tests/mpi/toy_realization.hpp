@@ -10,7 +10,7 @@
 namespace efdem::test {
 
 class ToyRealization final : public mpi_driver::Realization {
-public:
+  public:
     ToyRealization(long index, Eigen::MatrixXd a, Eigen::VectorXd x0, double h)
         : index_(index), a_(std::move(a)), x_(std::move(x0)), h_(h) {}
     long index() const override { return index_; }
@@ -32,16 +32,19 @@ public:
         o.z_max = x_.maxCoeff();
         return o;
     }
-    mpi_driver::LiftPayload lift_input() const override { return {{x_.data(), x_.data() + x_.size()}, {}}; }
+    mpi_driver::LiftPayload lift_input() const override {
+        return {{x_.data(), x_.data() + x_.size()}, {}};
+    }
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override {
         return {static_cast<std::size_t>(x_.size()), 0};
     }
     void apply_lift(const mpi_driver::LiftPayload& p) override {
-        x_ = Eigen::Map<const Eigen::VectorXd>(p.reals.data(), static_cast<Eigen::Index>(p.reals.size()));
+        x_ = Eigen::Map<const Eigen::VectorXd>(p.reals.data(),
+                                               static_cast<Eigen::Index>(p.reals.size()));
     }
     const Eigen::VectorXd& state() const { return x_; }
 
-private:
+  private:
     long index_;
     Eigen::MatrixXd a_;
     Eigen::VectorXd x_;
@@ -51,7 +54,7 @@ private:
 
 /// Lifting of the toy: the state becomes the target exactly.
 class ToyLifter final : public mpi_driver::Lifter {
-public:
+  public:
     mpi_driver::LiftOutcome lift(const Eigen::VectorXd& target, const mpi_driver::LiftPayload&,
                                  const coarse::ProbabilityGrid&, RandomStream&) const override {
         mpi_driver::LiftOutcome o;

@@ -42,12 +42,15 @@ bool has_comment_line(const std::filesystem::path& file) {
 }
 }  // namespace
 
-TEST_CASE("the run's CSV files start with their column names and hold only rows, and the sidecar says how the run ended",
-          "[unit][output]") {
+TEST_CASE(
+    "the run's CSV files start with their column names and hold only rows, and the sidecar says "
+    "how the run ended",
+    "[unit][output]") {
     const auto dir = std::filesystem::temp_directory_path() / "efdem_csv_recorder_test";
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
-    const auto icdf = dir / "run_mean_icdf.csv", steps = dir / "run_cpi_steps.csv", meta = dir / "run_csv_meta.json";
+    const auto icdf = dir / "run_mean_icdf.csv", steps = dir / "run_cpi_steps.csv",
+               meta = dir / "run_csv_meta.json";
     {
         CsvRecorder r(dir, "run", cpi_provenance());
         CHECK(r.files() == std::vector<std::filesystem::path>{icdf, steps, meta});

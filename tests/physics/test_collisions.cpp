@@ -66,9 +66,11 @@ TEST_CASE("head-on collisions: e = 0.9 and t_c of physics.md §5.2 for every pai
     }
 }
 
-TEST_CASE("light-light collision at v_rel = 1: maximum overlap about 1.1e-3 d", "[physics][contact]") {
+TEST_CASE("light-light collision at v_rel = 1: maximum overlap about 1.1e-3 d",
+          "[physics][contact]") {
     // physics.md §12.1: undamped bound v_rel/omega_0 = 1.14e-3; damping lowers it slightly.
-    const Collision r = collide(paper_contact(DampingModel::restitution, TangentialModel::none), 0, 0, false);
+    const Collision r =
+        collide(paper_contact(DampingModel::restitution, TangentialModel::none), 0, 0, false);
     CHECK(r.max_overlap < 1.144e-3);
     CHECK(r.max_overlap > 1.0e-3);
 }
@@ -84,10 +86,8 @@ TEST_CASE("head-on collisions with LAMMPS' single gamma_n: e = 0.900/0.885/0.862
         double e_paper, m_eff;
     };
     const Case cases[] = {
-        {0, 0, false, 0.900, m_l / 2},
-        {0, 1, false, 0.885, m_l * m_h / (m_l + m_h)},
-        {1, 1, false, 0.862, m_h / 2},
-        {0, 0, true, 0.862, m_l},
+        {0, 0, false, 0.900, m_l / 2}, {0, 1, false, 0.885, m_l * m_h / (m_l + m_h)},
+        {1, 1, false, 0.862, m_h / 2}, {0, 0, true, 0.862, m_l},
         {1, 0, true, 0.810, m_h},
     };
     const ContactSpec spec = paper_contact(DampingModel::gamma, TangentialModel::none);
@@ -143,9 +143,9 @@ TEST_CASE("contact energy of pairs and the floor follows the normal law the forc
         p.add(1, {1.0, 2.0, 3.0}, {}, 0, species);
         p.add(2, {2.0 - dp, 2.0, 3.0}, {}, 1, species);
         p.add(3, {3.0, 2.0, 0.5 - dw}, {}, 0, species);
-        System s = test::make_system(species, Domain{5.0, 5.0}, std::move(p),
-                                     std::move(test::EffectList{}.pair(spec, species).wall(spec, species)),
-                                     1e-5);
+        System s = test::make_system(
+            species, Domain{5.0, 5.0}, std::move(p),
+            std::move(test::EffectList{}.pair(spec, species).wall(spec, species)), 1e-5);
         const double pair = law == NormalModel::hooke ? 0.5 * kn * dp * dp
                                                       : 0.4 * kn * std::sqrt(0.25 * dp) * dp * dp;
         const double wall = law == NormalModel::hooke ? 0.5 * kn * dw * dw

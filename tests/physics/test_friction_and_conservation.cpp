@@ -123,7 +123,8 @@ System random_gas(const ContactSpec& spec, int n, double l, bool walls, double l
 
 Vec3 momentum(const System& s) {
     Vec3 m{};
-    for (std::size_t i = 0; i < s.particles().size(); ++i) m += s.particles().v()[i] * s.particles().mass()[i];
+    for (std::size_t i = 0; i < s.particles().size(); ++i)
+        m += s.particles().v()[i] * s.particles().mass()[i];
     return m;
 }
 }  // namespace

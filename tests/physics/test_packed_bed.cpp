@@ -39,7 +39,8 @@ BedStats measure(const Particles& p, const Domain& d, double z_lo, double z_hi) 
     }
     for (int k = 0; k < 2; ++k) {
         s.mean_z[k] /= static_cast<double>(s.count[k]);
-        s.sd_z[k] = std::sqrt(s.sd_z[k] / static_cast<double>(s.count[k]) - s.mean_z[k] * s.mean_z[k]);
+        s.sd_z[k] =
+            std::sqrt(s.sd_z[k] / static_cast<double>(s.count[k]) - s.mean_z[k] * s.mean_z[k]);
     }
     s.phi_bulk = volume / (d.area() * (z_hi - z_lo));
     return s;
@@ -48,10 +49,13 @@ BedStats measure(const Particles& p, const Domain& d, double z_lo, double z_hi) 
 Particles settled_bed(const std::string& extra, long n_each, double l, std::uint64_t seed) {
     auto t = test::scene_table(
         "dt = 1e-4\neffects = gravity pair_contact wall_contact\n"
-        "domain.lx = " + std::to_string(l) + "\ndomain.ly = " + std::to_string(l) + "\ndomain.lid = 150\n"
+        "domain.lx = " +
+        std::to_string(l) + "\ndomain.ly = " + std::to_string(l) +
+        "\ndomain.lid = 150\n"
         "species.names = light heavy\nspecies.density = 1 2\nspecies.diameter = 1 1\n"
         "pair_contact.kn = 2e5\npair_contact.damping = gamma\npair_contact.gamma_n = 58.5928\n"
-        "pair_contact.mu = 0.1\nbed.count = " + std::to_string(n_each) + " " + std::to_string(n_each) + "\n" + extra);
+        "pair_contact.mu = 0.1\nbed.count = " +
+        std::to_string(n_each) + " " + std::to_string(n_each) + "\n" + extra);
     const DemScene scene = DemScene::from_params(t.root());
     make_effects(scene, t.root());
     const BedSpec bed = BedSpec::from_params(t.root().scope("bed"), scene);
@@ -69,7 +73,8 @@ TEST_CASE("a small bed settles to a packed, mixed state", "[physics][bed]") {
     // same way reached 0.612 (lammps_reference.md). A narrow box packs slightly less densely.
     CHECK(s.phi_bulk > 0.58);
     CHECK(s.phi_bulk < 0.64);
-    // Expected height from the volume: N (pi/6) / (phi l^2) = 1000 * 0.5236 / (0.61 * 56.25) = 15.3.
+    // Expected height from the volume: N (pi/6) / (phi l^2) = 1000 * 0.5236 / (0.61 * 56.25)
+    // = 15.3.
     CHECK(s.top > 14.0);
     CHECK(s.top < 17.5);
     CHECK(s.count[0] == 500);

@@ -16,8 +16,8 @@
 #include <fmt/format.h>
 
 #include "core/rng.hpp"
-#include "dem/realization_builder.hpp"
 #include "dem/io/lammps_data.hpp"
+#include "dem/realization_builder.hpp"
 #include "tests/support/collisions.hpp"
 #include "tests/support/dem_fixtures.hpp"
 #include "tests/support/report.hpp"

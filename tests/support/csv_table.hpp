@@ -13,8 +13,8 @@
 namespace efdem::test {
 
 struct CsvTable {
-    std::vector<std::string> header;              ///< the first line's fields
-    std::vector<std::vector<std::string>> rows;   ///< every later line's fields
+    std::vector<std::string> header;             ///< the first line's fields
+    std::vector<std::vector<std::string>> rows;  ///< every later line's fields
     /// Rows whose field count differs from the header's (pandas would misalign or refuse them).
     std::size_t ragged_rows() const {
         std::size_t n = 0;

@@ -9,10 +9,10 @@
 
 #include "core/param_table.hpp"
 #include "dem/contact/contact_model.hpp"
-#include "dem/gas/gas_drag.hpp"
-#include "dem/effects/gravity.hpp"
 #include "dem/contact/pair_contact.hpp"
 #include "dem/contact/wall_contact.hpp"
+#include "dem/effects/gravity.hpp"
+#include "dem/gas/gas_drag.hpp"
 #include "dem/scene.hpp"
 #include "dem/system.hpp"
 
@@ -24,8 +24,9 @@ inline dem::SpeciesTable binary_species() {
 }
 
 /// The paper's contact model (physics.md §5): hooke, kn = 2e5, e = 0.9, kt = 2/7 kn, mu = 0.1.
-inline dem::ContactSpec paper_contact(dem::DampingModel damping = dem::DampingModel::restitution,
-                                      dem::TangentialModel tangential = dem::TangentialModel::history) {
+inline dem::ContactSpec paper_contact(
+    dem::DampingModel damping = dem::DampingModel::restitution,
+    dem::TangentialModel tangential = dem::TangentialModel::history) {
     dem::ContactSpec s;
     s.normal = dem::NormalModel::hooke;
     s.kn = 2e5;
@@ -96,7 +97,8 @@ inline const std::string kSmallBinaryScene =
 /// n binary-species particles (alternating light, heavy) at uniform random positions in
 /// [0, l)^2 x [z_lo, z_hi) with standard-normal velocity components; overlaps are not avoided
 /// (for tests of fields and forces that do not involve contacts).
-inline dem::Particles random_particles(int n, double l, double z_lo, double z_hi, std::uint32_t seed) {
+inline dem::Particles random_particles(int n, double l, double z_lo, double z_hi,
+                                       std::uint32_t seed) {
     const auto species = binary_species();
     std::mt19937 gen(seed);
     std::uniform_real_distribution<double> ux(0, l), uz(z_lo, z_hi);

@@ -3,12 +3,16 @@
 #include <cfenv>
 
 namespace efdem::test {
-inline void enable_fp_traps() { feenableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW); }
-inline void disable_fp_traps() { fedisableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW); }
+inline void enable_fp_traps() {
+    feenableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW);
+}
+inline void disable_fp_traps() {
+    fedisableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW);
+}
 
 /// Turns traps off for a scope (for a test that deliberately produces a NaN).
 class FpTrapsOff {
-public:
+  public:
     FpTrapsOff() : saved_(fegetexcept()) { disable_fp_traps(); }
     ~FpTrapsOff() {
         std::feclearexcept(FE_ALL_EXCEPT);
@@ -17,7 +21,7 @@ public:
     FpTrapsOff(const FpTrapsOff&) = delete;
     FpTrapsOff& operator=(const FpTrapsOff&) = delete;
 
-private:
+  private:
     int saved_;
 };
 }  // namespace efdem::test
