@@ -8,7 +8,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake
+  build-essential cmake clang-format
   libopenmpi-dev openmpi-bin
   libeigen3-dev
   libhdf5-openmpi-dev zlib1g-dev
