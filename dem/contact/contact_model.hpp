@@ -5,6 +5,7 @@
 ///
 /// Scene keys, in the scope of the effect (`pair_contact.` or `wall_contact.`):
 ///
+// clang-format off: a table wider than the column limit
 /// | key                  | meaning                                              | default |
 /// |----------------------|------------------------------------------------------|------------------|
 /// | normal               | `hooke` or `hertz`                                   | hooke | | kn |
@@ -19,6 +20,7 @@
 /// tangential_damping   | eta_t / eta_n (LAMMPS: gamma_t = gamma_n / 2)        | 0.5              |
 /// | mu                   | Coulomb friction coefficient                         | required if
 /// history |
+// clang-format on
 ///
 /// wall_contact reads the same keys; each key it does not set falls back to pair_contact's
 /// value when pair_contact is in the scene ("the same sub-models drive particle-floor contact").

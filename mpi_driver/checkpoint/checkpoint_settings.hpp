@@ -4,6 +4,7 @@
 /// reads its own keys). They are read in every run, so that a scene with a checkpoint block is
 /// valid whether or not it checkpoints, and a restart may change them freely.
 ///
+// clang-format off: a table wider than the column limit
 /// | key                          | meaning                                              | default
 /// |
 /// |------------------------------|------------------------------------------------------|---------|
@@ -15,6 +16,7 @@
 /// keys    | false   | | debug.checkpoint_delay       | test only: seconds to sleep inside every
 /// checkpoint  | 0       | |                              | write (between the collective part and
 /// the marker)   |         |
+// clang-format on
 
 #include <filesystem>
 
