@@ -4,7 +4,11 @@
 #   core                 -> (nothing of efdem; no MPI, no HDF5)
 #   dem                  -> core                    (no MPI)
 #   coarse (generic)     -> core                    (no DEM, no MPI)
-#     equation_free/     -> no coarse/demixing/, coarse/dem_adapters/ (generic numerics)
+#     equation_free/     -> no coarse/demixing/, coarse/dem_adapters/ (generic numerics), by method:
+#       (top: the seam)  -> none of its method folders
+#       estimators/      -> the seam only          krylov/     -> the seam only
+#       projective/      -> the seam, estimators/, krylov/ (not steady/)
+#       steady/          -> the seam, estimators/, krylov/ (not projective/)
 #     demixing/          -> no coarse/dem_adapters/
 #   coarse/dem_adapters  -> coarse, dem, core       (no MPI)
 #   mpi_driver           -> everything, in rooms:
@@ -97,6 +101,13 @@ check_tree() {
     forbid coarse/equation_free 'coarse/(demixing|dem_adapters)/' \
         "coarse/demixing/ or coarse/dem_adapters/ (generic equation-free numerics know no demixing)"
     forbid coarse/demixing 'coarse/dem_adapters/' "coarse/dem_adapters/"
+    local ef=coarse/equation_free
+    forbid_files $ef "^$ef/[^/]+$" "$ef/(projective|estimators|steady|krylov)/" \
+        "the seam (the top of $ef/) must not include its method folders"
+    forbid $ef/estimators "$ef/(projective|steady|krylov)/" "projective/, steady/ or krylov/ (estimators stand on the seam)"
+    forbid $ef/krylov "$ef/(projective|steady|estimators)/" "projective/, steady/ or estimators/ (krylov stands on the seam)"
+    forbid $ef/projective "$ef/steady/" "$ef/steady/ (the two methods know nothing of each other)"
+    forbid $ef/steady "$ef/projective/" "$ef/projective/ (the two methods know nothing of each other)"
     forbid mpi_driver/output 'mpi_driver/(ensemble|checkpoint|run)/|mpi\.h' \
         "mpi_driver/ensemble/, checkpoint/, run/ or MPI (recorders only record)"
     forbid mpi_driver/ensemble 'mpi_driver/run/|mpi_driver/checkpoint/(checkpoint_writer|checkpoint_reader|checkpoint_settings|restart_check|restart_loader)|hdf5\.h|H5[A-Za-z_]*\.h' \
@@ -113,7 +124,8 @@ check_tree() {
 if [ "${1:-}" = "--self-test" ]; then
     scratch=$(mktemp -d)
     trap 'rm -rf "$scratch"' EXIT
-    mkdir -p "$scratch"/{core,dem/{contact,gas,effects,beds,settling,io},coarse/{dem_adapters,equation_free,demixing}} \
+    mkdir -p "$scratch"/{core,dem/{contact,gas,effects,beds,settling,io},coarse/{dem_adapters,demixing}} \
+             "$scratch"/coarse/equation_free/{projective,estimators,steady,krylov} \
              "$scratch"/mpi_driver/{output,ensemble,checkpoint,run}
     echo '#include "core/vec3.hpp"' > "$scratch/dem/ok.cpp"
     # What the rooms of dem/ may include (the exceptions of the rules must not be flagged).
@@ -134,6 +146,10 @@ if [ "${1:-}" = "--self-test" ]; then
     echo '#include "dem/particles.hpp"' > "$scratch/coarse/dem_adapters/ok.cpp"
     echo '#include <mpi.h>' > "$scratch/mpi_driver/ok.cpp"
     echo '#include "coarse/equation_free/coarse_stepper.hpp"' > "$scratch/coarse/demixing/ok.cpp"
+    printf '#include "coarse/equation_free/%s"\n' coarse_stepper.hpp estimators/slope_estimators.hpp \
+        krylov/gmres.hpp > "$scratch/coarse/equation_free/steady/ok.cpp"
+    printf '#include "coarse/equation_free/%s"\n' coarse_stepper.hpp estimators/phase_drift.hpp \
+        > "$scratch/coarse/equation_free/projective/ok.cpp"
     printf '#include "%s"\n' mpi_driver/checkpoint/checkpoint_format.hpp mpi_driver/checkpoint/realization_state.hpp \
         mpi_driver/output/run_recorder.hpp '<mpi.h>' > "$scratch/mpi_driver/ensemble/ok.cpp"
     printf '#include %s\n' '<hdf5.h>' '"mpi_driver/ensemble/ensemble_layout.hpp"' '"mpi_driver/output/h5_file.hpp"' \
@@ -157,6 +173,11 @@ if [ "${1:-}" = "--self-test" ]; then
                "dem/beds/bed_builder.cpp:#include \"dem/effects/viscous_damping.hpp\"" \
                "coarse/equation_free/m.cpp:#include \"coarse/demixing/quantiles.hpp\"" \
                "coarse/demixing/n.hpp:#include \"coarse/dem_adapters/apply_colours.hpp\"" \
+               "coarse/equation_free/n1.hpp:#include \"coarse/equation_free/projective/projective_run.hpp\"" \
+               "coarse/equation_free/estimators/n2.cpp:#include \"coarse/equation_free/projective/cpi_settings.hpp\"" \
+               "coarse/equation_free/krylov/n3.cpp:#include \"coarse/equation_free/steady/coarse_map.hpp\"" \
+               "coarse/equation_free/projective/n4.cpp:#include \"coarse/equation_free/steady/coarse_map.hpp\"" \
+               "coarse/equation_free/steady/n5.cpp:#include \"coarse/equation_free/projective/projective_jump.hpp\"" \
                "mpi_driver/output/o.cpp:#include \"mpi_driver/ensemble/ensemble_stepper.hpp\"" \
                "mpi_driver/output/p.cpp:#include <mpi.h>" \
                "mpi_driver/ensemble/q.cpp:#include <hdf5.h>" \

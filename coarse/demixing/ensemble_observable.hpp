@@ -17,7 +17,7 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/ensemble_statistics.hpp"  // ensemble_mean, ensemble_variance
-#include "coarse/equation_free/projective_integrator.hpp"
+#include "coarse/equation_free/projective/projective_integrator.hpp"
 
 namespace efdem::coarse {
 

@@ -6,7 +6,7 @@
 /// A Newton step or a Krylov direction in u can then never make the lifted ICDF non-monotone;
 /// only the bed's top and floor remain for the repair to clip.
 
-#include "coarse/equation_free/coarse_map.hpp"
+#include "coarse/equation_free/steady/coarse_map.hpp"
 
 namespace efdem::coarse {
 

@@ -5,8 +5,8 @@
 /// change the System. Heights in d_p, pressures in rho_s g d_p (physics.md §2).
 ///
 /// The travelling-wave period is not here: it is a property of a *time series* and is estimated
-/// by coarse::estimate_period (coarse/equation_free/period_estimator.hpp) on z_com(t), by the
-/// driver or a test.
+/// by coarse::estimate_period (coarse/equation_free/estimators/period_estimator.hpp) on z_com(t),
+/// by the driver or a test.
 
 #include <vector>
 

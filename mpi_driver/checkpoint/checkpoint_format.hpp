@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
 

@@ -11,8 +11,8 @@
 
 #include <Eigen/Core>
 
-#include "coarse/equation_free/projective_integrator.hpp"
-#include "coarse/equation_free/steady_run.hpp"
+#include "coarse/equation_free/projective/projective_integrator.hpp"
+#include "coarse/equation_free/steady/steady_run.hpp"
 
 namespace efdem::mpi_driver {
 

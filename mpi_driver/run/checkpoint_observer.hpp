@@ -4,7 +4,7 @@
 /// `interval` coarse steps, written between two steps (nothing of a burst is pending there),
 /// with the run loop's state so that a restart continues the run exactly.
 
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 
 namespace efdem::mpi_driver {

@@ -5,7 +5,7 @@
 #include <string>
 
 #include <fmt/format.h>
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 
@@ -110,8 +110,7 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
 RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
                    coarse::EnsembleObservable* fallback, RunRecorder* recorder, Progress& progress,
                    const RunControl& control) {
-    if (s.cpi.projection == coarse::CoarseRunSettings::Projection::periods &&
-        stepper.realizations() > 1)
+    if (s.cpi.projection == coarse::CpiSettings::Projection::periods && stepper.realizations() > 1)
         log::warn(
             "cpi.projection = periods measures the wave period from the ensemble-mean centre of "
             "mass; the {} realizations' waves start in phase (they fluidize together) but lose "

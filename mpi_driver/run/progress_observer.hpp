@@ -4,7 +4,7 @@
 /// from the DEM work the run still needs (a jump advances simulated time for free, so the
 /// simulated time left is no measure of the work left).
 
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "mpi_driver/output/progress.hpp"
 

@@ -69,7 +69,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     const Params cpi = root.scope("cpi");
     const auto observables = coarse::observable_table().names();
     s.observable = cpi.get_or_choice("observable", observables.front(), observables);
-    s.cpi = coarse::CoarseRunSettings::from_params(cpi, s.observe.interval, s.is_cpi());
+    s.cpi = coarse::CpiSettings::from_params(cpi, s.observe.interval, s.is_cpi());
     s.lift_members = cpi.get_or_choice("lift", "mean", {"mean", "members"}) == "members";
     if (s.lift_members && s.is_cpi() && !restricts_members(s.observable, s.observe.quantiles))
         cpi.fail(
@@ -217,8 +217,7 @@ const char* RunSettings::mode_name() const {
 
 void RunSettings::check_ensemble(const Params& root, int realizations) {
     // A run that measures the spread of the realizations' slopes needs two of them to the end.
-    const bool spread =
-        is_cpi() && cpi.projection == coarse::CoarseRunSettings::Projection::adaptive;
+    const bool spread = is_cpi() && cpi.projection == coarse::CpiSettings::Projection::adaptive;
     on_failure.min_active = spread ? 2 : 1;
     if (on_failure.max_failures < 0) on_failure.max_failures = std::max(1, realizations / 4);
     if (on_failure.action == FailurePolicy::Action::drop &&

@@ -2,12 +2,13 @@
 /// \file
 /// RunSettings: the run-level keys of a scene (everything that is not one realization's DEM).
 /// Each room reads its own keys and RunSettings gathers them: the coarse layer its cpi.* keys
-/// (coarse/equation_free/coarse_run_settings.hpp; cpi.observable from the table of
+/// (coarse/equation_free/projective/cpi_settings.hpp; cpi.observable from the table of
 /// coarse/demixing/observable_table.hpp), the checkpoint room checkpoint.* and restart.*
 /// (mpi_driver/checkpoint/checkpoint_settings.hpp). Times are in sqrt(d_p/g); every time is
 /// checked against the time step it must be a multiple of, so that samples fall exactly on
 /// DEM steps.
 ///
+// clang-format off: a table wider than the column limit
 /// | key                            | meaning                                             | default
 /// |
 /// |--------------------------------|-----------------------------------------------------|---------|
@@ -36,7 +37,7 @@
 /// |                                | `compact` ((A,B,C,D)); coarse/demixing/observable_table | |
 /// | cpi.lift                       | `mean`: every realization lifted to the projected X;| mean |
 /// |                                | `members`: each moved by the same increment         | | |
-/// cpi.*                          | the coarse run loop: coarse_run_settings.hpp        |         |
+/// cpi.*                          | the coarse run loop: projective/cpi_settings.hpp    |         |
 /// | output.directory               | where the run writes (relative: to the scene's      | . | |
 /// | folder; on the command line: to the working dir)    |         | | output.prefix | file stem of
 /// the run's files                        | efdem   | | output.vtk_interval            | time
@@ -47,13 +48,14 @@
 /// checkpoint/checkpoint_settings.hpp                  |         | | debug.fail_realization | test
 /// only: this realization fails ...               | -1      | | debug.fail_time                |
 /// ... at the first sample at or after this time       | 0       |
+// clang-format on
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
 
-#include "coarse/equation_free/coarse_run_settings.hpp"
-#include "coarse/equation_free/steady_run_settings.hpp"
+#include "coarse/equation_free/projective/cpi_settings.hpp"
+#include "coarse/equation_free/steady/steady_run_settings.hpp"
 #include "core/param_table.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/checkpoint_settings.hpp"
@@ -95,7 +97,7 @@ struct RunSettings {
     /// offset from the mean (the ensemble stepper's lift); `mean` (default): all lifted to X.
     bool lift_members = false;
     /// The other cpi.* keys, read by the coarse layer.
-    coarse::CoarseRunSettings cpi;
+    coarse::CpiSettings cpi;
     /// mode = steady | continuation: the steady.* and continuation.* keys.
     coarse::SteadyRunSettings steady;
     OutputSettings output;

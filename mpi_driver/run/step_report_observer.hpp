@@ -3,7 +3,7 @@
 /// StepReportObserver: reports every coarse step of a cpi run: the step record and what lifting
 /// did go to the run's recorders (HDF5, CSV), and one line goes to the log.
 
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
 

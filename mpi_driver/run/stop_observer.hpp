@@ -5,7 +5,7 @@
 /// signal), it ends the loop there with RunInterrupted. Plugged in before the checkpoint
 /// observer, so that a periodic checkpoint sees every sample recorded.
 
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 
 namespace efdem::mpi_driver {

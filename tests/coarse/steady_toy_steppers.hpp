@@ -1,7 +1,7 @@
 #pragma once
 // Toy coarse time-steppers with known steady states for the steady-state solvers
-// (coarse/equation_free/newton_krylov.hpp, continuation.hpp): all of them can keep their state
-// (common random numbers), as EnsembleStepper can.
+// (coarse/equation_free/steady/newton_krylov.hpp, continuation.hpp): all of them can keep their
+// state (common random numbers), as EnsembleStepper can.
 #include <cmath>
 #include <cstdint>
 #include <functional>

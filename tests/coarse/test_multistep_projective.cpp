@@ -13,12 +13,12 @@
 
 #include <Eigen/Core>
 
-#include "coarse/equation_free/multistep_projection.hpp"
-#include "coarse/equation_free/multistep_projective_integrator.hpp"
-#include "coarse/equation_free/period_estimator.hpp"
-#include "coarse/equation_free/phase_drift.hpp"
-#include "coarse/equation_free/projective_stability.hpp"
-#include "coarse/equation_free/step_size_controller.hpp"
+#include "coarse/equation_free/estimators/period_estimator.hpp"
+#include "coarse/equation_free/estimators/phase_drift.hpp"
+#include "coarse/equation_free/projective/multistep_projection.hpp"
+#include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
+#include "coarse/equation_free/projective/projective_stability.hpp"
+#include "coarse/equation_free/projective/step_size_controller.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem;

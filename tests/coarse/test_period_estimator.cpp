@@ -5,7 +5,7 @@
 #include <numbers>
 #include <vector>
 
-#include "coarse/equation_free/period_estimator.hpp"
+#include "coarse/equation_free/estimators/period_estimator.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;

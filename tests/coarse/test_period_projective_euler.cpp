@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "coarse/equation_free/period_projective_euler.hpp"
+#include "coarse/equation_free/projective/period_projective_euler.hpp"
 #include "core/rng.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 

@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "coarse/demixing/monotone_repair.hpp"
-#include "coarse/equation_free/projective_forward_euler.hpp"
-#include "coarse/equation_free/projective_jump.hpp"
-#include "coarse/equation_free/projective_stability.hpp"
+#include "coarse/equation_free/projective/projective_forward_euler.hpp"
+#include "coarse/equation_free/projective/projective_jump.hpp"
+#include "coarse/equation_free/projective/projective_stability.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem::coarse;

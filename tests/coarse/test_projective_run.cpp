@@ -1,5 +1,5 @@
-// The coarse run loop (coarse/equation_free/projective_run.hpp) on toy steppers, without MPI or
-// DEM: the end-of-run rule, the observable fallback, the no-progress and instability stops,
+// The coarse run loop (coarse/equation_free/projective/projective_run.hpp) on toy steppers, without
+// MPI or DEM: the end-of-run rule, the observable fallback, the no-progress and instability stops,
 // the observers' calls, and a resumed run that continues the uninterrupted one bit for bit.
 #include <catch2/catch.hpp>
 
@@ -10,8 +10,8 @@
 
 #include <Eigen/Core>
 
-#include "coarse/equation_free/coarse_run_settings.hpp"
-#include "coarse/equation_free/projective_run.hpp"
+#include "coarse/equation_free/projective/cpi_settings.hpp"
+#include "coarse/equation_free/projective/projective_run.hpp"
 #include "core/param_table.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 #include "tests/support/input_error.hpp"
@@ -31,8 +31,8 @@ test::LinearToyStepper slow_toy() {
 }
 
 /// Bursts of 1 + 1, DT = 8: a cycle of 10 time units.
-CoarseRunSettings fixed_settings(double warmup = 0.0) {
-    CoarseRunSettings s;
+CpiSettings fixed_settings(double warmup = 0.0) {
+    CpiSettings s;
     s.warmup = warmup;
     s.fixed.healing = 1.0;
     s.fixed.window = 1.0;
@@ -250,7 +250,7 @@ TEST_CASE("StabilityPolicy::stop ends the run at the first flagged step", "[unit
     // |1 - 16| >> 1, so the monitor flags the first step and the stop policy takes no jump.
     test::LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, std::exp(-2.0 * kH)), kH,
                                Eigen::VectorXd::Constant(1, 5.0));
-    CoarseRunSettings s = fixed_settings();
+    CpiSettings s = fixed_settings();
     s.fixed.healing = 0.0;
     s.fixed.window = 2.0;
     s.fixed.stability_policy = StabilityPolicy::stop;
@@ -320,14 +320,13 @@ TEST_CASE("a run resumed from before its warm-up does the warm-up and equals the
     CHECK(r.end_rest.state() == r.end_whole.state());
 }
 
-TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings",
-          "[unit][coarse][run]") {
+TEST_CASE("CpiSettings reads the cpi keys into the integrators' settings", "[unit][coarse][run]") {
     ParamTable table = ParamTable::from_text(
         "cpi.projection = periods\ncpi.healing = 4\ncpi.window = 6\ncpi.periods = 3\ncpi.stability "
         "= halve\n",
         "scene.cfg", "/scenes");
-    const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.5);
-    CHECK(s.projection == CoarseRunSettings::Projection::periods);
+    const CpiSettings s = CpiSettings::from_params(table.root().scope("cpi"), 0.5);
+    CHECK(s.projection == CpiSettings::Projection::periods);
     CHECK(s.periods.healing == 4.0);
     CHECK(s.periods.window == 6.0);
     CHECK(s.periods.periods_per_step == 3);
@@ -338,22 +337,21 @@ TEST_CASE("CoarseRunSettings reads the cpi keys into the integrators' settings",
     CHECK(s.make_integrator({})->name() == "period_projective_euler");
 
     ParamTable bad = ParamTable::from_text("cpi.window = 1\n", "scene.cfg", "/scenes");
-    const std::string e = test::input_error([&] {
-                              CoarseRunSettings::from_params(bad.root().scope("cpi"), 0.5);
-                          }).what();
+    const std::string e =
+        test::input_error([&] { CpiSettings::from_params(bad.root().scope("cpi"), 0.5); }).what();
     CHECK_THAT(e, Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.window") &&
                       Catch::Contains("holds 2 samples; a slope needs at least 3"));
 }
 
-TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive would ignore",
+TEST_CASE("CpiSettings reads the adaptive keys and refuses what adaptive would ignore",
           "[unit][coarse][run]") {
     ParamTable table = ParamTable::from_text(
         "cpi.projection = adaptive\ncpi.integrator = adams_bashforth2\ncpi.healing = 4\ncpi.window "
         "= 6\n"
         "cpi.tolerance = 0.05\ncpi.dt_max = 60\n",
         "scene.cfg", "/scenes");
-    const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.5);
-    CHECK(s.projection == CoarseRunSettings::Projection::adaptive);
+    const CpiSettings s = CpiSettings::from_params(table.root().scope("cpi"), 0.5);
+    CHECK(s.projection == CpiSettings::Projection::adaptive);
     CHECK(s.multistep.adaptive);
     CHECK(s.multistep.steps == 2);
     CHECK(s.multistep.control.tolerance == 0.05);
@@ -366,7 +364,7 @@ TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive w
     // Fixed DT with Adams-Bashforth 2: the multistep integrator without the controller.
     ParamTable ab2 = ParamTable::from_text("cpi.integrator = adams_bashforth2\ncpi.dt = 40\n",
                                            "scene.cfg", "/scenes");
-    const CoarseRunSettings f = CoarseRunSettings::from_params(ab2.root().scope("cpi"), 0.5);
+    const CpiSettings f = CpiSettings::from_params(ab2.root().scope("cpi"), 0.5);
     CHECK(!f.multistep.adaptive);
     CHECK(f.multistep.dt == 40.0);
     CHECK(f.make_integrator({})->name() == "projective_adams_bashforth2");
@@ -374,7 +372,7 @@ TEST_CASE("CoarseRunSettings reads the adaptive keys and refuses what adaptive w
     auto refused = [](const std::string& text) {
         ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
         return std::string(test::input_error([&] {
-                               CoarseRunSettings::from_params(t.root().scope("cpi"), 0.5);
+                               CpiSettings::from_params(t.root().scope("cpi"), 0.5);
                            }).what());
     };
     // Each message names the key, the file and line, and what is allowed.
@@ -423,7 +421,7 @@ TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drift
             "cpi.window = 4\ncpi.warmup = 1\ncpi.warmup_until = " +
                 until + "\n",
             "scene.cfg", "/scenes");
-        const CoarseRunSettings s = CoarseRunSettings::from_params(table.root().scope("cpi"), 0.1);
+        const CpiSettings s = CpiSettings::from_params(table.root().scope("cpi"), 0.1);
         test::OuEnsembleStepper toy(k, 0.005, 8, 0.1, Eigen::VectorXd::Constant(5, 3.0), 2);
         ProjectiveRun run(s, toy, variable("ou"));
         WarmupTime w;
@@ -456,10 +454,10 @@ TEST_CASE("a direct run reads the cpi block without checking it against the samp
     // are not multiples of it. A cpi run refuses that, naming the key; a direct run does not use
     // them and must not.
     ParamTable table = ParamTable::from_text("cpi.projection = adaptive\n", "scene.cfg", "/scenes");
-    CHECK_NOTHROW(CoarseRunSettings::from_params(table.root().scope("cpi"), 0.09, false));
+    CHECK_NOTHROW(CpiSettings::from_params(table.root().scope("cpi"), 0.09, false));
     ParamTable strict = ParamTable::from_text("cpi.tolerance = 0.1\n", "scene.cfg", "/scenes");
     try {
-        (void)CoarseRunSettings::from_params(strict.root().scope("cpi"), 0.09, true);
+        (void)CpiSettings::from_params(strict.root().scope("cpi"), 0.09, true);
         FAIL("expected an InputError");
     } catch (const InputError& e) {
         CHECK(e.key() == "cpi.healing");

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "coarse/equation_free/projective_stability.hpp"
-#include "coarse/equation_free/stability_monitor.hpp"
+#include "coarse/equation_free/projective/projective_stability.hpp"
+#include "coarse/equation_free/projective/stability_monitor.hpp"
 
 using namespace efdem::coarse;
 

@@ -6,7 +6,7 @@
 #include <numbers>
 #include <vector>
 
-#include "coarse/equation_free/slope_estimators.hpp"
+#include "coarse/equation_free/estimators/slope_estimators.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;

@@ -1,4 +1,4 @@
-// The run loop of mode = steady | continuation (coarse/equation_free/steady_run.hpp) on toy
+// The run loop of mode = steady | continuation (coarse/equation_free/steady/steady_run.hpp) on toy
 // steppers, without DEM or MPI: warm-up, solve, spectrum, observers, the budget stop, the
 // repair count, and continuation in a scaled parameter reported in the scene's units.
 #include <catch2/catch.hpp>
@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 
 #include "coarse/demixing/icdf_gap_coordinates.hpp"
-#include "coarse/equation_free/steady_run.hpp"
+#include "coarse/equation_free/steady/steady_run.hpp"
 #include "tests/coarse/steady_toy_steppers.hpp"
 
 using namespace efdem;

@@ -16,14 +16,14 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
-#include "coarse/equation_free/arclength_system.hpp"
-#include "coarse/equation_free/coarse_map.hpp"
-#include "coarse/equation_free/coarse_spectrum.hpp"
-#include "coarse/equation_free/continuation.hpp"
-#include "coarse/equation_free/fixed_point_iteration.hpp"
-#include "coarse/equation_free/fixed_point_system.hpp"
-#include "coarse/equation_free/gmres.hpp"
-#include "coarse/equation_free/newton_krylov.hpp"
+#include "coarse/equation_free/krylov/gmres.hpp"
+#include "coarse/equation_free/steady/arclength_system.hpp"
+#include "coarse/equation_free/steady/coarse_map.hpp"
+#include "coarse/equation_free/steady/coarse_spectrum.hpp"
+#include "coarse/equation_free/steady/continuation.hpp"
+#include "coarse/equation_free/steady/fixed_point_iteration.hpp"
+#include "coarse/equation_free/steady/fixed_point_system.hpp"
+#include "coarse/equation_free/steady/newton_krylov.hpp"
 #include "tests/coarse/steady_toy_steppers.hpp"
 
 using namespace efdem;

@@ -22,7 +22,7 @@
 
 #include "coarse/demixing/probability_grid.hpp"
 #include "coarse/demixing/quantiles.hpp"
-#include "coarse/equation_free/period_estimator.hpp"
+#include "coarse/equation_free/estimators/period_estimator.hpp"
 #include "dem/beds/bed_diagnostics.hpp"
 #include "dem/gas/slab_fields.hpp"
 #include "dem/realization_builder.hpp"

@@ -1,0 +1,149 @@
+#include "coarse/equation_free/projective/cpi_settings.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "core/whole_multiple.hpp"
+
+namespace efdem::coarse {
+
+CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, bool for_cpi_run) {
+    const char* interval = "observe.interval";
+    // Times on the sampling grid: checked only for a run that uses them (a direct run reads the
+    // cpi block of its scene without running it).
+    auto on_grid = [&](const char* key, double value) -> long {
+        if (!for_cpi_run) return std::lround(value / sample_interval);
+        return whole_multiple(cpi, key, value, sample_interval, interval);
+    };
+    CpiSettings s;
+    const std::string projection =
+        cpi.get_or_choice("projection", "fixed", {"fixed", "periods", "adaptive"});
+    s.projection = projection == "periods"    ? Projection::periods
+                   : projection == "adaptive" ? Projection::adaptive
+                                              : Projection::fixed;
+    const bool adaptive = s.projection == Projection::adaptive;
+    s.steps = cpi.get_or_choice("integrator", "euler", {"euler", "adams_bashforth2"}) ==
+                      "adams_bashforth2"
+                  ? 2
+                  : 1;
+    if (s.steps == 2 && s.projection == Projection::periods)
+        cpi.fail("integrator",
+                 "needs slopes at known times from every burst; cpi.projection = periods takes "
+                 "period means over bursts of varying length",
+                 "euler with cpi.projection = periods; adams_bashforth2 with fixed or adaptive");
+    s.warmup = cpi.get_or<double>("warmup", 0.0, Bounds::closed(0.0, 1e7));
+    on_grid("warmup", s.warmup);
+    const double healing = cpi.get_or<double>("healing", 10.0, Bounds::closed(0.0, 1e7));
+    on_grid("healing", healing);
+    const double window = cpi.get_or<double>("window", 10.0, Bounds::open_closed(0.0, 1e7));
+    const long window_samples = on_grid("window", window);
+    if (for_cpi_run && window_samples < 3)
+        cpi.fail("window",
+                 fmt::format("holds {} samples; a slope needs at least 3", window_samples),
+                 fmt::format(">= 3 x {} = {:g}", interval, 3 * sample_interval));
+    s.fixed.dt = cpi.get_or<double>("dt", 80.0, Bounds::closed(0.0, 1e7));
+    if (adaptive) {
+        for (const char* key : {"periods", "max_extension"})
+            if (cpi.contains(key))
+                cpi.fail(key,
+                         "is not read with cpi.projection = adaptive (it belongs to cpi.projection "
+                         "= periods)",
+                         "remove it, or choose cpi.projection = periods");
+    } else {
+        s.periods.periods_per_step = cpi.get_or<int>("periods", 2, Bounds::closed(0, 1000));
+        s.periods.max_extension =
+            cpi.get_or<double>("max_extension", 30.0, Bounds::closed(0.0, 1e7));
+        on_grid("max_extension", s.periods.max_extension);
+        for (const char* key : {"tolerance", "dt_min", "dt_max", "safety", "growth"})
+            if (cpi.contains(key))
+                cpi.fail(
+                    key,
+                    fmt::format("is read only with cpi.projection = adaptive (this run uses {})",
+                                projection),
+                    "remove it, or set cpi.projection = adaptive");
+    }
+    const std::string policy = cpi.get_or_choice("stability", "warn", {"warn", "halve", "stop"});
+    const StabilityPolicy stability = policy == "halve"  ? StabilityPolicy::halve_step
+                                      : policy == "stop" ? StabilityPolicy::stop
+                                                         : StabilityPolicy::warn;
+    s.fixed.healing = s.periods.healing = healing;
+    s.fixed.window = s.periods.window = window;
+    s.fixed.stability_policy = s.periods.stability_policy = stability;
+    MultistepSettings& m = s.multistep;
+    m.healing = healing;
+    m.window = window;
+    m.steps = s.steps;
+    m.adaptive = adaptive;
+    m.dt = s.fixed.dt;
+    m.stability_policy = stability;
+    m.dt_quantum = sample_interval;
+    if (adaptive) {
+        const double burst = healing + window;
+        StepSizeSettings& c = m.control;
+        c.tolerance = for_cpi_run
+                          ? cpi.get<double>("tolerance", Bounds::open_closed(0.0, 1e6))
+                          : cpi.get_or<double>("tolerance", 1.0, Bounds::open_closed(0.0, 1e6));
+        c.dt_min = cpi.get_or<double>("dt_min", 0.5 * burst, Bounds::open_closed(0.0, 1e7));
+        on_grid("dt_min", c.dt_min);
+        c.dt_max = cpi.get_or<double>("dt_max", 8.0 * burst, Bounds::open_closed(0.0, 1e7));
+        on_grid("dt_max", c.dt_max);
+        if (c.dt_min > c.dt_max)
+            cpi.fail("dt_min", fmt::format("is larger than cpi.dt_max = {:g}", c.dt_max),
+                     "cpi.dt_min <= cpi.dt_max");
+        c.safety = cpi.get_or<double>("safety", 0.8, Bounds::open_closed(0.0, 1.0));
+        c.growth = cpi.get_or<double>("growth", 2.0, Bounds::open_closed(1.0, 100.0));
+        if (cpi.contains("dt")) {
+            if (s.fixed.dt < c.dt_min || s.fixed.dt > c.dt_max)
+                cpi.fail(
+                    "dt",
+                    fmt::format(
+                        "caps the first jump with cpi.projection = adaptive and must lie in "
+                        "cpi.dt_min..cpi.dt_max = {:g}..{:g}",
+                        c.dt_min, c.dt_max),
+                    fmt::format(
+                        "{:g} <= cpi.dt <= {:g}, or leave it out (first jump from the tolerance)",
+                        c.dt_min, c.dt_max));
+            m.first_dt = s.fixed.dt;
+        }
+        m.drift_rate =
+            c.tolerance / burst;  // the phase signal moves less than the tolerance per burst
+        const Params debug = cpi.scope("debug");
+        const std::string force =
+            debug.get_or_choice("force", "none", {"none", "reject", "shrink"});
+        m.force.kind = force == "reject"   ? ForcedDecision::Kind::reject
+                       : force == "shrink" ? ForcedDecision::Kind::shrink
+                                           : ForcedDecision::Kind::none;
+        m.force.attempt = debug.get_or<long>("force_attempt", 1, Bounds::closed(1, 1000000));
+    }
+    s.warmup_until_steady = cpi.get_or_choice("warmup_until", adaptive ? "steady" : "time",
+                                              {"time", "steady"}) == "steady";
+    s.warmup_max =
+        cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::closed(0.0, 1e7));
+    on_grid("warmup_max", s.warmup_max);
+    s.drift_rate = adaptive ? m.drift_rate : 0.0;
+    // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
+    s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
+    return s;
+}
+
+double CpiSettings::burst() const {
+    return projection == Projection::periods ? periods.healing + periods.window
+                                             : fixed.healing + fixed.window;
+}
+
+double CpiSettings::window() const {
+    return projection == Projection::periods ? periods.window : fixed.window;
+}
+
+std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {
+    if (projection == Projection::adaptive || (projection == Projection::fixed && steps == 2))
+        return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
+    if (projection == Projection::fixed)
+        return std::make_unique<ProjectiveForwardEuler>(fixed, std::move(repair));
+    return std::make_unique<PeriodProjectiveEuler>(periods, std::move(repair));
+}
+
+}  // namespace efdem::coarse

@@ -1,0 +1,83 @@
+#pragma once
+/// \file
+/// CpiSettings: the scene's `cpi.*` keys that the coarse run loop (projective_run.hpp)
+/// and its integrator read, filled straight into the integrators' own settings (no copy of
+/// them is kept anywhere else). `cpi.observable` names the coarse variable and is read by the
+/// demixing room (coarse/demixing/observable_table.hpp). Times in sqrt(d_p/g).
+///
+// clang-format off: a table wider than the column limit
+/// | key               | meaning                                                       | default |
+/// |-------------------|---------------------------------------------------------------|---------|
+/// | cpi.projection    | `fixed` (DT = cpi.dt), `periods` (DT = k T) or `adaptive`     | fixed   |
+/// | cpi.integrator    | `euler` or `adams_bashforth2` (fixed, adaptive)               | euler   |
+/// | cpi.warmup        | direct simulation before the first coarse step (lower bound)  | 0       |
+/// | cpi.warmup_until  | `time` (cpi.warmup exactly) or `steady`: on until the phase    |
+/// adaptive:| |                   | signal (bed centre of mass) no longer drifts (phase_drift.hpp)
+/// | steady  | | cpi.warmup_max    | steady: most time the warm-up may run beyond cpi.warmup | 10
+/// burst| | cpi.healing       | start of each burst left out of the slope                     | 10
+/// | | cpi.window        | estimation window after healing (>= 3 samples)                | 10 | |
+/// cpi.dt            | projective step DT (projection = fixed)                       | 80      | |
+/// cpi.periods       | k in DT = k T (projection = periods)                          | 2       | |
+/// cpi.max_extension | most a burst may be lengthened to see 2 periods               | 30      | |
+/// cpi.stability     | `warn`, `halve` or `stop` when DT is flagged                  | warn    | |
+/// cpi.tolerance     | adaptive: error one jump may add, RMS over the ICDF [d_p]     | required| |
+/// cpi.dt_min        | adaptive: shortest jump; below it a burst runs directly       | burst/2 | |
+/// cpi.dt_max        | adaptive: longest jump                                        | 8 burst | |
+/// cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     | |
+/// cpi.growth        | adaptive: DT_next <= growth x DT_last                         | 2       |
+// clang-format on
+///
+/// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance
+/// when healing >= window gives the first burst a curvature, else one burst) and the keys of
+/// `periods` are refused; the adaptive keys are refused with the other projections.
+/// warmup, healing, window and max_extension must be whole multiples of the sampling interval.
+
+#include <memory>
+
+#include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
+#include "coarse/equation_free/projective/period_projective_euler.hpp"
+#include "coarse/equation_free/projective/projective_forward_euler.hpp"
+#include "coarse/equation_free/projective/projective_integrator.hpp"
+#include "core/param_table.hpp"
+
+namespace efdem::coarse {
+
+struct CpiSettings {
+    enum class Projection { fixed, periods, adaptive } projection = Projection::fixed;
+    /// 1: forward Euler; 2: Adams-Bashforth 2 (cpi.integrator).
+    int steps = 1;
+    /// Direct simulation before the first coarse step (the packed start is not on the slow
+    /// manifold).
+    double warmup = 0.0;
+    /// Warm-up on evidence: after `warmup`, go on in windows until the phase signal's drift is
+    /// within its noise (or slower than `drift_rate`), at most `warmup_max` longer.
+    bool warmup_until_steady = false;
+    double warmup_max = 0.0;
+    /// A drift of the phase signal this slow counts as steady [unit per sqrt(d_p/g)]:
+    /// cpi.tolerance per burst length (adaptive), 0 otherwise.
+    double drift_rate = 0.0;
+    /// Projection = fixed: healing, window, DT, stability policy.
+    ProjectiveEulerSettings fixed;
+    /// Projection = periods: healing, window, k, burst extension, stability policy.
+    PeriodProjectiveEulerSettings periods;
+    /// Projection = adaptive, or fixed with Adams-Bashforth 2.
+    MultistepSettings multistep;
+
+    /// Reads the keys above from the `cpi` scope (in the order of the table). Both
+    /// projections' keys are read, so that switching cpi.projection on the command line works on
+    /// a scene written for the other one. `sample_interval`: the stepper's sampling interval,
+    /// which the times must be whole multiples of (its key is `observe.interval`).
+    /// `for_cpi_run` false (a direct run of a cpi scene): the keys are read and their values
+    /// range-checked, but not checked against the sampling grid, and none is required.
+    static CpiSettings from_params(const Params& cpi, double sample_interval,
+                                   bool for_cpi_run = true);
+
+    /// healing + window of the selected projection: the length of an unextended burst.
+    double burst() const;
+    /// The estimation window of the selected projection.
+    double window() const;
+    /// The integrator these settings select, with `repair` applied to every projected vector.
+    std::unique_ptr<ProjectiveIntegrator> make_integrator(RepairHook repair) const;
+};
+
+}  // namespace efdem::coarse

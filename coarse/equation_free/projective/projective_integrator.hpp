@@ -1,0 +1,145 @@
+#pragma once
+/// \file
+/// The macro integrator of coarse projective integration: one outer step = burst (healing +
+/// estimation window) -> slope -> stability check -> extrapolation -> repair -> lift
+/// (physics.md §10). Implementations: ProjectiveForwardEuler (fixed DT, least-squares slope)
+/// and PeriodProjectiveEuler (DT = k T, period-mean slope).
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/projective/stability_monitor.hpp"
+#include "coarse/equation_free/repair_report.hpp"
+
+namespace efdem::coarse {
+
+/// How an outer step ended. After every status the micro model is in a valid state: at the
+/// end of the burst (no jump), or lifted to the projected vector.
+enum class StepStatus {
+    projected,              ///< burst, slope, jump and lift done (DT may have been halved)
+    burst_only,             ///< DT = 0 (configured, or halved to 0): burst only, no lift
+    stopped_unstable,       ///< StabilityPolicy::stop and the planned DT was flagged
+    too_few_periods,        ///< DT = k T: < 2 periods after healing, even after extension
+    invalid_burst,          ///< too few samples for the slope, non-finite samples, no phase
+                            ///< signal, or the last sample is not at the end of the burst
+    infeasible_projection,  ///< the projected vector is not finite, or the repair hook said so
+    rejected,               ///< adaptive: the burst after the jump showed its error above the
+                            ///< tolerance; the micro model is back where the jump started
+};
+
+std::string_view to_string(StepStatus status);
+
+/// What the step-size controller of the multistep integrator measured and decided for one
+/// jump (docs/error_control.md). Errors are RMS over the coarse vector's components [d_p for
+/// the ICDF]; per-component vectors in the same unit.
+struct ControllerRecord {
+    static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    bool active = false;                ///< the step was made by the multistep integrator
+    bool adaptive = false;              ///< DT chosen by the controller (else fixed)
+    int steps = 0;                      ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
+    double tolerance = nan;             ///< cpi.tolerance (NaN when fixed)
+    bool accepted = false;              ///< the jump was kept
+    double statistical = nan;           ///< projection noise of the jump
+    double truncation = nan;            ///< from the slope after the jump (a posteriori)
+    double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
+    Eigen::VectorXd statistical_nodes;  ///< per component
+    Eigen::VectorXd truncation_nodes;   ///< per component (noise not removed)
+    /// Largest DT the tolerance allows with the realizations run, and with 2 and 4 times as
+    /// many (standard errors / sqrt(2), / 2): what more realizations would buy.
+    double dt_tolerance = nan, dt_tolerance_2r = nan, dt_tolerance_4r = nan;
+    std::string limited_by;  ///< what set DT: "tolerance", "growth", "first jump", ...
+    double error() const { return statistical + truncation; }
+};
+
+/// Everything one outer step did, for output, diagnosis and tests. Times in sqrt(d_p/g).
+struct ProjectiveStepRecord {
+    StepStatus status = StepStatus::invalid_burst;
+    /// Empty for a plain step; otherwise warnings and reasons, "; "-separated.
+    std::string message;
+
+    double t_start = 0.0;       ///< micro clock at the start of the burst
+    double burst_length = 0.0;  ///< total time run, extensions included
+    double healing = 0.0;       ///< discarded start of the burst
+    double window = 0.0;        ///< time span the slope was estimated over
+    double dt_requested = 0.0;  ///< planned DT (k T for the period integrator)
+    double dt = 0.0;            ///< DT taken; 0 when there was no jump
+    /// Measured period T (NaN when the integrator does not use one).
+    double period = std::numeric_limits<double>::quiet_NaN();
+    int periods_per_step = 0;  ///< k taken (DT = k T); 0 for the fixed-DT integrator
+
+    Eigen::VectorXd slope;  ///< coarse slope s [unit of X per sqrt(d_p/g)]
+    /// Standard error of `slope` per component, from the spread of the members' own slopes
+    /// over the same window (slope_standard_error(); same unit as slope); DT times it is the
+    /// projection noise. Empty when the burst has no members or fewer than two.
+    Eigen::VectorXd slope_standard_error;
+    double t_end = 0.0;             ///< time of the last burst sample
+    Eigen::VectorXd x_end;          ///< X(t_end), the raw last sample
+    Eigen::VectorXd x_projected;    ///< X(t_end) + DT s after the repair hook (= x_end if no jump)
+    RepairReport repair;            ///< what the repair hook did (default: nothing)
+    StabilityAssessment stability;  ///< the monitor's verdict on the planned DT
+    bool lifted = false;            ///< the stepper's lift() was called
+    BurstSamples burst;             ///< the samples of this step's burst
+    ControllerRecord controller;    ///< the multistep integrator's error estimates and choice
+
+    /// The largest slope_standard_error over the components; NaN when there is none.
+    double max_slope_standard_error() const {
+        return slope_standard_error.size() == 0
+                   ? std::numeric_limits<double>::quiet_NaN()
+                   : slope_standard_error.maxCoeff<Eigen::PropagateNaN>();
+    }
+
+    /// The step ended in a state from which the next step can go on as planned.
+    bool advanced() const {
+        return status == StepStatus::projected || status == StepStatus::burst_only ||
+               status == StepStatus::rejected;
+    }
+};
+
+/// The rule by which a run ends at t_end: the largest DT allowed after a burst ending at
+/// `t_after_burst`, when the planned DT is `dt` and a burst lasts `burst`: the time left if it
+/// is at most dt; the time left minus one burst if a full jump would leave less than a burst;
+/// otherwise +infinity (also for an infinite t_end). Times compared to time_tolerance(t_end).
+double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, double burst);
+
+/// A macro integrator: advances a CoarseStepper by one outer step.
+class ProjectiveIntegrator {
+  public:
+    virtual ~ProjectiveIntegrator() = default;
+    virtual std::string_view name() const = 0;
+    /// One outer step. Never throws for a numerical condition: the record's status says what
+    /// happened (check advanced()). Collective if the stepper is.
+    virtual ProjectiveStepRecord step(CoarseStepper& stepper) = 0;
+
+    /// The run ends at `t_end`: from now on a jump never carries the state past it, and the
+    /// jump before the last burst leaves room for exactly that burst, so that a run whose
+    /// remaining time is at least one burst ends at t_end exactly (default: no end).
+    void set_end_time(double t_end) { end_time_ = t_end; }
+    double end_time() const { return end_time_; }
+
+    /// The integrator's own state between two steps (slope history, step-size controller), for
+    /// a checkpoint; integrators without one save nothing. restore_state() takes what
+    /// save_state() wrote, so that the next step is bit for bit the one the saved run made.
+    virtual void save_state(std::vector<double>& reals, std::string& text) const;
+    /// What the integrator did over the run, in a few lines for the log and the run file
+    /// (`realizations`: the ensemble's R); empty for integrators with nothing to add.
+    virtual std::string summary(int realizations) const {
+        (void)realizations;
+        return {};
+    }
+    virtual void restore_state(const std::vector<double>& reals, const std::string& text);
+
+  protected:
+    /// end_of_run_jump_limit() for this integrator's end time.
+    double jump_limit(double t_after_burst, double dt, double burst) const;
+
+  private:
+    double end_time_ = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace efdem::coarse

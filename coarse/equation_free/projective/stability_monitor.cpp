@@ -1,0 +1,112 @@
+#include "coarse/equation_free/projective/stability_monitor.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "coarse/equation_free/estimators/slope_estimators.hpp"
+#include "core/contracts.hpp"
+
+namespace efdem::coarse {
+
+DecayRateEstimate decay_rate_from_slopes(const Eigen::VectorXd& early, const Eigen::VectorXd& late,
+                                         double delay) {
+    EFDEM_EXPECTS(early.size() == late.size() && delay > 0.0);
+    DecayRateEstimate est;
+    est.delay = delay;
+    const double norm2 = early.squaredNorm();
+    if (norm2 == 0.0) {
+        est.message = "the slope over the first half of the window is zero: no decay rate";
+        return est;
+    }
+    est.ratio = early.dot(late) / norm2;
+    if (est.ratio <= 0.0) {
+        est.message = fmt::format(
+            "the slope reverses between the two halves of the window (ratio {:.3g}): an "
+            "oscillation or noise dominates, no single decay rate",
+            est.ratio);
+        return est;
+    }
+    est.rate = std::log(est.ratio) / delay;
+    est.ok = true;
+    return est;
+}
+
+DecayRateEstimate estimate_decay_rate(std::span<const double> t, std::span<const Eigen::VectorXd> x,
+                                      double t_start) {
+    EFDEM_EXPECTS(x.size() == t.size());
+    const std::size_t first = first_sample_at_or_after(t, t_start);
+    DecayRateEstimate est;
+    if (t.size() < first + 4) {
+        est.message =
+            fmt::format("the window t >= {:.6g} holds {} samples; the decay-rate estimate needs 4",
+                        t_start, t.size() - first);
+        return est;
+    }
+    const double t_mid = 0.5 * (t[first] + t.back());
+    // Halves [t_first, t_mid] and [t_mid, t_last]; a sample at t_mid belongs to both.
+    const std::size_t late_first = first_sample_at_or_after(t, t_mid);
+    const std::size_t early_end =
+        t[late_first] <= t_mid + time_tolerance(t_mid) ? late_first + 1 : late_first;
+    const SlopeEstimate early =
+        least_squares_slope(t.first(early_end), x.first(early_end), t_start);
+    const SlopeEstimate late = least_squares_slope(t, x, t_mid);
+    if (!early.ok || !late.ok) {
+        est.message = !early.ok ? early.message : late.message;
+        return est;
+    }
+    return decay_rate_from_slopes(early.slope, late.slope, t_mid - t[first]);
+}
+
+DecayRateEstimate estimate_decay_rate_periodic(std::span<const double> t,
+                                               std::span<const Eigen::VectorXd> x, double period,
+                                               double t_start, double t_end) {
+    EFDEM_EXPECTS(period > 0.0 && x.size() == t.size());
+    DecayRateEstimate est;
+    if (t_end - 3.0 * period < t_start - time_tolerance(t_start)) {
+        est.message = fmt::format(
+            "the window [{:.6g}, {:.6g}] holds fewer than three periods (T = {:.6g}); the "
+            "decay-rate estimate needs three",
+            t_start, t_end, period);
+        return est;
+    }
+    const std::size_t first = first_sample_at_or_after(t, t_start);
+    const auto tw = t.subspan(first);
+    const auto xw = x.subspan(first);
+    const SlopeEstimate early = period_mean_slope(tw, xw, period, t_end - period);
+    const SlopeEstimate late = period_mean_slope(tw, xw, period, t_end);
+    if (!early.ok || !late.ok) {
+        est.message = !early.ok ? early.message : late.message;
+        return est;
+    }
+    return decay_rate_from_slopes(early.slope, late.slope, period);
+}
+
+StabilityAssessment assess_stability(const DecayRateEstimate& decay, const CpiCycle& cycle) {
+    StabilityAssessment a;
+    if (!decay.ok) {
+        a.message = "stability not assessed: " + decay.message;
+        return a;
+    }
+    a.assessed = true;
+    a.rate = decay.rate;
+    if (decay.rate >= 0.0) {
+        a.message = fmt::format("no decaying transient in the window (lambda = {:.3g})", a.rate);
+        return a;
+    }
+    a.amplification = cpi_amplification(cycle, a.rate);
+    a.exact = std::exp(a.rate * (cycle.burst + cycle.dt));
+    a.stable = std::abs(a.amplification) <= 1.0;
+    a.message = fmt::format(
+        "measured transient lambda = {:.4g} per unit time: G(lambda) = {:.4g} for DT = {:.6g} "
+        "(burst {:.6g}, {} {:.6g}; exact factor {:.4g}){}",
+        a.rate, a.amplification, cycle.dt, cycle.burst,
+        cycle.estimator == SlopeEstimator::least_squares ? "window" : "period", cycle.window,
+        a.exact,
+        a.stable ? ""
+                 : ": |G| > 1, the projective step would amplify this mode (physics.md §10; "
+                   "cure: longer healing or smaller DT)");
+    return a;
+}
+
+}  // namespace efdem::coarse
