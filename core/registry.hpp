@@ -11,10 +11,22 @@
 #include <string_view>
 #include <vector>
 
+#include "core/bounds.hpp"
+
 namespace efdem {
 
+/// A key of a plug-in that a run may change while it goes on (the parameter a continuation
+/// follows): its name in the plug-in's scope, the bounds the scene reads it with (one owner:
+/// the plug-in reads the key with these bounds too) and a one-line summary.
+struct RunParameter {
+    std::string_view key;  ///< in the plug-in's scope: "superficial_velocity"
+    Bounds bounds;
+    std::string_view summary;
+};
+
 /**
- * \brief A name -> factory table for plug-ins of base type `Product`.
+ * \brief A name -> factory table for plug-ins of base type `Product`; a row may also list the
+ * plug-in's RunParameters (keys a run may change between steps).
  * \tparam Product the interface the factories return
  * \tparam Args    the arguments every factory takes
  *
@@ -34,6 +46,7 @@ class Registry {
         std::string_view name;
         Factory make;
         std::string_view summary;
+        std::span<const RunParameter> parameters = {};  ///< keys a run may change
     };
 
     constexpr explicit Registry(std::span<const Entry> entries) : entries_(entries) {}

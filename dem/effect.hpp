@@ -96,6 +96,10 @@ class Effect {
     virtual void describe(EffectReport&) const {}
     /// Called after particles changed species (lifting): refresh anything derived from masses.
     virtual void species_changed(const Particles&) {}
+    /// Sets `key`, one of the RunParameters of this effect's registry row (effect_registry.hpp),
+    /// to `value` between steps (mode = continuation). System::set_parameter checks the key and
+    /// its bounds first; an effect whose row lists none is never asked (a contract).
+    virtual void set_parameter(std::string_view key, double value);
 };
 
 }  // namespace efdem::dem

@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "core/contracts.hpp"
 #include "core/error.hpp"
+#include "dem/effect_registry.hpp"
 
 namespace efdem::dem {
 
@@ -55,6 +58,20 @@ const Effect* System::find_effect(std::string_view name) const {
 
 Effect* System::find_effect(std::string_view name) {
     return const_cast<Effect*>(std::as_const(*this).find_effect(name));
+}
+
+void System::set_parameter(std::string_view key, double value) {
+    const std::optional<EffectParameter> p = find_run_parameter(key);
+    EFDEM_EXPECTS(p.has_value());  // the settings accept only run_parameters()
+    if (!p) throw std::logic_error(fmt::format("'{}' is not a run parameter of any effect", key));
+    Effect* effect = find_effect(p->effect);
+    if (!effect)
+        throw RuntimeFailure(fmt::format(
+            "{} cannot be set: the scene does not list {} in its effects", key, p->effect));
+    if (!p->parameter.bounds.contains(value))
+        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: it must be {}",
+                                         key, value, p->parameter.bounds.describe()));
+    effect->set_parameter(p->parameter.key, value);
 }
 
 ForceContext System::context() {

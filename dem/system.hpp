@@ -68,6 +68,12 @@ class System {
     const Effect* find_effect(std::string_view name) const;
     /// The same, to change the effect between steps (e.g. GasDrag::set_superficial_velocity).
     Effect* find_effect(std::string_view name);
+    /// Sets a key a run may change between steps ("gas_drag.superficial_velocity": one of
+    /// run_parameters(), effect_registry.hpp) to `value`. A RuntimeFailure when the scene does
+    /// not list the key's effect or `value` is outside the bounds the scene reads the key with
+    /// (the coarse solvers keep to them: this is the last line against a value no bed can be
+    /// run at); an unknown key is a contract.
+    void set_parameter(std::string_view key, double value);
     /// The union of what the effects need.
     Needs needs() const { return needs_; }
 

@@ -22,15 +22,15 @@
 # and, between the rooms of dem/ (one target; dem/CMakeLists.txt):
 #
 #   contact/ <-/-> gas/                  the two physics rooms know nothing of each other
-#   contact/, gas/, effects/             -> no beds/, settling/, io/, realization builder
+#   contact/, gas/, body_forces/             -> no beds/, settling/, io/, realization builder
 #                                           (forces come before preparing beds and writing)
-#   io/                                  -> no contact/, gas/, effects/, settling/, effect
+#   io/                                  -> no contact/, gas/, body_forces/, settling/, effect
 #                                           registry, realization builder (it reads a System)
 #   top level (scene, System, ...)       -> no beds/, settling/, io/: only realization_builder
 #                                           puts them together (no scene <-> beds cycle)
 #   settling/                            <- realization_builder.cpp only
 #   realization_builder.hpp              <- nothing in dem/ (it is the top)
-#   effect headers (effects/, contact/{pair,wall}_contact.hpp, gas/gas_drag.hpp)
+#   effect headers (body_forces/, contact/{pair,wall}_contact.hpp, gas/gas_drag.hpp)
 #                                        <- effect_registry.cpp, settling/ (its damping stage),
 #                                           beds/bed_diagnostics.cpp (GasDrag::pressure_drop)
 #
@@ -84,9 +84,9 @@ check_tree() {
     local late='dem/(beds|settling|io)/|dem/realization_builder\.hpp'
     forbid dem/contact "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
     forbid dem/gas "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
-    forbid dem/effects "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
+    forbid dem/body_forces "$late" "dem/beds/, dem/settling/, dem/io/ or the realization builder"
     forbid dem/io 'dem/(contact|gas|effects|settling)/|dem/effect_registry\.hpp|dem/realization_builder\.hpp' \
-        "dem/contact/, dem/gas/, dem/effects/, dem/settling/, the effect registry or the realization builder"
+        "dem/contact/, dem/gas/, dem/body_forces/, dem/settling/, the effect registry or the realization builder"
     forbid_files dem '^dem/[^/]+$' 'dem/(beds|settling|io)/' \
         "the top level of dem/ must not include dem/beds/, dem/settling/ or dem/io/ (only dem/realization_builder.* puts them together)" \
         '^dem/realization_builder\.(hpp|cpp)$'
@@ -94,7 +94,7 @@ check_tree() {
         "dem/settling/ is included by dem/realization_builder.cpp only" '^dem/(realization_builder\.cpp|settling/)'
     forbid_files dem '^dem/' 'dem/realization_builder\.hpp' \
         "nothing in dem/ includes dem/realization_builder.hpp (it is the top of dem/)"
-    forbid_files dem '^dem/' 'dem/(effects/|contact/(pair|wall)_contact\.hpp|gas/gas_drag\.hpp)' \
+    forbid_files dem '^dem/' 'dem/(body_forces/|contact/(pair|wall)_contact\.hpp|gas/gas_drag\.hpp)' \
         "effect headers are included by dem/effect_registry.cpp, dem/settling/ and dem/beds/bed_diagnostics.cpp only (effects are made by name)" \
         '^dem/(effect_registry\.cpp|beds/bed_diagnostics\.cpp)$|^dem/settling/'
     # The rooms of coarse/ and mpi_driver/ (the table at the top).
@@ -124,20 +124,20 @@ check_tree() {
 if [ "${1:-}" = "--self-test" ]; then
     scratch=$(mktemp -d)
     trap 'rm -rf "$scratch"' EXIT
-    mkdir -p "$scratch"/{core,dem/{contact,gas,effects,beds,settling,io},coarse/{dem_adapters,demixing}} \
+    mkdir -p "$scratch"/{core,dem/{contact,gas,body_forces,beds,settling,io},coarse/{dem_adapters,demixing}} \
              "$scratch"/coarse/equation_free/{projective,estimators,steady,krylov} \
              "$scratch"/mpi_driver/{output,ensemble,checkpoint,run}
     echo '#include "core/vec3.hpp"' > "$scratch/dem/ok.cpp"
     # What the rooms of dem/ may include (the exceptions of the rules must not be flagged).
     printf '#include "dem/%s"\n' realization_builder.hpp settling/settling.hpp beds/bed_builder.hpp \
         io/lammps_data.hpp > "$scratch/dem/realization_builder.cpp"
-    printf '#include "dem/%s"\n' settling/settling.hpp beds/bed_builder.hpp effects/viscous_damping.hpp \
+    printf '#include "dem/%s"\n' settling/settling.hpp beds/bed_builder.hpp body_forces/viscous_damping.hpp \
         effect_registry.hpp > "$scratch/dem/settling/settling.cpp"
-    printf '#include "dem/%s"\n' effects/gravity.hpp contact/pair_contact.hpp gas/gas_drag.hpp \
+    printf '#include "dem/%s"\n' body_forces/gravity.hpp contact/pair_contact.hpp gas/gas_drag.hpp \
         > "$scratch/dem/effect_registry.cpp"
     printf '#include "dem/%s"\n' beds/bed_diagnostics.hpp gas/gas_drag.hpp gas/slab_fields.hpp \
         > "$scratch/dem/beds/bed_diagnostics.cpp"
-    printf '#include "dem/%s"\n' effects/gravity.hpp effect.hpp > "$scratch/dem/effects/gravity.cpp"
+    printf '#include "dem/%s"\n' body_forces/gravity.hpp effect.hpp > "$scratch/dem/body_forces/gravity.cpp"
     printf '#include "dem/%s"\n' contact/pair_contact.hpp contact/contact_history.hpp neighbor_list.hpp \
         > "$scratch/dem/contact/pair_contact.cpp"
     printf '#include "dem/%s"\n' io/bed_time_series.hpp beds/bed_diagnostics.hpp system.hpp \
@@ -163,14 +163,14 @@ if [ "${1:-}" = "--self-test" ]; then
                "core/e.cpp:#include \"dem/particles.hpp\"" "coarse/dem_adapters/f.cpp:#include <mpi.h>" \
                "dem/contact/g.cpp:#include \"dem/gas/slab_fields.hpp\"" \
                "dem/gas/h.hpp:#include \"dem/contact/contact_laws.hpp\"" \
-               "dem/effects/i.cpp:#include \"dem/beds/bed_builder.hpp\"" \
+               "dem/body_forces/i.cpp:#include \"dem/beds/bed_builder.hpp\"" \
                "dem/io/j.cpp:#include \"dem/contact/contact_history.hpp\"" \
                "dem/scene.cpp:#include \"dem/beds/bed_builder.hpp\"" \
                "dem/beds/k.cpp:#include \"dem/settling/settling.hpp\"" \
                "dem/io/l.cpp:#include \"dem/realization_builder.hpp\"" \
                "dem/scene.hpp:#include \"dem/realization_builder.hpp\"" \
                "dem/system.cpp:#include \"dem/contact/pair_contact.hpp\"" \
-               "dem/beds/bed_builder.cpp:#include \"dem/effects/viscous_damping.hpp\"" \
+               "dem/beds/bed_builder.cpp:#include \"dem/body_forces/viscous_damping.hpp\"" \
                "coarse/equation_free/m.cpp:#include \"coarse/demixing/quantiles.hpp\"" \
                "coarse/demixing/n.hpp:#include \"coarse/dem_adapters/apply_colours.hpp\"" \
                "coarse/equation_free/n1.hpp:#include \"coarse/equation_free/projective/projective_run.hpp\"" \

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "core/contracts.hpp"
-#include "dem/effects/gravity.hpp"
+#include "dem/body_forces/gravity.hpp"
 #include "dem/gas/gas_drag.hpp"
 #include "dem/gas/slab_fields.hpp"
 

@@ -29,8 +29,8 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     if (!s.law)
         p.fail("law", "names an unknown drag law '" + law + "'",
                fmt::format("known drag laws: {}", fmt::join(drag_law_names(), ", ")));
-    s.superficial_velocity =
-        p.get<double>("superficial_velocity", Bounds::closed(0.0, kMaxSuperficialVelocity));
+    const RunParameter& u_s = GasDrag::run_parameters().front();
+    s.superficial_velocity = p.get<double>(std::string(u_s.key), u_s.bounds);
     s.phi_cap = p.get_or<double>("phi_cap", 0.70, Bounds::open(0.0, 1.0));
     s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::at_least(0.1));
 
@@ -89,6 +89,20 @@ inline SlabTerms slab_terms(const GasDragSpec& s, double phi, const Vec3& u_s) {
 }  // namespace
 
 GasDrag::GasDrag(const EffectSetup& s) : GasDrag(checked_spec(s), s.species) {}
+
+std::span<const RunParameter> GasDrag::run_parameters() {
+    static const RunParameter kParameters[] = {
+        {"superficial_velocity", Bounds::closed(0.0, kMaxSuperficialVelocity),
+         "U_s, the superficial gas velocity [sqrt(g d_p)]"},
+    };
+    return kParameters;
+}
+
+void GasDrag::set_parameter(std::string_view key, double value) {
+    EFDEM_EXPECTS(key == run_parameters().front().key);
+    (void)key;  // the only one
+    set_superficial_velocity(value);
+}
 
 GasDrag::GasDrag(const GasDragSpec& spec, const SpeciesTable& species) : spec_(spec) {
     for (std::size_t k = 0; k < species.size(); ++k) {

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "core/registry.hpp"
 #include "dem/effect.hpp"
 #include "dem/gas/drag_laws.hpp"
 
@@ -78,8 +79,13 @@ class GasDrag final : public Effect {
     void describe(EffectReport& r) const override;
 
     const GasDragSpec& spec() const { return spec_; }
+    /// The keys a run may change between steps (the registry row lists them): U_s, read by the
+    /// scene with these same bounds.
+    static std::span<const RunParameter> run_parameters();
     /// Changes U_s between steps (a U_s sweep, continuation in U_s).
     void set_superficial_velocity(double u) { spec_.superficial_velocity = u; }
+    /// key = "superficial_velocity": set_superficial_velocity(value).
+    void set_parameter(std::string_view key, double value) override;
 
     /// (-grad p)_j of the discrete gas momentum balance, one vector per slab [rho_s g]; its z
     /// component is -dp/dz. \pre out.size() >= slabs.size().

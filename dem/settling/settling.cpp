@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "core/log.hpp"
+#include "dem/body_forces/viscous_damping.hpp"
 #include "dem/effect_registry.hpp"
-#include "dem/effects/viscous_damping.hpp"
 #include "dem/system.hpp"
 
 namespace efdem::dem {

@@ -11,7 +11,6 @@
 #include "coarse/demixing/colour_lifting.hpp"
 #include "core/contracts.hpp"
 #include "core/error.hpp"
-#include "dem/gas/gas_drag.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -63,23 +62,8 @@ void DemRealization::after_sample(long samples_taken) {
     if (thermo_ && samples_taken % output_.thermo_every == 0) thermo_->write(system_);
 }
 
-std::vector<std::string> continuation_parameters() {
-    return {"gas_drag.superficial_velocity"};
-}
-
 void DemRealization::set_parameter(const std::string& key, double value) {
-    EFDEM_EXPECTS(key == "gas_drag.superficial_velocity");
-    auto* gas = dynamic_cast<dem::GasDrag*>(system_.find_effect("gas_drag"));
-    if (!gas)
-        throw RuntimeFailure(
-            fmt::format("{} cannot be set: the scene does not list gas_drag in its effects", key));
-    // The scene key's own bounds; the coarse solvers keep to them (ContinuationSettings::
-    // evaluation_min/max), so this is the last line against a value no bed can be run at.
-    if (!(value >= 0.0 && value <= dem::kMaxSuperficialVelocity))
-        throw RuntimeFailure(
-            fmt::format("{} = {:g} asked for by the coarse solver: outside [0, {:g}]", key, value,
-                        dem::kMaxSuperficialVelocity));
-    gas->set_superficial_velocity(value);
+    system_.set_parameter(key, value);
 }
 
 RealizationState DemRealization::save_state() const {

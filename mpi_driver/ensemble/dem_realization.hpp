@@ -17,9 +17,6 @@
 
 namespace efdem::mpi_driver {
 
-/// The scene keys mode = continuation can continue in (DemRealization::set_parameter).
-std::vector<std::string> continuation_parameters();
-
 /// Per-realization output settings (intervals in samples; 0 = none).
 struct RealizationOutput {
     std::filesystem::path directory;

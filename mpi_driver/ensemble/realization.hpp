@@ -67,8 +67,9 @@ class Realization {
     virtual void apply_lift(const LiftPayload& lifted) = 0;
     /// Called after every sample with the running sample count (per-realization outputs).
     virtual void after_sample(long samples_taken) { (void)samples_taken; }
-    /// Sets the scene parameter `key` (one of continuation_parameters(), dem_realization.hpp)
-    /// to `value` between steps: mode = continuation. Realizations without it refuse.
+    /// Sets the scene parameter `key` (a DEM realization: one of dem::run_parameters(),
+    /// dem/effect_registry.hpp) to `value` between steps: mode = continuation. Realizations
+    /// without it refuse.
     virtual void set_parameter(const std::string& key, double value) {
         (void)value;
         throw RuntimeFailure("this realization type cannot change " + key);

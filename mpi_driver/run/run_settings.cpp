@@ -7,7 +7,7 @@
 #include "coarse/demixing/observable_table.hpp"
 #include "coarse/demixing/probability_grid.hpp"
 #include "core/whole_multiple.hpp"
-#include "mpi_driver/ensemble/dem_realization.hpp"
+#include "dem/effect_registry.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -83,22 +83,25 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
             row ? static_cast<long>(
                       row->make(coarse::ProbabilityGrid(s.observe.quantiles))->dimension())
                 : s.observe.quantiles;
+        // The parameters a continuation may follow: the keys the effects' registry rows list as
+        // changeable during a run, with the bounds each effect reads its key with.
+        std::vector<coarse::ContinuationParameter> parameters;
+        for (const dem::EffectParameter& p : dem::run_parameters())
+            parameters.push_back({p.key, p.parameter.bounds});
         s.steady = coarse::SteadyRunSettings::from_params(
-            root, s.observe.interval, dimension, s.mode == Mode::continuation,
-            continuation_parameters(), [&](const std::string& key) {
-                const auto dot = key.find('.');
-                const std::string effect = key.substr(0, dot);
-                if (std::find(scene.effect_names.begin(), scene.effect_names.end(), effect) ==
+            root, s.observe.interval, dimension, s.mode == Mode::continuation, parameters,
+            [&](const std::string& key) {
+                const dem::EffectParameter p = *dem::find_run_parameter(key);
+                if (std::find(scene.effect_names.begin(), scene.effect_names.end(), p.effect) ==
                     scene.effect_names.end())
                     root.scope("continuation")
                         .fail(
                             "parameter",
                             fmt::format("names a key of {}, which the scene's effects do not list",
-                                        effect),
-                            fmt::format("a key of a listed effect (add {} to effects)", effect));
-                // Read with the bounds its effect reads it with (dem/gas/gas_drag.cpp).
-                return root.scope(effect).get<double>(key.substr(dot + 1),
-                                                      Bounds::closed(0.0, 1e3));
+                                        p.effect),
+                            fmt::format("a key of a listed effect (add {} to effects)", p.effect));
+                return root.scope(std::string(p.effect))
+                    .get<double>(std::string(p.parameter.key), p.parameter.bounds);
             });
         if (s.steady.gap_coordinates && s.observable != "icdf")
             root.scope("steady").fail(

@@ -3,6 +3,7 @@
 // input errors with clear messages.
 #include <catch2/catch.hpp>
 
+#include "core/error.hpp"
 #include "dem/effect_registry.hpp"
 #include "dem/realization_builder.hpp"
 #include "dem/scene.hpp"
@@ -134,4 +135,58 @@ TEST_CASE("hertz with LAMMPS' single gamma_n is refused", "[unit][effects]") {
                                "pair_contact.damping = gamma\n");
     const auto e = input_error([&] { build(t); });
     CHECK(e.key() == "pair_contact.damping");
+}
+
+// Parameters by name: the coarse layer changes a scene key during a run (mode = continuation)
+// without knowing which effect owns it; the registry row lists the key with the bounds the
+// effect reads it with.
+TEST_CASE("the registry lists the keys a run may change, with the bounds the scene reads them with",
+          "[unit][effects]") {
+    const std::vector<EffectParameter> all = run_parameters();
+    REQUIRE(all.size() == 1);  // today only U_s; a new row shows up here
+    CHECK(all[0].key == "gas_drag.superficial_velocity");
+    CHECK(all[0].effect == "gas_drag");
+    CHECK(all[0].parameter.bounds.describe() == "in [0, 1000]");
+    CHECK(find_run_parameter("gas_drag.superficial_velocity").has_value());
+    CHECK_FALSE(find_run_parameter("gas_drag.phi_cap").has_value());
+    CHECK_FALSE(find_run_parameter("superficial_velocity").has_value());
+    // The same bounds as the scene key: 1000 is accepted, 1000.5 refused with them.
+    auto ok = test::scene_table(kBase +
+                                "effects = gravity gas_drag\n"
+                                "gas_drag.A = 0.114939\ngas_drag.superficial_velocity = 1000\n");
+    CHECK_NOTHROW(build(ok));
+    auto bad = test::scene_table(kBase +
+                                 "effects = gravity gas_drag\n"
+                                 "gas_drag.A = 0.114939\ngas_drag.superficial_velocity = 1000.5\n");
+    const InputError e = input_error([&] { build(bad); });
+    CHECK_THAT(e.what(), Catch::Contains("in [0, 1000]"));
+}
+
+TEST_CASE("System::set_parameter changes an effect's key by name, within its bounds",
+          "[unit][effects]") {
+    auto t = test::scene_table(kBase +
+                               "effects = gravity pair_contact wall_contact gas_drag\n"
+                               "gas_drag.A = 0.114939\ngas_drag.superficial_velocity = 0.19\n");
+    System s = build(t);
+    s.set_parameter("gas_drag.superficial_velocity", 0.41);
+    CHECK(test::gas_effect(s).spec().superficial_velocity == 0.41);  // stored as given
+    // Outside the key's bounds: a runtime failure naming the key, the value and the bounds; the
+    // effect keeps its value.
+    try {
+        s.set_parameter("gas_drag.superficial_velocity", -0.01);
+        FAIL("a negative U_s was accepted");
+    } catch (const RuntimeFailure& f) {
+        CHECK_THAT(f.what(), Catch::Contains("gas_drag.superficial_velocity = -0.01") &&
+                                 Catch::Contains("in [0, 1000]"));
+    }
+    CHECK(test::gas_effect(s).spec().superficial_velocity == 0.41);
+
+    auto no_gas = test::scene_table(kBase + "effects = gravity pair_contact wall_contact\n");
+    System dry = build(no_gas);
+    try {
+        dry.set_parameter("gas_drag.superficial_velocity", 0.3);
+        FAIL("a scene without gas_drag accepted U_s");
+    } catch (const RuntimeFailure& f) {
+        CHECK_THAT(f.what(), Catch::Contains("does not list gas_drag"));
+    }
 }

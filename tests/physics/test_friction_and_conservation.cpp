@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/rng.hpp"
-#include "dem/effects/gravity.hpp"
+#include "dem/body_forces/gravity.hpp"
 #include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;

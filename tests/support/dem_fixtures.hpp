@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "core/param_table.hpp"
+#include "dem/body_forces/gravity.hpp"
 #include "dem/contact/contact_model.hpp"
 #include "dem/contact/pair_contact.hpp"
 #include "dem/contact/wall_contact.hpp"
-#include "dem/effects/gravity.hpp"
 #include "dem/gas/gas_drag.hpp"
 #include "dem/scene.hpp"
 #include "dem/system.hpp"

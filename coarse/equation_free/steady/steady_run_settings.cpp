@@ -20,7 +20,7 @@ void refuse(const Params& scope, const std::vector<const char*>& keys, const std
 
 SteadyRunSettings SteadyRunSettings::from_params(
     const Params& root, double sample_interval, long dimension, bool continuation,
-    const std::vector<std::string>& allowed_parameters,
+    const std::vector<ContinuationParameter>& allowed_parameters,
     const std::function<double(const std::string&)>& current_value) {
     SteadyRunSettings s;
     s.continuation = continuation;
@@ -104,9 +104,15 @@ SteadyRunSettings SteadyRunSettings::from_params(
                           "remove it, or set mode = continuation");
         return s;
     }
-    s.parameter = cont.get_choice("parameter", allowed_parameters);
+    std::vector<std::string> names;
+    for (const ContinuationParameter& p : allowed_parameters) names.push_back(p.key);
+    s.parameter = cont.get_choice("parameter", names);
+    const Bounds parameter_bounds =
+        std::find_if(allowed_parameters.begin(), allowed_parameters.end(),
+                     [&](const ContinuationParameter& p) { return p.key == s.parameter; })
+            ->bounds;
     s.parameter_start = current_value(s.parameter);
-    s.parameter_end = cont.get<double>("end", Bounds::closed(0.0, 1e3));
+    s.parameter_end = cont.get<double>("end", parameter_bounds);
     const double range = std::abs(s.parameter_end - s.parameter_start);
     if (range <= 1e-12 * std::max(1.0, std::abs(s.parameter_start)))
         cont.fail("end",
@@ -137,10 +143,10 @@ SteadyRunSettings SteadyRunSettings::from_params(
     b.parameter_min = std::min(s.parameter_start, s.parameter_end) / s.parameter_scale;
     b.parameter_max = std::max(s.parameter_start, s.parameter_end) / s.parameter_scale;
     b.display_scale = s.parameter_scale;
-    // Every parameter continuation.parameter may name is a velocity-like key in [0, 1000] (the
-    // bounds continuation.end is read with): no corrector runs the DEM outside.
-    b.evaluation_min = 0.0;
-    b.evaluation_max = 1e3 / s.parameter_scale;
+    // The bounds the micro model reads the parameter with (continuation.end too): no corrector
+    // runs the micro model outside.
+    b.evaluation_min = parameter_bounds.lo / s.parameter_scale;
+    b.evaluation_max = parameter_bounds.hi / s.parameter_scale;
     b.stability = s.eigenvalues > 0;
     b.spectrum = s.spectrum;
     b.spectrum.eigenvalues = 1;

@@ -52,6 +52,13 @@
 
 namespace efdem::coarse {
 
+/// A scene key continuation.parameter may name, with the bounds the micro model reads it with:
+/// continuation.end is read with them, and no corrector runs the micro model outside them.
+struct ContinuationParameter {
+    std::string key;  ///< "gas_drag.superficial_velocity"
+    Bounds bounds;
+};
+
 struct SteadyRunSettings {
     enum class Solver { newton, anderson } solver = Solver::newton;
     bool continuation = false;  ///< mode = continuation (else mode = steady)
@@ -87,7 +94,7 @@ struct SteadyRunSettings {
     /// `current_value` the scene's value of one of them (the start of the branch).
     static SteadyRunSettings from_params(
         const Params& root, double sample_interval, long dimension, bool continuation,
-        const std::vector<std::string>& allowed_parameters,
+        const std::vector<ContinuationParameter>& allowed_parameters,
         const std::function<double(const std::string&)>& current_value);
 };
 

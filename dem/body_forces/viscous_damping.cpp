@@ -1,4 +1,4 @@
-#include "dem/effects/viscous_damping.hpp"
+#include "dem/body_forces/viscous_damping.hpp"
 
 #include <fmt/format.h>
 

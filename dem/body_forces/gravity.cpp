@@ -1,4 +1,4 @@
-#include "dem/effects/gravity.hpp"
+#include "dem/body_forces/gravity.hpp"
 
 #include <fmt/format.h>
 
