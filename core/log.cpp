@@ -38,6 +38,18 @@ void write_warn(const std::string& message) {
     std::fprintf(stderr, "efdem: %swarning: %s\n", rank_prefix().c_str(), message.c_str());
     std::fflush(stderr);
 }
+void write_notice(const std::string& message) {
+    std::fprintf(stderr, "efdem: %s\n", message.c_str());
+    std::fflush(stderr);
+}
+void write_rank_error(const std::string& message) {
+    std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", g_rank, g_n_ranks, message.c_str());
+    std::fflush(stderr);
+}
+void write_output(const std::string& text) {
+    std::fputs(text.c_str(), stdout);
+    std::fflush(stdout);
+}
 void write_error(const std::string& message) {
     std::fprintf(stderr, "efdem: %serror: %s\n", rank_prefix().c_str(), message.c_str());
     std::fflush(stderr);

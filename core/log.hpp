@@ -6,6 +6,12 @@
 /// * warn(): printed by whichever rank calls it, prefixed with the rank when there are several
 ///   (to stderr), so that a warning seen on one rank only is not lost.
 /// * error(): the final message of a failing run (stderr), always printed.
+/// * rank_error(): a failure only this rank sees (a realization's), "efdem: [rank r of n]
+///   error: ..." on stderr, always printed, whatever the rank count.
+/// * notice(): the final message of a run that ends without failing but unfinished (a stop
+///   signal: where it was saved, how to continue), "efdem: ..." on stderr, always printed.
+/// * output(): what a command prints as its answer (--help, --list-effects, --check, ...):
+///   stdout on the root, whatever the level.
 
 #include <string>
 #include <utility>
@@ -25,6 +31,9 @@ void write_info(const std::string& message);
 void write_warn(const std::string& message);
 void write_error(const std::string& message);
 void write_debug(const std::string& message);
+void write_notice(const std::string& message);
+void write_rank_error(const std::string& message);
+void write_output(const std::string& message);
 
 template <class... Args>
 void info(fmt::format_string<Args...> f, Args&&... args) {
@@ -38,6 +47,18 @@ void debug(fmt::format_string<Args...> f, Args&&... args) {
 template <class... Args>
 void warn(fmt::format_string<Args...> f, Args&&... args) {
     if (level() >= Level::warn) write_warn(fmt::format(f, std::forward<Args>(args)...));
+}
+template <class... Args>
+void rank_error(fmt::format_string<Args...> f, Args&&... args) {
+    write_rank_error(fmt::format(f, std::forward<Args>(args)...));
+}
+template <class... Args>
+void notice(fmt::format_string<Args...> f, Args&&... args) {
+    write_notice(fmt::format(f, std::forward<Args>(args)...));
+}
+/// `text` as it is (no newline added), on the root only.
+inline void output(const std::string& text) {
+    if (rank() == 0) write_output(text);
 }
 template <class... Args>
 void error(fmt::format_string<Args...> f, Args&&... args) {

@@ -1,0 +1,168 @@
+#include "mpi_driver/run/ensemble_run.hpp"
+
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/version.hpp"
+#include "mpi_driver/checkpoint/restart_check.hpp"
+#include "mpi_driver/ensemble/dem_realization.hpp"
+#include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/output/csv_recorder.hpp"
+#include "mpi_driver/output/recorder_list.hpp"
+#include "mpi_driver/run/driver.hpp"
+#include "mpi_driver/run/run_end.hpp"
+#include "mpi_driver/run/run_observables.hpp"
+#include "mpi_driver/run/run_provenance.hpp"
+#include "mpi_driver/run/steady_driver.hpp"
+#if EFDEM_HAVE_HDF5
+#include "mpi_driver/checkpoint/checkpoint_writer.hpp"
+#include "mpi_driver/output/hdf5_recorder.hpp"
+#endif
+
+namespace efdem::mpi_driver {
+
+int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
+                 std::vector<dem::System> systems, const RestartData* restart,
+                 const SetupWall& wall) {
+    const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
+    const RunProvenance prov = provenance(mpi, table, s, systems.front(), bed);
+    const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
+    RunObservables observables = RunObservables::from_settings(s);
+
+    std::unique_ptr<RecorderList> recorders;
+    std::vector<std::unique_ptr<Realization>> local;
+    const bool resume = restart != nullptr;
+    try {
+        if (mpi.is_root()) {
+            if (resume) restore_outputs(restart->header, s.output.directory, s.output.prefix);
+            std::vector<std::unique_ptr<RunRecorder>> owned;
+#if EFDEM_HAVE_HDF5
+            owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory, s.output.prefix,
+                                                           prov, observables.primary->dimension(),
+                                                           resume));
+#endif
+            owned.push_back(
+                std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov, resume));
+            recorders = std::make_unique<RecorderList>(std::move(owned));
+        }
+        RealizationOutput out{
+            s.output.directory, s.output.prefix,
+            std::lround(s.output.vtk_interval / s.observe.interval),
+            std::lround(s.output.thermo_interval / s.observe.interval),
+            resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
+        for (auto& sys : systems)
+            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species,
+                                                             s.observe.other, out, resume, bed));
+    } catch (const std::exception& e) {
+        mpi.abort(e.what(), kExitRuntimeFailure);
+    }
+    if (resume) {
+        const Agreement agreed = restore_realizations(mpi.comm(), *restart, local);
+        if (agreed.exit_code != kExitOk) {
+            if (mpi.is_root()) log::error("{}", agreed.message);
+            return agreed.exit_code;
+        }
+        log::info("restarted from {} at t = {:.6g}", restart->path.string(), local.front()->time());
+    }
+    log::info(
+        "efdem {}: {} run of {} on {} ranks x {} = {} realizations ({} particles each), output "
+        "{}/{}.*",
+        version(), prov.mode, table.file(), mpi.size(), s.realizations_per_rank, prov.realizations,
+        local.front()->particles(), s.output.directory.string(), s.output.prefix);
+
+    StepperSettings ss;
+    ss.sample_interval = s.observe.interval;
+    ss.steps_per_sample = s.observe.steps_per_sample;
+    ss.quantiles = s.observe.quantiles;
+    ss.seed = s.seed;
+    ss.failure = s.injected_failure;
+    ss.on_failure = s.on_failure;
+    ss.recorded = observables.recorded.get();
+    ss.bed = bed;
+    ss.parameter = s.steady.parameter;
+    ss.lift_members = s.lift_members && s.is_cpi();
+    // The run's start (progress counts from there; on the non-root ranks it is not used).
+    const double t0 =
+        resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
+    Progress progress(t0, t0 + s.duration, 2.0);
+    const ColourLifter lifter;
+    // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).
+    EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter,
+                            recorders.get(), mpi.is_root() && !s.is_steady() ? &progress : nullptr);
+    RunControl control;
+    if (resume) {
+        stepper.restore_state(restart->header.stepper);
+        control.resume = restart->header.driver;
+    }
+#if EFDEM_HAVE_HDF5
+    // Always a writer: a stop signal checkpoints even a run without periodic checkpoints.
+    std::unique_ptr<CheckpointWriter> writer;
+    {
+        CheckpointHeader identity;
+        identity.mode = prov.mode;
+        identity.realizations = prov.realizations;
+        identity.scene_text = table.text();
+        identity.parameters = parameter_lines(table);
+        // The recorders (root only) name the files they write; the checkpoint stores them whole.
+        writer = std::make_unique<CheckpointWriter>(
+            layout, s.checkpoint, s.output.prefix, std::move(identity),
+            recorders ? recorders->files() : std::vector<std::filesystem::path>{});
+        stepper.set_checkpoint_writer(writer.get(), s.checkpoint.enabled());
+        control.checkpoint_interval = s.checkpoint.interval;
+    }
+#endif
+    if (!mpi.is_root()) {
+        try {
+            stepper.serve();
+        } catch (const RunFailed&) {
+            return kExitRuntimeFailure;  // the failing rank said why; the root marks the run file
+        }
+        return stepper.finish_code();
+    }
+    RunSummary summary;
+    try {
+        summary = s.is_steady() ? run_steady(stepper, s, recorders.get(), progress)
+                  : s.is_cpi()  ? run_cpi(stepper, s, observables.fallback.get(), recorders.get(),
+                                          progress, control)
+                                : run_direct(stepper, s, progress, control);
+        wall.fill(summary);
+        recorders->finish(summary);
+    } catch (const RunFailed& e) {
+        summary.end_status = std::string("failed: ") + e.what();
+        summary.simulated_time = stepper.time() - t0;
+        summary.dem_time = stepper.micro_time();
+        summary.particle_steps = stepper.particle_steps();
+        summary.wall_seconds = progress.elapsed_seconds();
+        wall.fill(summary);
+        try {
+            recorders->finish(summary);
+        } catch (const std::exception& again) {
+            log::error("the run file could not be marked failed: {}", again.what());
+        }
+        log::error("the run failed; its files in {} are marked 'failed'",
+                   s.output.directory.string());
+        return kExitRuntimeFailure;
+    } catch (const std::exception& e) {
+        // A failure on the root (e.g. its run file on a full disk): mark the run file if it can
+        // be (finish() frees its reserve first), then end every rank.
+        summary.end_status = std::string("failed: ") + e.what();
+        wall.fill(summary);
+        try {
+            recorders->finish(summary);
+        } catch (const std::exception&) {
+        }
+        mpi.abort(e.what(), kExitRuntimeFailure);
+    }
+    return report_end(summary, s, table, mpi.size());
+}
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,42 @@
+#include "mpi_driver/run/run_end.hpp"
+
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/output/progress.hpp"
+
+namespace efdem::mpi_driver {
+
+int report_end(const RunSummary& summary, const RunSettings& s, const ParamTable& table,
+               int ranks) {
+    log::info(
+        "{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall ({} settling the beds, {} "
+        "the run), "
+        "{:.3e} particle-steps",
+        summary.end_status, summary.simulated_time, summary.dem_time,
+        format_duration(summary.total_wall_seconds), format_duration(summary.settling_wall_seconds),
+        format_duration(summary.wall_seconds), summary.particle_steps);
+    if (summary.stop_signal == 0) return summary.unconverged ? kExitRuntimeFailure : kExitOk;
+    const std::string signal = signal_name(summary.stop_signal);
+    if (s.is_steady()) {
+        log::notice(
+            "stopped by {}; the iterates so far and the best one are in {}/{}.h5 (mode = {} cannot "
+            "be continued from a checkpoint)",
+            signal, s.output.directory.string(), s.output.prefix, s.mode_name());
+    } else if (summary.checkpoint.empty()) {
+        log::notice("stopped by {}; nothing could be saved (no HDF5)", signal);
+    } else {
+        std::string command = fmt::format("mpirun -n {} efdem {}", ranks, table.file());
+        for (const auto& o : table.overrides()) command += " " + o;
+        log::notice("stopped by {}: checkpoint {} (t = {:.6g}); continue with: {} restart={}",
+                    signal, summary.checkpoint, summary.checkpoint_time, command,
+                    summary.checkpoint);
+    }
+    return kExitInterrupted;
+}
+
+}  // namespace efdem::mpi_driver

@@ -1,0 +1,138 @@
+#include "mpi_driver/run/setup.hpp"
+
+#include <exception>
+#include <filesystem>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "dem/realization_builder.hpp"
+#include "dem/scene.hpp"
+#include "mpi_driver/checkpoint/restart_check.hpp"
+#include "mpi_driver/ensemble/scene_input.hpp"
+#include "mpi_driver/run/output_guard.hpp"
+#include "mpi_driver/run/settling_progress.hpp"
+#if EFDEM_HAVE_HDF5
+#include "mpi_driver/checkpoint/checkpoint_reader.hpp"
+#endif
+
+namespace efdem::mpi_driver {
+
+namespace {
+
+/// Every rank: reads the scene and builds its beds; throws what a bad scene or a failing build
+/// throws (the caller turns it into the agreement).
+void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out) {
+    out.table.emplace(read_scene(mpi, options.scene, options.overrides));
+    Params root = out.table->root();
+    const dem::DemScene scene = dem::DemScene::from_params(root);
+    out.settings = RunSettings::from_params(root, scene);
+    RunSettings& settings = *out.settings;
+    settings.check_ensemble(root, out.ranks * settings.realizations_per_rank);
+    const int k = out.check ? 1 : settings.realizations_per_rank;
+    // Settling a paper-size bed takes minutes: the root says how its own realizations go (the
+    // other ranks settle theirs at the same time).
+    SettlingProgressLine settling_line(5.0);
+    const dem::SettlingReport settling =
+        mpi.is_root() ? settling_line.report() : dem::SettlingReport{};
+    // A restart replaces every particle state by the checkpoint's (positions, velocities,
+    // species, neighbours, contact history, clock, random streams; a dropped realization is
+    // never advanced again), so its beds are built but not settled: settling them would only
+    // cost minutes on a paper-size bed and be thrown away.
+    if (settings.is_steady() && !options.restart.empty())
+        throw InputError(SourceLocation{"<command line>", 0},
+                         fmt::format("restart = '{}': mode = {} cannot be continued from a "
+                                     "checkpoint (a solve keeps "
+                                     "micro states in memory that a checkpoint does not hold)",
+                                     options.restart, settings.mode_name()));
+    const bool skip_settling = out.check || !options.restart.empty();
+    for (int j = 0; j < k; ++j) {
+        const long realization = out.check ? 0 : static_cast<long>(mpi.rank()) * k + j;
+        out.systems.push_back(
+            dem::build_system(root, {settings.seed, realization, skip_settling}, settling));
+    }
+    out.table->check_all_used(
+        [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
+    // What a new run may not write over (the same check in --check); the root looks.
+    if (mpi.is_root()) {
+        check_output_is_free(root, settings, !options.restart.empty());
+#if EFDEM_HAVE_HDF5
+        if (out.check && !options.restart.empty())
+            check_restart(options.restart, read_checkpoint_header(options.restart),
+                          parameter_lines(*out.table), mpi.size() * settings.realizations_per_rank,
+                          settings.checkpoint.allow_physics_change);
+#endif
+    }
+    if (!out.check) {
+        std::filesystem::create_directories(settings.output.directory);
+        std::filesystem::create_directories(
+            settings.checkpoint.directory);  // a stop signal checkpoints
+    }
+#if !EFDEM_HAVE_HDF5
+    if (settings.checkpoint.enabled() || !options.restart.empty())
+        throw InputError(SourceLocation{"<command line>", 0},
+                         "checkpoints need HDF5, and this efdem was built without it "
+                         "(EFDEM_ENABLE_HDF5=OFF)");
+#endif
+}
+
+/// output.overwrite = true (not a restart): the root deletes the earlier run's files, so that
+/// none stays mixed with this run's; nobody writes before it has. Collective.
+Agreement replace_earlier_run(const MpiSession& mpi, const RunSettings& settings) {
+    int removal = kExitOk;
+    std::string why;
+    if (mpi.is_root()) {
+        try {
+            const auto removed = remove_earlier_run(settings);
+            if (!removed.empty())
+                log::info(
+                    "output.overwrite = true: deleted the {} file(s) of the earlier run {}/{}",
+                    removed.size(), settings.output.directory.string(), settings.output.prefix);
+        } catch (const RuntimeFailure& e) {
+            removal = kExitRuntimeFailure;
+            why = e.what();
+        }
+    }
+    return agree_on_failure(mpi.comm(), removal, why);
+}
+
+}  // namespace
+
+Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wall, SetUp& out) {
+    out.check = options.action == RunOptions::Action::check ||
+                options.action == RunOptions::Action::list_keys;
+    out.ranks = options.ranks > 0 ? options.ranks : mpi.size();
+    int code = kExitOk;
+    std::string message;
+    const SetupWall::Clock::time_point settling_start = SetupWall::Clock::now();
+    try {
+        read_and_build(mpi, options, out);
+    } catch (const InputError& e) {
+        code = kExitInputError;
+        message = e.what();
+    } catch (const RuntimeFailure& e) {
+        code = kExitRuntimeFailure;
+        message = e.what();
+    } catch (const std::filesystem::filesystem_error& e) {
+        code = kExitInputError;
+        message = fmt::format("{} = '{}' cannot be created: {}",
+                              e.path1() == out.settings->output.directory ? "output.directory"
+                                                                          : "checkpoint.directory",
+                              quote_for_message(e.path1().string()), e.code().message());
+    } catch (const std::exception& e) {
+        code = kExitRuntimeFailure;
+        message = std::string("unexpected failure during set-up: ") + e.what();
+    }
+    const Agreement agreed = agree_on_failure(mpi.comm(), code, message);
+    // Every rank has built (and settled) its realizations: the set-up's wall time, almost all
+    // settling.
+    wall.settling_seconds = SetupWall::seconds_since(settling_start);
+    if (agreed.exit_code != kExitOk) return agreed;
+    if (!out.check && out.settings->output.overwrite && options.restart.empty())
+        return replace_earlier_run(mpi, *out.settings);
+    return agreed;
+}
+
+}  // namespace efdem::mpi_driver
