@@ -2,8 +2,11 @@
 /// \file
 /// The macro integrator of coarse projective integration: one outer step = burst (healing +
 /// estimation window) -> slope -> stability check -> extrapolation -> repair -> lift
-/// (physics.md §10). Implementations: ProjectiveForwardEuler (fixed DT, least-squares slope)
-/// and PeriodProjectiveEuler (DT = k T, period-mean slope).
+/// (physics.md §10). Implementations: ProjectiveForwardEuler (fixed DT, least-squares slope),
+/// PeriodProjectiveEuler (DT = k T, period-mean slope) and MultistepProjectiveIntegrator
+/// (forward Euler or Adams-Bashforth 2 from the last slopes, fixed DT or error-controlled
+/// adaptive DT with reject-and-redo; multistep_projective_integrator.hpp). projective_run.hpp
+/// chooses one from the cpi.* keys (cpi_settings.hpp).
 
 #include <functional>
 #include <limits>
