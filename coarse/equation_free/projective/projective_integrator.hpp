@@ -15,6 +15,7 @@
 
 #include "coarse/equation_free/coarse_stepper.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
+#include "coarse/equation_free/projective/step_size_controller.hpp"
 #include "coarse/equation_free/repair_report.hpp"
 
 namespace efdem::coarse {
@@ -35,6 +36,18 @@ enum class StepStatus {
 
 std::string_view to_string(StepStatus status);
 
+/// The burst every integrator runs before a jump, shared by their settings
+/// (ProjectiveEulerSettings, PeriodProjectiveEulerSettings, MultistepSettings). Times in
+/// sqrt(d_p/g).
+struct BurstSettings {
+    double healing = 10.0;  ///< start of each burst left out of the slope (>= 0)
+    double window = 10.0;   ///< estimation window after healing (> 0); burst = healing + window
+    /// What a DT the stability monitor flags does (fixed DT and DT = k T; the adaptive
+    /// controller always shortens DT until stable, and the multistep integrator with a fixed DT
+    /// does not consult the monitor).
+    StabilityPolicy stability = StabilityPolicy::warn;
+};
+
 /// What the step-size controller of the multistep integrator measured and decided for one
 /// jump (docs/error_control.md). Errors are RMS over the coarse vector's components [d_p for
 /// the ICDF]; per-component vectors in the same unit.
@@ -53,7 +66,8 @@ struct ControllerRecord {
     /// Largest DT the tolerance allows with the realizations run, and with 2 and 4 times as
     /// many (standard errors / sqrt(2), / 2): what more realizations would buy.
     double dt_tolerance = nan, dt_tolerance_2r = nan, dt_tolerance_4r = nan;
-    std::string limited_by;  ///< what set DT: "tolerance", "growth", "first jump", ...
+    /// What set DT (the run file and the log hold its text: to_string(DtLimit)).
+    DtLimit limited_by = DtLimit::none;
     double error() const { return statistical + truncation; }
 };
 

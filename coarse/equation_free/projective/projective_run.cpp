@@ -141,12 +141,15 @@ void ProjectiveRun::warm_up() {
     }
     const double length = std::min(std::max(settings_.warmup, burst), room);
     if (length > 0) stepper_.run(length, w);
-    // On until the phase signal's drift over the last burst length is within its noise.
+    // On until the phase signal's drift over the last burst length is within its noise, or
+    // slower than warmup_drift_rate = steady_drift_rate(cpi.tolerance, burst) (adaptive; a
+    // derivation, see cpi_settings.hpp), i.e. cpi.tolerance per burst.
     const double window = settings_.window();
     const double t_limit = std::min(t0 + settings_.warmup + settings_.warmup_max, t0 + room);
     const double tol = time_tolerance(t_end_);
     while (true) {
-        const PhaseDrift d = phase_drift(w, stepper_.time() - burst - tol, settings_.drift_rate);
+        const PhaseDrift d =
+            phase_drift(w, stepper_.time() - burst - tol, settings_.warmup_drift_rate);
         if (!d.measured) {
             log::warn(
                 "warm-up: {:.4g} time units; the drift of the phase signal cannot be measured (no "
