@@ -307,12 +307,10 @@ TEST_CASE("an adaptive run resumed from the saved integrator state continues bit
         MultistepProjectiveIntegrator a(s);
         a.set_end_time(300.0);
         for (int i = 0; i < before; ++i) REQUIRE(a.step(toy).advanced());
-        std::vector<double> reals;
-        std::string text;
-        a.save_state(reals, text);
+        const IntegratorState saved = a.save_state();
         test::OuEnsembleStepper copy = toy;
         MultistepProjectiveIntegrator b(s);
-        b.restore_state(reals, text);
+        b.restore_state(saved);
         b.set_end_time(300.0);
         for (int i = 0; i < 8; ++i) {
             const ProjectiveStepRecord ra = a.step(toy), rb = b.step(copy);
@@ -321,9 +319,7 @@ TEST_CASE("an adaptive run resumed from the saved integrator state continues bit
             CHECK(to_string(ra.status) == to_string(rb.status));
         }
         CHECK((toy.mean().array() == copy.mean().array()).all());
-        std::vector<double> again;
-        b.save_state(again, text);
-        a.save_state(reals, text);
+        const IntegratorState again = b.save_state(), reals = a.save_state();
         CHECK(again == reals);
     }
 }

@@ -336,83 +336,35 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
     return s;
 }
 
-void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::string& text) const {
-    r.clear();
-    const Eigen::Index m = x_end_.size();
-    r.insert(r.end(), {3.0 /* layout version */, static_cast<double>(history_.size()),
-                       static_cast<double>(m), t_end_, controller_.state().dt_last,
-                       controller_.state().dt_cap,
-                       static_cast<double>(controller_.state().consecutive_rejections),
-                       decay_.ok ? 1.0 : 0.0, decay_.rate, decay_.ratio, decay_.delay});
-    r.insert(r.end(), x_end_.data(), x_end_.data() + m);
-    for (const auto& n : history_) {
-        r.push_back(n.tau);
-        r.insert(r.end(), n.slope.data(), n.slope.data() + m);
-        r.insert(r.end(), n.se.data(), n.se.data() + m);
-    }
-    const Totals& t = totals_;
-    r.insert(r.end(),
-             {static_cast<double>(t.attempts), static_cast<double>(t.accepted),
-              static_cast<double>(t.rejected), static_cast<double>(t.direct), t.dt_taken,
-              t.dt_tolerance, t.dt_tolerance_2r, t.dt_tolerance_4r, t.statistical, t.truncation});
-    r.push_back(curvature_only_front_ ? 1.0 : 0.0);  // layout 3
-    text = decay_.message + '\n' + std::string(to_string(hold_kind_)) + '\n' + hold_;
+IntegratorState MultistepProjectiveIntegrator::save_state() const {
+    MultistepState s;
+    s.t_end = t_end_;
+    s.x_end = x_end_;
+    s.history.assign(history_.begin(), history_.end());
+    s.curvature_only_front = curvature_only_front_;
+    s.decay = decay_;
+    s.hold_kind = hold_kind_;
+    s.hold = hold_;
+    s.controller = controller_.state();
+    s.totals = totals_;
+    return s;
 }
 
-void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r,
-                                                  const std::string& text) {
+void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) {
     history_.clear();
     curvature_only_front_ = false;
-    if (r.empty()) return;  // saved before the first burst
-    // Layout 2 (checkpoint format 2 of earlier versions) lacks the last value: no curvature-only
-    // node.
-    EFDEM_EXPECTS(r.size() >= 11 && (r[0] == 2.0 || r[0] == 3.0));
-    const auto n = static_cast<std::size_t>(r[1]);
-    const auto m = static_cast<Eigen::Index>(r[2]);
-    const std::size_t layout_extra = r[0] == 3.0 ? 1 : 0;
-    EFDEM_EXPECTS(r.size() ==
-                  11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10 + layout_extra);
-    t_end_ = r[3];
-    controller_.restore(
-        {.dt_last = r[4], .dt_cap = r[5], .consecutive_rejections = static_cast<long>(r[6])});
-    decay_.ok = r[7] != 0.0;
-    decay_.rate = r[8];
-    decay_.ratio = r[9];
-    decay_.delay = r[10];
-    // Three lines: the decay estimate's message, then why no jump may start here (kind, text).
-    const std::size_t a = text.find('\n'), b = a == std::string::npos ? a : text.find('\n', a + 1);
-    EFDEM_EXPECTS(b != std::string::npos);
-    decay_.message = text.substr(0, a);
-    const std::optional<DtLimit> kind = dt_limit_from_string(text.substr(a + 1, b - a - 1));
-    EFDEM_EXPECTS(kind.has_value());
-    hold_kind_ = *kind;
-    hold_ = text.substr(b + 1);
-    std::size_t k = 11;
-    auto vec = [&] {
-        Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(r.data() + k, m);
-        k += static_cast<std::size_t>(m);
-        return v;
-    };
-    x_end_ = vec();
-    for (std::size_t i = 0; i < n; ++i) {
-        SlopeNode node;
-        node.tau = r[k++];
-        node.slope = vec();
-        node.se = vec();
-        history_.push_back(std::move(node));
-    }
-    Totals& t = totals_;
-    t.attempts = static_cast<long>(r[k]);
-    t.accepted = static_cast<long>(r[k + 1]);
-    t.rejected = static_cast<long>(r[k + 2]);
-    t.direct = static_cast<long>(r[k + 3]);
-    t.dt_taken = r[k + 4];
-    t.dt_tolerance = r[k + 5];
-    t.dt_tolerance_2r = r[k + 6];
-    t.dt_tolerance_4r = r[k + 7];
-    t.statistical = r[k + 8];
-    t.truncation = r[k + 9];
-    if (layout_extra) curvature_only_front_ = r[k + 10] != 0.0;
+    if (!state) return;  // nothing saved: as new
+    const MultistepState& s = *state;
+    EFDEM_EXPECTS(s.history.size() <= static_cast<std::size_t>(settings_.steps) + 1);
+    t_end_ = s.t_end;
+    x_end_ = s.x_end;
+    history_.assign(s.history.begin(), s.history.end());
+    curvature_only_front_ = s.curvature_only_front;
+    decay_ = s.decay;
+    hold_kind_ = s.hold_kind;
+    hold_ = s.hold;
+    controller_.restore(s.controller);
+    totals_ = s.totals;
 }
 
 }  // namespace efdem::coarse

@@ -81,20 +81,15 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// Adaptive: needs stepper.can_keep_state() and a stepper with members (slope standard
     /// errors); without members the step ends invalid_burst and says so.
     ProjectiveStepRecord step(CoarseStepper& stepper) override;
-    void save_state(std::vector<double>& reals, std::string& text) const override;
-    void restore_state(const std::vector<double>& reals, const std::string& text) override;
+    /// Always a state (also before the first burst: an empty history).
+    IntegratorState save_state() const override;
+    /// nullopt (a checkpoint written by a single-step integrator, or of format 1): the state
+    /// of a new integrator.
+    void restore_state(const IntegratorState& state) override;
 
     const MultistepSettings& settings() const { return settings_; }
     /// Totals since the start of the run (saved with the state).
-    struct Totals {
-        long attempts = 0;  ///< jumps tried
-        long accepted = 0;  ///< jumps kept
-        long rejected = 0;  ///< jumps redone
-        long direct = 0;    ///< bursts run without a jump because the tolerance allowed < dt_min
-        double dt_taken = 0, dt_tolerance = 0, dt_tolerance_2r = 0,
-               dt_tolerance_4r = 0;              ///< sums over kept jumps
-        double statistical = 0, truncation = 0;  ///< sums over kept jumps
-    };
+    using Totals = MultistepTotals;
     const Totals& totals() const { return totals_; }
     /// Adaptive: the run's controller in a few lines for the log and the run file: jumps kept,
     /// rejected, direct bursts, mean DT, the statistical share of the error, and the mean DT

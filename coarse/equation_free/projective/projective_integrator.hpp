@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/projective/multistep_state.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
 #include "coarse/equation_free/repair_report.hpp"
@@ -121,6 +123,10 @@ struct ProjectiveStepRecord {
 /// otherwise +infinity (also for an infinite t_end). Times compared to time_tolerance(t_end).
 double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, double burst);
 
+/// An integrator's own state between two steps, for a checkpoint: only the multistep
+/// integrator has one (nullopt for the single-step integrators).
+using IntegratorState = std::optional<MultistepState>;
+
 /// A macro integrator: advances a CoarseStepper by one outer step.
 class ProjectiveIntegrator {
   public:
@@ -137,16 +143,17 @@ class ProjectiveIntegrator {
     double end_time() const { return end_time_; }
 
     /// The integrator's own state between two steps (slope history, step-size controller), for
-    /// a checkpoint; integrators without one save nothing. restore_state() takes what
-    /// save_state() wrote, so that the next step is bit for bit the one the saved run made.
-    virtual void save_state(std::vector<double>& reals, std::string& text) const;
+    /// a checkpoint; integrators without one save nothing (nullopt). restore_state() takes what
+    /// save_state() returned, so that the next step is bit for bit the one the saved run made.
+    virtual IntegratorState save_state() const { return std::nullopt; }
     /// What the integrator did over the run, in a few lines for the log and the run file
     /// (`realizations`: the ensemble's R); empty for integrators with nothing to add.
     virtual std::string summary(int realizations) const {
         (void)realizations;
         return {};
     }
-    virtual void restore_state(const std::vector<double>& reals, const std::string& text);
+    /// \pre state is what this kind of integrator saves (nullopt for those without a state).
+    virtual void restore_state(const IntegratorState& state);
 
   protected:
     /// end_of_run_jump_limit() for this integrator's end time.

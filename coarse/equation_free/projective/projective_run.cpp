@@ -46,20 +46,20 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
     // From here on the fallback is the coarse variable when the primary one failed, now or
     // before the checkpoint this run resumed from.
     use(state_.fell_back && fallback_ ? *fallback_ : primary_);
-    if (resume) integrator_->restore_state(state_.integrator, state_.integrator_text);
+    if (resume) integrator_->restore_state(state_.integrator);
     ProjectiveRunOutcome out;
     out.end_status = "completed";
     if ((settings_.warmup > 0 || settings_.warmup_until_steady) && !state_.warmed_up) {
         // The initial state (a packed bed at rest) is far from the slow manifold: run it
         // directly until the fast transients are gone before the first projection.
-        integrator_->save_state(state_.integrator, state_.integrator_text);
+        state_.integrator = integrator_->save_state();
         for (auto* o : observers_) o->between_steps(*this);
         warm_up();
         for (auto* o : observers_) o->warmup_done(*this);
     }
     state_.warmed_up = true;
     while (stepper_.time() < t_end_ - tol) {
-        integrator_->save_state(state_.integrator, state_.integrator_text);
+        state_.integrator = integrator_->save_state();
         for (auto* o : observers_) o->between_steps(*this);
         // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
         // plus one burst (or one whose period bursts were extended) can be left with less.
