@@ -17,6 +17,40 @@ std::uint64_t hash_text(const std::string& s, std::uint64_t h) {
     h = hash_value(static_cast<std::uint64_t>(s.size()), h);
     return fnv1a(s.data(), s.size(), h);
 }
+std::uint64_t hash_vector(const Eigen::VectorXd& v, std::uint64_t h) {
+    h = hash_value(static_cast<std::uint64_t>(v.size()), h);
+    return v.size() == 0 ? h
+                         : fnv1a(v.data(), static_cast<std::size_t>(v.size()) * sizeof(double), h);
+}
+/// Format 4: every field of the integrator's state, in the order of coarse::MultistepState.
+std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_t h) {
+    h = hash_value(state ? 1L : 0L, h);
+    if (!state) return h;
+    const coarse::MultistepState& s = *state;
+    h = hash_value(s.t_end, h);
+    h = hash_vector(s.x_end, h);
+    h = hash_value(static_cast<std::uint64_t>(s.history.size()), h);
+    for (const auto& n : s.history) {
+        h = hash_value(n.tau, h);
+        h = hash_vector(n.slope, h);
+        h = hash_vector(n.se, h);
+    }
+    h = hash_value(s.curvature_only_front ? 1L : 0L, h);
+    h = hash_value(s.decay.ok ? 1L : 0L, h);
+    for (double d : {s.decay.rate, s.decay.ratio, s.decay.delay}) h = hash_value(d, h);
+    h = hash_text(s.decay.message, h);
+    h = hash_text(std::string(coarse::to_string(s.hold_kind)), h);
+    h = hash_text(s.hold, h);
+    h = hash_value(s.controller.dt_last, h);
+    h = hash_value(s.controller.dt_cap, h);
+    h = hash_value(s.controller.consecutive_rejections, h);
+    const coarse::MultistepTotals& t = s.totals;
+    for (long v : {t.attempts, t.accepted, t.rejected, t.direct}) h = hash_value(v, h);
+    for (double d : {t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r, t.dt_tolerance_4r,
+                     t.statistical, t.truncation})
+        h = hash_value(d, h);
+    return h;
+}
 }  // namespace
 
 std::uint64_t CheckpointHeader::checksum() const {
@@ -37,9 +71,11 @@ std::uint64_t CheckpointHeader::checksum() const {
     h = hash_value(driver.coarse_steps, h);
     h = hash_value(driver.without_progress, h);
     h = hash_value(driver.fell_back ? 1L : 0L, h);
-    if (format_version >= 2) {
-        h = fnv1a_array(driver.integrator, h);
-        h = hash_text(driver.integrator_text, h);
+    if (format_version >= 4) {
+        h = hash_integrator(driver.integrator, h);
+    } else if (format_version >= 2) {
+        h = fnv1a_array(integrator_layout, h);
+        h = hash_text(integrator_layout_text, h);
     }
     if (format_version >= 3) {
         h = hash_value(driver.warmed_up ? 1L : 0L, h);

@@ -13,7 +13,16 @@
 ///                           warmed_up (format 3; earlier formats: 4 values, warmed up)
 ///   /driver/lifting         R x 4: each realization's lifting random stream (xoshiro state)
 ///   /driver/observable, /driver/recorded   warm starts of the coarse observables
-///   /driver/integrator, /driver/integrator_text   the integrator's own state (version >= 2)
+///   /driver/integrator/     the multistep integrator's state by name (format 4; absent for the
+///                           single-step integrators): t_end, x_end, curvature_only_front,
+///                           hold_kind, hold; history/{tau, slope, se} (n, n x m, n x m);
+///                           decay/{ok, rate, ratio, delay, message};
+///                           controller/{dt_last, dt_cap, consecutive_rejections};
+///                           totals/{attempts, accepted, rejected, direct, dt_taken,
+///                           dt_tolerance, dt_tolerance_2r, dt_tolerance_4r, statistical,
+///                           truncation} (coarse::MultistepState)
+///   /driver/integrator, /driver/integrator_text   formats 2 and 3: the same state as a
+///                           positional vector and three lines of text
 ///   /output/<suffix>        the run's output files (HDF5, CSV) as they were at the checkpoint,
 ///                           named by what follows output.prefix (".h5", "_mean_icdf.csv", ...)
 ///   /realizations/...       per realization (global index order): meta (index, step,
@@ -34,8 +43,10 @@
 namespace efdem::mpi_driver {
 
 /// 2 added /driver/integrator and /driver/integrator_text (the multistep integrator's slope
-/// history and step-size controller); version 1 files (without them) are still read.
-inline constexpr std::int64_t kCheckpointFormatVersion = 3;
+/// history and step-size controller, positional); 3 added warmed_up, /driver/active and
+/// /driver/failures; 4 stores the integrator's state as named fields (the group
+/// /driver/integrator). Versions 1 to 3 are still read (tests/data/checkpoint_format_*.h5).
+inline constexpr std::int64_t kCheckpointFormatVersion = 4;
 inline constexpr std::int64_t kOldestReadableCheckpointFormat = 1;
 
 /// The root's state of the coarse layer (EnsembleStepper).
@@ -73,6 +84,11 @@ struct CheckpointHeader {
     StepperState stepper;
     DriverState driver;
     std::vector<OutputBlob> outputs;
+    /// Formats 2 and 3 only: the integrator's state as they stored it (a positional vector and
+    /// three lines of text), for their checksum; driver.integrator holds it by name
+    /// (coarse::MultistepState::from_layout). Empty in a header written now.
+    std::vector<double> integrator_layout;
+    std::string integrator_layout_text;
 
     /// FNV-1a over every field: stored with the header, verified on restart.
     std::uint64_t checksum() const;

@@ -1,6 +1,8 @@
 #include "mpi_driver/checkpoint/checkpoint_reader.hpp"
 
 #include <functional>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -31,6 +33,62 @@ T with_checkpoint(const std::filesystem::path& path, const std::function<T(const
         if (path.extension() == ".tmp") refuse(path, kPartialWrite);
         refuse(path, fmt::format("cannot be read: it is truncated or corrupted ({})", e.what()));
     }
+}
+
+/// The multistep integrator's state from its named fields (format 4; checkpoint_format.hpp).
+coarse::MultistepState read_integrator_state(const H5File& f, const std::filesystem::path& path) {
+    const std::string g = "/driver/integrator/";
+    auto values = [&](const std::string& name, std::size_t size) {
+        std::vector<double> v = f.read_doubles(g + name);
+        if (v.size() != size)
+            refuse(path, fmt::format("has a malformed {}{} dataset ({} values, {} expected)", g,
+                                     name, v.size(), size));
+        return v;
+    };
+    auto real = [&](const std::string& name) { return values(name, 1)[0]; };
+    auto integer = [&](const std::string& name) {
+        const std::vector<std::int64_t> v = f.read_integers(g + name);
+        if (v.size() != 1) refuse(path, "has a malformed " + g + name + " dataset");
+        return v[0];
+    };
+    coarse::MultistepState s;
+    s.t_end = real("t_end");
+    const std::vector<double> x = f.read_doubles(g + "x_end");
+    const auto m = static_cast<Eigen::Index>(x.size());
+    s.x_end = Eigen::Map<const Eigen::VectorXd>(x.data(), m);
+    s.curvature_only_front = integer("curvature_only_front") != 0;
+    const std::string kind = f.read_text(g + "hold_kind");
+    const std::optional<coarse::DtLimit> hold_kind = coarse::dt_limit_from_string(kind);
+    if (!hold_kind) refuse(path, "names an unknown " + g + "hold_kind '" + kind + "'");
+    s.hold_kind = *hold_kind;
+    s.hold = f.read_text(g + "hold");
+    const std::vector<double> tau = f.read_doubles(g + "history/tau");
+    const std::size_t n = tau.size(), mm = x.size();
+    const std::vector<double> slope = values("history/slope", n * mm),
+                              se = values("history/se", n * mm);
+    for (std::size_t i = 0; i < n; ++i)
+        s.history.push_back({tau[i], Eigen::Map<const Eigen::VectorXd>(slope.data() + i * mm, m),
+                             Eigen::Map<const Eigen::VectorXd>(se.data() + i * mm, m)});
+    s.decay.ok = integer("decay/ok") != 0;
+    s.decay.rate = real("decay/rate");
+    s.decay.ratio = real("decay/ratio");
+    s.decay.delay = real("decay/delay");
+    s.decay.message = f.read_text(g + "decay/message");
+    s.controller.dt_last = real("controller/dt_last");
+    s.controller.dt_cap = real("controller/dt_cap");
+    s.controller.consecutive_rejections = integer("controller/consecutive_rejections");
+    coarse::MultistepTotals& t = s.totals;
+    t.attempts = integer("totals/attempts");
+    t.accepted = integer("totals/accepted");
+    t.rejected = integer("totals/rejected");
+    t.direct = integer("totals/direct");
+    t.dt_taken = real("totals/dt_taken");
+    t.dt_tolerance = real("totals/dt_tolerance");
+    t.dt_tolerance_2r = real("totals/dt_tolerance_2r");
+    t.dt_tolerance_4r = real("totals/dt_tolerance_4r");
+    t.statistical = real("totals/statistical");
+    t.truncation = real("totals/truncation");
+    return s;
 }
 
 std::vector<Vec3> vectors(const std::vector<double>& flat) {
@@ -100,9 +158,12 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
                                          from_stored(lifting[r + 2]), from_stored(lifting[r + 3])});
         h.stepper.observable = f.read_doubles("/driver/observable");
         h.stepper.recorded = f.read_doubles("/driver/recorded");
-        if (h.format_version >= 2) {
-            h.driver.integrator = f.read_doubles("/driver/integrator");
-            h.driver.integrator_text = f.read_text("/driver/integrator_text");
+        if (h.format_version >= 4) {
+            if (f.exists("/driver/integrator"))
+                h.driver.integrator = read_integrator_state(f, path);
+        } else if (h.format_version >= 2) {
+            h.integrator_layout = f.read_doubles("/driver/integrator");
+            h.integrator_layout_text = f.read_text("/driver/integrator_text");
         }
         for (const std::string& name : f.members("/output")) {
             const auto bytes = f.read_bytes("/output/" + name);
@@ -111,6 +172,15 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         if (!f.has_attribute("/", "header_checksum") ||
             from_stored(f.attribute_integer("/", "header_checksum")) != h.checksum())
             refuse(path, "is corrupted: the checksum of its root-level state does not match");
+        // Formats 2 and 3: the positional state, by name (empty: a single-step integrator's).
+        if (!h.integrator_layout.empty()) {
+            try {
+                h.driver.integrator = coarse::MultistepState::from_layout(h.integrator_layout,
+                                                                          h.integrator_layout_text);
+            } catch (const std::invalid_argument& e) {
+                refuse(path, e.what());
+            }
+        }
         return h;
     });
 }

@@ -10,10 +10,65 @@
 
 #include <fmt/format.h>
 
+#include "core/contracts.hpp"
 #include "core/error.hpp"
 #include "mpi_driver/output/h5_file.hpp"
 
 namespace efdem::mpi_driver {
+
+namespace {
+/// The multistep integrator's state as named fields under /driver/integrator (format 4;
+/// checkpoint_format.hpp lists them); nothing for an integrator without a state.
+void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
+    if (!state) return;
+    const coarse::MultistepState& s = *state;
+    const std::string g = "/driver/integrator/";
+    for (const char* group : {"", "history", "decay", "controller", "totals"})
+        f.create_group(g + group);
+    auto real = [&](const std::string& name, double v) {
+        f.write(g + name, std::span<const double>(&v, 1), {1});
+    };
+    auto integer = [&](const std::string& name, std::int64_t v) {
+        f.write(g + name, std::span<const std::int64_t>(&v, 1), {1});
+    };
+    const auto m = static_cast<std::size_t>(s.x_end.size());
+    real("t_end", s.t_end);
+    f.write(g + "x_end", std::span<const double>(s.x_end.data(), m), {m});
+    integer("curvature_only_front", s.curvature_only_front ? 1 : 0);
+    f.write_text(g + "hold_kind", std::string(coarse::to_string(s.hold_kind)));
+    f.write_text(g + "hold", s.hold);
+    std::vector<double> tau, slope, se;
+    for (const auto& n : s.history) {
+        EFDEM_ASSERT(static_cast<std::size_t>(n.slope.size()) == m &&
+                     static_cast<std::size_t>(n.se.size()) == m);
+        tau.push_back(n.tau);
+        slope.insert(slope.end(), n.slope.data(), n.slope.data() + m);
+        se.insert(se.end(), n.se.data(), n.se.data() + m);
+    }
+    f.write(g + "history/tau", std::span<const double>(tau), {tau.size()});
+    f.write(g + "history/slope", std::span<const double>(slope), {tau.size(), m});
+    f.write(g + "history/se", std::span<const double>(se), {tau.size(), m});
+    integer("decay/ok", s.decay.ok ? 1 : 0);
+    real("decay/rate", s.decay.rate);
+    real("decay/ratio", s.decay.ratio);
+    real("decay/delay", s.decay.delay);
+    f.write_text(g + "decay/message", s.decay.message);
+    real("controller/dt_last", s.controller.dt_last);
+    real("controller/dt_cap", s.controller.dt_cap);
+    integer("controller/consecutive_rejections", s.controller.consecutive_rejections);
+    const coarse::MultistepTotals& t = s.totals;
+    integer("totals/attempts", t.attempts);
+    integer("totals/accepted", t.accepted);
+    integer("totals/rejected", t.rejected);
+    integer("totals/direct", t.direct);
+    real("totals/dt_taken", t.dt_taken);
+    real("totals/dt_tolerance", t.dt_tolerance);
+    real("totals/dt_tolerance_2r", t.dt_tolerance_2r);
+    real("totals/dt_tolerance_4r", t.dt_tolerance_4r);
+    real("totals/statistical", t.statistical);
+    real("totals/truncation", t.truncation);
+}
+}  // namespace
 
 namespace {
 std::string read_whole_file(const std::filesystem::path& p) {
@@ -262,9 +317,7 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     f.write("/driver/failures", std::span<const std::int64_t>(failures), {1});
     f.write("/driver/observable", std::span<const double>(s.observable), {s.observable.size()});
     f.write("/driver/recorded", std::span<const double>(s.recorded), {s.recorded.size()});
-    f.write("/driver/integrator", std::span<const double>(h.driver.integrator),
-            {h.driver.integrator.size()});
-    f.write_text("/driver/integrator_text", h.driver.integrator_text);
+    write_integrator_state(f, h.driver.integrator);
     f.create_group("/output");
     for (const auto& o : h.outputs)
         f.write_bytes("/output/" + o.name,

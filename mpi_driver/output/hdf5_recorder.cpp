@@ -275,7 +275,8 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
             {"dt_tolerance_4r", c.dt_tolerance_4r}};
         for (const auto& [name, value] : reals)
             scalar(fmt::format("controller/{}", name).c_str(), value);
-        series("/cpi/controller/limited_by", {}, T::text).append_text(c.limited_by);
+        series("/cpi/controller/limited_by", {}, T::text)
+            .append_text(std::string(coarse::to_string(c.limited_by)));
         vec("controller/error_statistical_nodes", c.statistical_nodes);
         vec("controller/error_truncation_nodes", c.truncation_nodes);
     }

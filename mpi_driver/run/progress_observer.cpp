@@ -19,8 +19,9 @@ void ProgressObserver::step_done(const coarse::ProjectiveRun& run,
     if (const coarse::ControllerRecord& c = rec.controller; c.adaptive && rec.lifted)
         note = fmt::format("DT {:.3g} {}: error {:.2f} of tolerance", rec.dt,
                            c.accepted ? "kept" : "rejected", c.error() / c.tolerance);
-    else if (c.adaptive && rec.status == coarse::StepStatus::burst_only && !c.limited_by.empty())
-        note = "no jump: " + c.limited_by;
+    else if (c.adaptive && rec.status == coarse::StepStatus::burst_only &&
+             c.limited_by != coarse::DtLimit::none)
+        note = "no jump: " + std::string(coarse::to_string(c.limited_by));
     progress_.update(stepper_.time(), stepper_.particle_steps(), note, true);
 }
 

@@ -24,7 +24,8 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
         s += fmt::format(
             ", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}), DT "
             "set by {}",
-            c.error(), c.error() / c.tolerance, c.statistical, c.truncation, c.limited_by);
+            c.error(), c.error() / c.tolerance, c.statistical, c.truncation,
+            coarse::to_string(c.limited_by));
     else if (c.active && r.lifted)
         s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})",
                          c.error(), c.statistical, c.truncation);

@@ -36,7 +36,8 @@ TEST_CASE("DT = k T lands on the trend line for any phase", "[unit][coarse]") {
         // round-off of values O(20): 1e-10.
         for (int trial = 0; trial < 50; ++trial) {
             auto toy = random_phase_toy(rng, 10.0);
-            PeriodProjectiveEuler cpi({.healing = 10, .window = 32, .periods_per_step = 2});
+            PeriodProjectiveEuler cpi(
+                {.burst = {.healing = 10, .window = 32}, .periods_per_step = 2});
             const ProjectiveStepRecord rec = cpi.step(toy);
             REQUIRE(rec.status == StepStatus::projected);
             CHECK(rec.period == Approx(10.0).epsilon(1e-10));
@@ -51,7 +52,7 @@ TEST_CASE("DT = k T lands on the trend line for any phase", "[unit][coarse]") {
         for (int trial = 0; trial < 50; ++trial) {
             const double period = rng.uniform(5.0, 14.0), h = 0.1, w = 2 * kPi / period;
             auto toy = random_phase_toy(rng, period, h);
-            PeriodProjectiveEuler cpi({.healing = 10, .window = 3.2 * period});
+            PeriodProjectiveEuler cpi({.burst = {.healing = 10, .window = 3.2 * period}});
             const ProjectiveStepRecord rec = cpi.step(toy);
             REQUIRE(rec.status == StepStatus::projected);
             CHECK(rec.period == Approx(period).epsilon(1e-4));
@@ -68,7 +69,7 @@ TEST_CASE("repeated DT = k T steps stay on the true trajectory", "[unit][coarse]
     efdem::RandomStream rng(13, 0, "test-period-cpi");
     auto toy = random_phase_toy(rng, 10.0);
     const SineTrendStepper original = toy;
-    PeriodProjectiveEuler cpi({.healing = 10, .window = 22});
+    PeriodProjectiveEuler cpi({.burst = {.healing = 10, .window = 22}});
     for (int i = 0; i < 5; ++i) REQUIRE(cpi.step(toy).status == StepStatus::projected);
     CHECK(toy.lifts == 5);
     for (double dt : {0.0, 3.3, 17.1})
@@ -81,8 +82,7 @@ TEST_CASE("a burst with fewer than two periods is extended, up to the maximum", 
     auto toy = random_phase_toy(rng, 10.0);
     // A window of 1.5 periods after healing, extended in steps of 5.
     auto step_with = [&](double max_extension) {
-        return PeriodProjectiveEuler({.healing = 10,
-                                      .window = 15,
+        return PeriodProjectiveEuler({.burst = {.healing = 10, .window = 15},
                                       .max_extension = max_extension,
                                       .extension_step = 5})
             .step(toy);
@@ -110,7 +110,7 @@ TEST_CASE("DT = k T: k = 0, a missing phase signal, and the stability monitor", 
     efdem::RandomStream rng(15, 0, "test-period-cpi");
     SECTION("k = 0 runs the burst only") {
         auto toy = random_phase_toy(rng, 10.0);
-        PeriodProjectiveEuler cpi({.healing = 10, .window = 25, .periods_per_step = 0});
+        PeriodProjectiveEuler cpi({.burst = {.healing = 10, .window = 25}, .periods_per_step = 0});
         const ProjectiveStepRecord rec = cpi.step(toy);
         CHECK(rec.status == StepStatus::burst_only);
         CHECK(rec.dt == 0.0);
@@ -128,7 +128,7 @@ TEST_CASE("DT = k T: k = 0, a missing phase signal, and the stability monitor", 
     SECTION("three periods: the monitor measures no transient in a sine + trend") {
         // Consecutive period-mean slopes are both exactly beta: ratio 1, lambda = 0 (1e-9).
         auto toy = random_phase_toy(rng, 10.0);
-        PeriodProjectiveEuler cpi({.healing = 10, .window = 35});
+        PeriodProjectiveEuler cpi({.burst = {.healing = 10, .window = 35}});
         const ProjectiveStepRecord rec = cpi.step(toy);
         REQUIRE(rec.status == StepStatus::projected);
         CHECK(rec.stability.assessed);
@@ -149,7 +149,7 @@ TEST_CASE("DT = k T records the s.e. of the period-mean slope from the members' 
     MemberTrendStepper toy(SineTrendStepper(Eigen::Vector2d(3.0, -1.0), Eigen::Vector2d(0.05, -0.2),
                                             Eigen::Vector2d(0.3, 1.0), 1.0, 10.0, 0.1),
                            d);
-    PeriodProjectiveEuler cpi({.healing = 10, .window = 32, .periods_per_step = 2});
+    PeriodProjectiveEuler cpi({.burst = {.healing = 10, .window = 32}, .periods_per_step = 2});
     const ProjectiveStepRecord rec = cpi.step(toy);
     REQUIRE(rec.status == StepStatus::projected);
     REQUIRE(rec.slope_standard_error.size() == 2);

@@ -25,7 +25,7 @@ namespace {
 /// the projected value from x = 1, which the theory says is sigma(rho).
 double pfe_step_from_one(double rho, int k, double m) {
     LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, rho), 1.0, Eigen::VectorXd::Ones(1));
-    ProjectiveForwardEuler pfe({.healing = k - 1.0, .window = 1.0, .dt = m});
+    ProjectiveForwardEuler pfe({.burst = {.healing = k - 1.0, .window = 1.0}, .dt = m});
     const ProjectiveStepRecord rec = pfe.step(toy);
     REQUIRE(rec.status == StepStatus::projected);
     return rec.x_projected[0];
@@ -85,7 +85,7 @@ TEST_CASE("runs inside the stable region stay bounded, runs outside blow up as p
     const double m = 10;
     for (double rho : {0.3, 0.6, 0.9}) {
         LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, rho), 1.0, Eigen::VectorXd::Ones(1));
-        ProjectiveForwardEuler pfe({.healing = k - 1.0, .window = 1.0, .dt = m});
+        ProjectiveForwardEuler pfe({.burst = {.healing = k - 1.0, .window = 1.0}, .dt = m});
         for (int i = 0; i < n; ++i) REQUIRE(pfe.step(toy).advanced());
         const double sigma = pfe_amplification(rho, k, m);
         const double predicted = std::pow(sigma, n);
@@ -112,7 +112,7 @@ TEST_CASE(
     std::vector<double> error;
     for (double dt : {1.5, 0.75, 0.375}) {
         LinearToyStepper toy(two_scale_propagator(a, c, d, h), h, x0);
-        ProjectiveForwardEuler pfe({.healing = healing, .window = window, .dt = dt});
+        ProjectiveForwardEuler pfe({.burst = {.healing = healing, .window = window}, .dt = dt});
         while (toy.time() < t_final - 1e-9) REQUIRE(pfe.step(toy).status == StepStatus::projected);
         REQUIRE(toy.time() == Approx(t_final).epsilon(1e-12));
         const Eigen::Vector2d exact = two_scale_propagator(a, c, d, t_final) * x0;
@@ -142,10 +142,10 @@ TEST_CASE("the stability monitor flags DT before the step, and the policy acts",
         return LinearToyStepper(Eigen::MatrixXd::Constant(1, 1, std::exp(lambda * h)), h,
                                 Eigen::VectorXd::Ones(1));
     };
-    const ProjectiveEulerSettings case_a{.healing = 10, .window = 10, .dt = 80};
+    const ProjectiveEulerSettings case_a{.burst = {.healing = 10, .window = 10}, .dt = 80};
     auto step_with = [&](StabilityPolicy policy, LinearToyStepper& stepper) {
         ProjectiveEulerSettings settings = case_a;
-        settings.stability_policy = policy;
+        settings.burst.stability = policy;
         return ProjectiveForwardEuler(settings).step(stepper);
     };
 
@@ -192,7 +192,7 @@ TEST_CASE("the stability monitor flags DT before the step, and the policy acts",
 TEST_CASE("DT = 0 runs the burst only", "[unit][coarse]") {
     LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, std::exp(-0.01)), 0.1,
                          Eigen::VectorXd::Ones(1));
-    ProjectiveForwardEuler pfe({.healing = 1, .window = 2, .dt = 0});
+    ProjectiveForwardEuler pfe({.burst = {.healing = 1, .window = 2}, .dt = 0});
     const ProjectiveStepRecord rec = pfe.step(toy);
     CHECK(rec.status == StepStatus::burst_only);
     CHECK(rec.advanced());
@@ -211,7 +211,7 @@ TEST_CASE("the repair hook sees the projection before the lift", "[unit][coarse]
     const Eigen::Vector3d x0(1.0, 1.5, 2.0);
     SECTION("clipping is applied to what is lifted, and reported") {
         LinearToyStepper toy(grow, 0.1, x0);
-        ProjectiveForwardEuler pfe({.healing = 1, .window = 1, .dt = 10},
+        ProjectiveForwardEuler pfe({.burst = {.healing = 1, .window = 1}, .dt = 10},
                                    [](Eigen::VectorXd& x) { return repair_monotone(x, 0.0, 3.0); });
         const ProjectiveStepRecord rec = pfe.step(toy);
         REQUIRE(rec.status == StepStatus::projected);
@@ -222,12 +222,13 @@ TEST_CASE("the repair hook sees the projection before the lift", "[unit][coarse]
     }
     SECTION("an infeasible report stops the step before the lift") {
         LinearToyStepper toy(grow, 0.1, x0);
-        ProjectiveForwardEuler pfe({.healing = 1, .window = 1, .dt = 10}, [](Eigen::VectorXd&) {
-            RepairReport r;
-            r.feasible = false;
-            r.message = "target outside the bed";
-            return r;
-        });
+        ProjectiveForwardEuler pfe({.burst = {.healing = 1, .window = 1}, .dt = 10},
+                                   [](Eigen::VectorXd&) {
+                                       RepairReport r;
+                                       r.feasible = false;
+                                       r.message = "target outside the bed";
+                                       return r;
+                                   });
         const ProjectiveStepRecord rec = pfe.step(toy);
         CHECK(rec.status == StepStatus::infeasible_projection);
         CHECK(toy.lifts == 0);
@@ -238,7 +239,7 @@ TEST_CASE("the repair hook sees the projection before the lift", "[unit][coarse]
 TEST_CASE("invalid bursts are reported, not projected", "[unit][coarse]") {
     SECTION("sampling coarser than the window: fewer than two samples") {
         LinearToyStepper toy(Eigen::MatrixXd::Identity(1, 1), 15.0, Eigen::VectorXd::Ones(1));
-        ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
+        ProjectiveForwardEuler pfe({.burst = {.healing = 10, .window = 10}, .dt = 80});
         const ProjectiveStepRecord rec = pfe.step(toy);
         CHECK(rec.status == StepStatus::invalid_burst);
         CHECK(toy.lifts == 0);
@@ -277,7 +278,7 @@ TEST_CASE("with an end time the jumps are shortened so that the run ends there e
     const auto run_to = [](double t_end) {
         LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5, Eigen::VectorXd::Ones(1),
                              10.0);
-        ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
+        ProjectiveForwardEuler pfe({.burst = {.healing = 10, .window = 10}, .dt = 80});
         pfe.set_end_time(t_end);
         std::vector<ProjectiveStepRecord> recs;
         while (toy.time() < t_end - 1e-9 && recs.size() < 20) {
@@ -307,7 +308,7 @@ TEST_CASE("with an end time the jumps are shortened so that the run ends there e
         // No end time: the full DT every cycle (210 for a run asked to stop at 200).
         LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, 0.999), 0.5, Eigen::VectorXd::Ones(1),
                              10.0);
-        ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80});
+        ProjectiveForwardEuler pfe({.burst = {.healing = 10, .window = 10}, .dt = 80});
         pfe.step(toy);
         pfe.step(toy);
         CHECK(toy.time() == Approx(210).margin(1e-9));
@@ -339,7 +340,7 @@ TEST_CASE("PFE records the slope's standard error from the members' own slopes",
         SineTrendStepper(Eigen::Vector3d(3.0, -1.0, 20.0), Eigen::Vector3d(0.05, -0.2, 0.01),
                          Eigen::Vector3d(0.0, 1.0, 2.0), 0.5, 10.0, 0.1),
         d);
-    ProjectiveForwardEuler pfe({.healing = 5, .window = 10, .dt = 20});
+    ProjectiveForwardEuler pfe({.burst = {.healing = 5, .window = 10}, .dt = 20});
     for (int step = 0; step < 2; ++step) {  // and again after a lift
         const ProjectiveStepRecord rec = pfe.step(toy);
         REQUIRE(rec.status == StepStatus::projected);
@@ -354,7 +355,7 @@ TEST_CASE("PFE records the slope's standard error from the members' own slopes",
     // A stepper without members: no s.e., and the slope is what it was.
     LinearToyStepper plain(Eigen::MatrixXd::Constant(1, 1, 0.99), 0.1, Eigen::VectorXd::Ones(1));
     const ProjectiveStepRecord rec =
-        ProjectiveForwardEuler({.healing = 1, .window = 1, .dt = 2}).step(plain);
+        ProjectiveForwardEuler({.burst = {.healing = 1, .window = 1}, .dt = 2}).step(plain);
     REQUIRE(rec.status == StepStatus::projected);
     CHECK(rec.slope_standard_error.size() == 0);
     CHECK(std::isnan(rec.max_slope_standard_error()));

@@ -34,8 +34,8 @@ test::LinearToyStepper slow_toy() {
 CpiSettings fixed_settings(double warmup = 0.0) {
     CpiSettings s;
     s.warmup = warmup;
-    s.fixed.healing = 1.0;
-    s.fixed.window = 1.0;
+    s.fixed.burst.healing = 1.0;
+    s.fixed.burst.window = 1.0;
     s.fixed.dt = 8.0;
     return s;
 }
@@ -251,9 +251,9 @@ TEST_CASE("StabilityPolicy::stop ends the run at the first flagged step", "[unit
     test::LinearToyStepper toy(Eigen::MatrixXd::Constant(1, 1, std::exp(-2.0 * kH)), kH,
                                Eigen::VectorXd::Constant(1, 5.0));
     CpiSettings s = fixed_settings();
-    s.fixed.healing = 0.0;
-    s.fixed.window = 2.0;
-    s.fixed.stability_policy = StabilityPolicy::stop;
+    s.fixed.burst.healing = 0.0;
+    s.fixed.burst.window = 2.0;
+    s.fixed.burst.stability = StabilityPolicy::stop;
     ProjectiveRun run(s, toy, variable("x"));
     const ProjectiveRunOutcome out = run.run(100.0);
     CHECK(out.coarse_steps == 1);
@@ -327,12 +327,12 @@ TEST_CASE("CpiSettings reads the cpi keys into the integrators' settings", "[uni
         "scene.cfg", "/scenes");
     const CpiSettings s = CpiSettings::from_params(table.root().scope("cpi"), 0.5);
     CHECK(s.projection == CpiSettings::Projection::periods);
-    CHECK(s.periods.healing == 4.0);
-    CHECK(s.periods.window == 6.0);
+    CHECK(s.periods.burst.healing == 4.0);
+    CHECK(s.periods.burst.window == 6.0);
     CHECK(s.periods.periods_per_step == 3);
     CHECK(s.periods.extension_step == 5.0);  // 5 time units on the 0.5 sample grid
     CHECK(s.fixed.dt == 80.0);               // read for both projections
-    CHECK(s.fixed.stability_policy == StabilityPolicy::halve_step);
+    CHECK(s.fixed.burst.stability == StabilityPolicy::halve_step);
     CHECK(s.burst() == 10.0);
     CHECK(s.make_integrator({})->name() == "period_projective_euler");
 

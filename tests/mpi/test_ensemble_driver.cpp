@@ -174,8 +174,8 @@ TEST_CASE("CPI of a linear toy model through EnsembleStepper equals the serial i
     ToyEnsemble toy(world, false);
     EnsembleStepper& stepper = toy.stepper;
     coarse::ProjectiveEulerSettings pfe;
-    pfe.healing = 0.5;  // 10 fast time constants
-    pfe.window = 0.5;
+    pfe.burst.healing = 0.5;  // 10 fast time constants
+    pfe.burst.window = 0.5;
     pfe.dt = 2.0;
     if (!world.is_root()) {
         stepper.serve();

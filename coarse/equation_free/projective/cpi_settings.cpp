@@ -69,16 +69,14 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
     const StabilityPolicy stability = policy == "halve"  ? StabilityPolicy::halve_step
                                       : policy == "stop" ? StabilityPolicy::stop
                                                          : StabilityPolicy::warn;
-    s.fixed.healing = s.periods.healing = healing;
-    s.fixed.window = s.periods.window = window;
-    s.fixed.stability_policy = s.periods.stability_policy = stability;
+    const BurstSettings burst_settings{
+        .healing = healing, .window = window, .stability = stability};
+    s.fixed.burst = s.periods.burst = burst_settings;
     MultistepSettings& m = s.multistep;
-    m.healing = healing;
-    m.window = window;
+    m.burst = burst_settings;
     m.steps = s.steps;
     m.adaptive = adaptive;
     m.dt = s.fixed.dt;
-    m.stability_policy = stability;
     m.dt_quantum = sample_interval;
     if (adaptive) {
         const double burst = healing + window;
@@ -108,8 +106,7 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                         c.dt_min, c.dt_max));
             m.first_dt = s.fixed.dt;
         }
-        m.drift_rate =
-            c.tolerance / burst;  // the phase signal moves less than the tolerance per burst
+        m.drift_rate = steady_drift_rate(c.tolerance, burst);
         const Params debug = cpi.scope("debug");
         const std::string force =
             debug.get_or_choice("force", "none", {"none", "reject", "shrink"});
@@ -123,19 +120,23 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
     s.warmup_max =
         cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::closed(0.0, 1e7));
     on_grid("warmup_max", s.warmup_max);
-    s.drift_rate = adaptive ? m.drift_rate : 0.0;
+    s.warmup_drift_rate = adaptive ? m.drift_rate : 0.0;
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
     return s;
 }
 
+double steady_drift_rate(double tolerance, double burst) {
+    return tolerance / burst;
+}
+
 double CpiSettings::burst() const {
-    return projection == Projection::periods ? periods.healing + periods.window
-                                             : fixed.healing + fixed.window;
+    return projection == Projection::periods ? periods.burst.healing + periods.burst.window
+                                             : fixed.burst.healing + fixed.burst.window;
 }
 
 double CpiSettings::window() const {
-    return projection == Projection::periods ? periods.window : fixed.window;
+    return projection == Projection::periods ? periods.burst.window : fixed.burst.window;
 }
 
 std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {

@@ -42,6 +42,17 @@
 
 namespace efdem::coarse {
 
+/// The drift rate of the phase signal (the bed's centre of mass, in the unit of the coarse
+/// vector: d_p) below which a burst counts as on the slow manifold: cpi.tolerance per burst
+/// length, i.e. over one burst the phase signal moves less than the error one jump may add.
+/// Used twice with cpi.projection = adaptive: by the warm-up (cpi.warmup_until = steady) and by
+/// the integrator, which makes no jump from a burst drifting faster (MultistepSettings::
+/// drift_rate). A derivation rather than a key of its own: it has the tolerance's unit and
+/// meaning ("small enough not to matter to one jump"), so a tighter tolerance asks for a
+/// steadier start and a steadier burst with nothing else to keep consistent by hand
+/// (docs/error_control.md §6).
+double steady_drift_rate(double tolerance, double burst);
+
 struct CpiSettings {
     enum class Projection { fixed, periods, adaptive } projection = Projection::fixed;
     /// 1: forward Euler; 2: Adams-Bashforth 2 (cpi.integrator).
@@ -53,9 +64,12 @@ struct CpiSettings {
     /// within its noise (or slower than `drift_rate`), at most `warmup_max` longer.
     bool warmup_until_steady = false;
     double warmup_max = 0.0;
-    /// A drift of the phase signal this slow counts as steady [unit per sqrt(d_p/g)]:
-    /// cpi.tolerance per burst length (adaptive), 0 otherwise.
-    double drift_rate = 0.0;
+    /// The warm-up's drift threshold: a drift of the phase signal this slow (and within its
+    /// noise) counts as steady [unit per sqrt(d_p/g)]. Derived, not a key:
+    /// steady_drift_rate(cpi.tolerance, burst) with cpi.projection = adaptive (the same
+    /// threshold the integrator holds a jump back by, multistep.drift_rate); 0 otherwise (no
+    /// tolerance: steady only when the drift is within its noise).
+    double warmup_drift_rate = 0.0;
     /// Projection = fixed: healing, window, DT, stability policy.
     ProjectiveEulerSettings fixed;
     /// Projection = periods: healing, window, k, burst extension, stability policy.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <span>
 #include <utility>
 
@@ -50,18 +51,18 @@ bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) 
 
 MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSettings& settings,
                                                              RepairHook repair)
-    : settings_(settings), repair_(std::move(repair)) {
-    EFDEM_EXPECTS(std::isfinite(settings.healing) && settings.healing >= 0.0);
-    EFDEM_EXPECTS(std::isfinite(settings.window) && settings.window > 0.0);
+    : settings_(settings),
+      repair_(std::move(repair)),
+      controller_(StepSizeSetup{.control = settings.control,
+                                .adaptive = settings.adaptive,
+                                .fixed_dt = settings.dt,
+                                .first_dt = settings.first_dt,
+                                .dt_quantum = settings.dt_quantum,
+                                .burst = settings.burst.healing + settings.burst.window,
+                                .window = settings.burst.window}) {
+    EFDEM_EXPECTS(std::isfinite(settings.burst.healing) && settings.burst.healing >= 0.0);
+    EFDEM_EXPECTS(std::isfinite(settings.burst.window) && settings.burst.window > 0.0);
     EFDEM_EXPECTS(settings.steps == 1 || settings.steps == 2);
-    if (settings.adaptive) {
-        [[maybe_unused]] const StepSizeSettings& c = settings.control;
-        EFDEM_EXPECTS(c.tolerance > 0.0 && std::isfinite(c.tolerance));
-        EFDEM_EXPECTS(c.dt_min > 0.0 && c.dt_min <= c.dt_max && std::isfinite(c.dt_max));
-        EFDEM_EXPECTS(c.safety > 0.0 && c.safety <= 1.0 && c.growth > 1.0 && c.max_rejections >= 0);
-    } else {
-        EFDEM_EXPECTS(std::isfinite(settings.dt) && settings.dt >= 0.0);
-    }
 }
 
 std::string_view MultistepProjectiveIntegrator::name() const {
@@ -73,7 +74,7 @@ std::string_view MultistepProjectiveIntegrator::name() const {
 bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec,
                                                   Measured& out, double length) const {
     const double t_start = stepper.time();
-    const double burst = settings_.healing + settings_.window;
+    const double burst = settings_.burst.healing + settings_.burst.window;
     if (!(length > 0.0)) length = burst;
     rec.burst = BurstSamples{};
     rec.burst_length = length;
@@ -87,7 +88,8 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     rec.t_end = origin_t;
     rec.x_end = std::move(origin_x);
     if (!valid) return false;
-    const double t_window = t_start + length - settings_.window;  // the last `window` of the burst
+    const double t_window =
+        t_start + length - settings_.burst.window;  // the last `window` of the burst
     WindowFit fit = fit_window(rec.burst, t_window, rec.burst.t.size());
     const SlopeEstimate& slope = fit.slope;
     if (!slope.ok) {
@@ -116,15 +118,15 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
         const WaveCoherence w = wave_coherence(rec.burst, t_start);
         if (d.drifting) {
-            out.hold_kind = "fast transient";
+            out.hold_kind = DtLimit::fast_transient;
             out.hold = "still in a fast transient (" + d.message + ")";
-        } else if (w.in_phase &&
-                   settings_.window < 2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
-            out.hold_kind = "in-phase wave";
+        } else if (w.in_phase && settings_.burst.window <
+                                     2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
+            out.hold_kind = DtLimit::in_phase_wave;
             out.hold = fmt::format(
                 "{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
                 "by the common wave beyond its standard error; use cpi.window >= {:.3g}",
-                w.message, settings_.window, 2.0 * w.period);
+                w.message, settings_.burst.window, 2.0 * w.period);
         }
     }
     rec.window = slope.t_last - slope.t_first;
@@ -159,104 +161,32 @@ double MultistepProjectiveIntegrator::prior_curvature() const {
 }
 
 double MultistepProjectiveIntegrator::direct_burst_length(const CoarseStepper& stepper) const {
-    const double burst = settings_.healing + settings_.window, left = end_time() - stepper.time();
+    const double burst = settings_.burst.healing + settings_.burst.window,
+                 left = end_time() - stepper.time();
     return left < 2.0 * burst - time_tolerance(end_time()) ? left : burst;
 }
 
 double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
-    const double burst = settings_.healing + settings_.window;
+    const DtPlan p = controller_.plan({.model = {method_nodes(), t_end_, prior_curvature(), 1.0},
+                                       .decay = decay_,
+                                       .hold = hold_kind_,
+                                       .hold_message = hold_,
+                                       .end_time = end_time()});
     ControllerRecord& c = rec.controller;
-    JumpErrorModel model{method_nodes(), t_end_, prior_curvature(), 1.0};
-    // The jump is followed by a burst: it must leave room for that burst, and for a whole
-    // burst more or none (the rule of end_of_run_jump_limit, one burst later).
-    auto end_limit = [&](double dt) { return jump_limit(t_end_ + burst, dt, burst); };
-    if (!settings_.adaptive) {
-        c.limited_by = "fixed";
-        return std::min(settings_.dt, end_limit(settings_.dt));
-    }
-    const StepSizeSettings& s = settings_.control;
-    if (!hold_.empty()) {  // the slope is a fast transient's or a common wave's, not the slow
-                           // dynamics'
-        append_message(rec, hold_ + ": one burst of direct simulation");
-        c.limited_by = hold_kind_;
-        return 0.0;
-    }
-    const double target = s.safety * s.tolerance;
-    c.dt_tolerance = largest_dt_within(model, target, s.dt_max);
-    model.se_scale = 1.0 / std::sqrt(2.0);
-    c.dt_tolerance_2r = largest_dt_within(model, target, s.dt_max);
-    model.se_scale = 0.5;
-    c.dt_tolerance_4r = largest_dt_within(model, target, s.dt_max);
-    model.se_scale = 1.0;  // the realizations this run has
-
-    double dt = c.dt_tolerance;
-    c.limited_by = dt >= s.dt_max ? "dt_max" : "tolerance";
-    auto limit = [&](double cap, const char* why) {
-        if (cap < dt) {
-            dt = cap;
-            c.limited_by = why;
-        }
-    };
-    if (std::isfinite(settings_.first_dt) && totals_.accepted == 0)
-        limit(settings_.first_dt, "first jump (cpi.dt)");
-    else if (!std::isfinite(model.curvature))
-        limit(std::max(s.dt_min, burst), "first jump (no curvature measured yet)");
-    if (std::isfinite(dt_last_)) limit(s.growth * dt_last_, "growth");
-    limit(dt_cap_, "rejection");
-    if (settings_.dt_quantum > 0.0 && std::isfinite(dt))
-        dt = std::floor(dt / settings_.dt_quantum * (1.0 + 1e-12)) * settings_.dt_quantum;
-    const double tol = time_tolerance(end_time());
-    if (end_limit(dt) <= tol) {  // this step's burst is the run's last: no jump before it
-        c.limited_by = "end of run";
-        return 0.0;
-    }
-    if (dt < s.dt_min * (1.0 - 1e-12)) {
-        const std::string why = c.limited_by == "rejection"
-                                    ? fmt::format(
-                                          "the curvature the rejected jump showed allows no DT >= "
-                                          "cpi.dt_min = {:.3g} within the "
-                                          "tolerance",
-                                          s.dt_min)
-                                    : fmt::format(
-                                          "the tolerance {:.3g} allows DT = {:.3g} < cpi.dt_min = "
-                                          "{:.3g} (statistical error of "
-                                          "one DT_min jump {:.3g})",
-                                          s.tolerance, c.dt_tolerance, s.dt_min,
-                                          jump_error(model, s.dt_min).statistical);
-        append_message(rec, why + ": one burst of direct simulation instead");
-        c.limited_by = "tolerance below dt_min";
-        return 0.0;
-    }
-    const double end = end_limit(dt);
-    if (end < dt) {
-        // The rule leaves room for one more burst; if the tolerance allows reaching the last
-        // burst in this jump (less than one burst further), do that instead.
-        const double to_last_burst = end_time() - (t_end_ + burst);
-        dt = to_last_burst > dt && to_last_burst <= c.dt_tolerance ? to_last_burst : end;
-        if (dt <= tol) return 0.0;  // rounding: nothing left to jump
-        c.limited_by = "end of run";
-    }
-    // Never a jump the measured transient would be amplified by: shorten until stable.
-    // The record keeps the assessment of the DT taken (or of the last one refused).
-    CpiCycle cycle{SlopeEstimator::least_squares, burst, settings_.window, dt,
-                   static_cast<int>(model.nodes.size())};
-    for (int i = 0; i < 20 && dt > 0.0; ++i) {
-        cycle.dt = dt;
-        const StabilityAssessment a = assess_stability(decay_, cycle);
-        rec.stability = a;
-        if (a.stable) break;
-        dt = dt * 0.5 >= s.dt_min ? dt * 0.5 : 0.0;
-        c.limited_by = "stability";
-        if (dt == 0.0) append_message(rec, "no DT >= cpi.dt_min is stable: " + a.message);
-    }
-    return dt;
+    c.limited_by = p.limited_by;
+    c.dt_tolerance = p.dt_tolerance;
+    c.dt_tolerance_2r = p.dt_tolerance_2r;
+    c.dt_tolerance_4r = p.dt_tolerance_4r;
+    if (p.stability) rec.stability = *p.stability;
+    if (!p.message.empty()) append_message(rec, p.message);
+    return p.dt;
 }
 
 ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper) {
     ProjectiveStepRecord rec;
     rec.t_start = stepper.time();
-    rec.healing = settings_.healing;
-    rec.burst_length = settings_.healing + settings_.window;
+    rec.healing = settings_.burst.healing;
+    rec.burst_length = settings_.burst.healing + settings_.burst.window;
     ControllerRecord& c = rec.controller;
     c.active = true;
     c.adaptive = settings_.adaptive;
@@ -268,9 +198,9 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
         // No lift before it: with healing >= window its start is a second window, whose slope
         // gives the first jump a curvature (for the error model only).
-        const double w = settings_.window;
+        const double w = settings_.burst.window;
         SlopeNode early;
-        if (settings_.adaptive && settings_.healing >= w * (1.0 - 1e-12) &&
+        if (settings_.adaptive && settings_.burst.healing >= w * (1.0 - 1e-12) &&
             window_node(rec.burst, m.t_end - 2.0 * w, m.t_end - w, early)) {
             history_.push_back(std::move(early));
             curvature_only_front_ = true;
@@ -281,7 +211,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         rec.x_end = rec.x_projected = x_end_;
         rec.slope = m.node.slope;
         rec.slope_standard_error = m.node.se;
-        c.limited_by = "first burst";
+        c.limited_by = DtLimit::first_burst;
         return rec;
     }
 
@@ -300,18 +230,18 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     rec.dt_requested = plan_dt(rec);
     if (forced_shrink) {  // as if a jump of the planned DT had been rejected (tests)
-        dt_cap_ = 0.5 * rec.dt_requested;
+        controller_.jump_failed(rec.dt_requested);
         rec.dt_requested = plan_dt(rec);
         append_message(rec, "DT halved (forced)");
     }
     rec.dt = rec.dt_requested;
     if (rec.dt == 0.0) {  // one burst of direct simulation from where we are
-        if (c.limited_by == "tolerance below dt_min") ++totals_.direct;
+        if (c.limited_by == DtLimit::below_dt_min) ++totals_.direct;
         if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
         accept_burst(m);
         rec.status = StepStatus::burst_only;
         rec.x_projected = rec.x_end;
-        dt_cap_ = std::numeric_limits<double>::infinity();
+        controller_.direct_burst_done();
         return rec;
     }
     ++totals_.attempts;
@@ -324,7 +254,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     c.statistical = rms(stat);
     Eigen::VectorXd x = x_end_ + projected_increment(nodes, w);
     if (!repair_projection(rec, x, repair_)) {
-        dt_cap_ = 0.5 * rec.dt;  // the next attempt jumps less far
+        controller_.jump_failed(rec.dt);  // the next attempt jumps less far
         return rec;
     }
     if (settings_.adaptive) stepper.keep_state();
@@ -339,7 +269,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         rec.burst = std::move(after.burst);
         append_message(rec, "the burst after the jump: " + after.message +
                                 (settings_.adaptive ? "; back to the state before the jump" : ""));
-        dt_cap_ = 0.5 * rec.dt;
+        controller_.jump_failed(rec.dt);
         return rec;
     }
     rec.burst = std::move(after.burst);
@@ -353,25 +283,14 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     c.truncation = d.norm * omega;
     c.truncation_nodes = d.value.cwiseAbs() * omega;
 
-    const StepSizeSettings& s = settings_.control;
-    const bool within = c.error() <= s.tolerance;
-    const bool at_floor = rec.dt <= s.dt_min * (1.0 + 1e-12);
-    const bool too_many = consecutive_rejections_ >= s.max_rejections;
-    const bool keep = !settings_.adaptive || (!forced_reject && (within || at_floor || too_many));
-    if (keep) {
-        if (settings_.adaptive) {
-            stepper.confirm_kept_state();
-            if (!within)
-                append_message(rec, fmt::format("error {:.3g} = {:.2f} x tolerance kept: {}",
-                                                c.error(), c.error() / s.tolerance,
-                                                at_floor ? "DT is at cpi.dt_min"
-                                                         : "too many rejections in a row"));
-        }
+    const JumpErrorModel posterior{nodes, t_end_, d.norm, 1.0};
+    const JumpVerdict verdict =
+        controller_.judge(rec.dt, {c.statistical, c.truncation}, posterior, forced_reject);
+    if (verdict.accepted) {
+        if (settings_.adaptive) stepper.confirm_kept_state();
+        if (!verdict.message.empty()) append_message(rec, verdict.message);
         c.accepted = true;
         accept_burst(m);
-        dt_last_ = rec.dt;
-        dt_cap_ = std::numeric_limits<double>::infinity();
-        consecutive_rejections_ = 0;
         ++totals_.accepted;
         totals_.dt_taken += rec.dt;
         if (settings_.adaptive) {
@@ -384,24 +303,11 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         rec.status = StepStatus::projected;
         return rec;
     }
-    // Rejected: back to the end of the last accepted burst; the next step jumps less far,
-    // planned with the curvature this burst showed.
+    // Rejected: back to the end of the last accepted burst; the controller caps the next step.
     stepper.return_to_kept_state();
-    const JumpErrorModel posterior{nodes, t_end_, d.norm, 1.0};
-    const double redo = largest_dt_within(posterior, s.safety * s.tolerance, rec.dt);
-    // A redo that the curvature seen would not allow even at dt_min is not tried: the next step
-    // runs one burst directly (cap 0) instead of a jump known to exceed the tolerance.
-    dt_cap_ = forced_reject     ? 0.5 * rec.dt
-              : redo < s.dt_min ? 0.0
-                                : std::max(s.dt_min, std::min(redo, 0.5 * rec.dt));
-    ++consecutive_rejections_;
     ++totals_.rejected;
     rec.status = StepStatus::rejected;
-    append_message(
-        rec, fmt::format("step rejected{}: error {:.3g} = {:.2f} x tolerance (statistical {:.3g}, "
-                         "truncation {:.3g}); back to t = {:.6g}, next DT <= {:.4g}",
-                         forced_reject ? " (forced)" : "", c.error(), c.error() / s.tolerance,
-                         c.statistical, c.truncation, t_end_, dt_cap_));
+    append_message(rec, verdict.message);
     return rec;
 }
 
@@ -430,81 +336,35 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
     return s;
 }
 
-void MultistepProjectiveIntegrator::save_state(std::vector<double>& r, std::string& text) const {
-    r.clear();
-    const Eigen::Index m = x_end_.size();
-    r.insert(r.end(), {3.0 /* layout version */, static_cast<double>(history_.size()),
-                       static_cast<double>(m), t_end_, dt_last_, dt_cap_,
-                       static_cast<double>(consecutive_rejections_), decay_.ok ? 1.0 : 0.0,
-                       decay_.rate, decay_.ratio, decay_.delay});
-    r.insert(r.end(), x_end_.data(), x_end_.data() + m);
-    for (const auto& n : history_) {
-        r.push_back(n.tau);
-        r.insert(r.end(), n.slope.data(), n.slope.data() + m);
-        r.insert(r.end(), n.se.data(), n.se.data() + m);
-    }
-    const Totals& t = totals_;
-    r.insert(r.end(),
-             {static_cast<double>(t.attempts), static_cast<double>(t.accepted),
-              static_cast<double>(t.rejected), static_cast<double>(t.direct), t.dt_taken,
-              t.dt_tolerance, t.dt_tolerance_2r, t.dt_tolerance_4r, t.statistical, t.truncation});
-    r.push_back(curvature_only_front_ ? 1.0 : 0.0);  // layout 3
-    text = decay_.message + '\n' + hold_kind_ + '\n' + hold_;
+IntegratorState MultistepProjectiveIntegrator::save_state() const {
+    MultistepState s;
+    s.t_end = t_end_;
+    s.x_end = x_end_;
+    s.history.assign(history_.begin(), history_.end());
+    s.curvature_only_front = curvature_only_front_;
+    s.decay = decay_;
+    s.hold_kind = hold_kind_;
+    s.hold = hold_;
+    s.controller = controller_.state();
+    s.totals = totals_;
+    return s;
 }
 
-void MultistepProjectiveIntegrator::restore_state(const std::vector<double>& r,
-                                                  const std::string& text) {
+void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) {
     history_.clear();
     curvature_only_front_ = false;
-    if (r.empty()) return;  // saved before the first burst
-    // Layout 2 (checkpoint format 2 of earlier versions) lacks the last value: no curvature-only
-    // node.
-    EFDEM_EXPECTS(r.size() >= 11 && (r[0] == 2.0 || r[0] == 3.0));
-    const auto n = static_cast<std::size_t>(r[1]);
-    const auto m = static_cast<Eigen::Index>(r[2]);
-    const std::size_t layout_extra = r[0] == 3.0 ? 1 : 0;
-    EFDEM_EXPECTS(r.size() ==
-                  11 + static_cast<std::size_t>(m) * (1 + 2 * n) + n + 10 + layout_extra);
-    t_end_ = r[3];
-    dt_last_ = r[4];
-    dt_cap_ = r[5];
-    consecutive_rejections_ = static_cast<long>(r[6]);
-    decay_.ok = r[7] != 0.0;
-    decay_.rate = r[8];
-    decay_.ratio = r[9];
-    decay_.delay = r[10];
-    // Three lines: the decay estimate's message, then why no jump may start here (kind, text).
-    const std::size_t a = text.find('\n'), b = a == std::string::npos ? a : text.find('\n', a + 1);
-    EFDEM_EXPECTS(b != std::string::npos);
-    decay_.message = text.substr(0, a);
-    hold_kind_ = text.substr(a + 1, b - a - 1);
-    hold_ = text.substr(b + 1);
-    std::size_t k = 11;
-    auto vec = [&] {
-        Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(r.data() + k, m);
-        k += static_cast<std::size_t>(m);
-        return v;
-    };
-    x_end_ = vec();
-    for (std::size_t i = 0; i < n; ++i) {
-        SlopeNode node;
-        node.tau = r[k++];
-        node.slope = vec();
-        node.se = vec();
-        history_.push_back(std::move(node));
-    }
-    Totals& t = totals_;
-    t.attempts = static_cast<long>(r[k]);
-    t.accepted = static_cast<long>(r[k + 1]);
-    t.rejected = static_cast<long>(r[k + 2]);
-    t.direct = static_cast<long>(r[k + 3]);
-    t.dt_taken = r[k + 4];
-    t.dt_tolerance = r[k + 5];
-    t.dt_tolerance_2r = r[k + 6];
-    t.dt_tolerance_4r = r[k + 7];
-    t.statistical = r[k + 8];
-    t.truncation = r[k + 9];
-    if (layout_extra) curvature_only_front_ = r[k + 10] != 0.0;
+    if (!state) return;  // nothing saved: as new
+    const MultistepState& s = *state;
+    EFDEM_EXPECTS(s.history.size() <= static_cast<std::size_t>(settings_.steps) + 1);
+    t_end_ = s.t_end;
+    x_end_ = s.x_end;
+    history_.assign(s.history.begin(), s.history.end());
+    curvature_only_front_ = s.curvature_only_front;
+    decay_ = s.decay;
+    hold_kind_ = s.hold_kind;
+    hold_ = s.hold;
+    controller_.restore(s.controller);
+    totals_ = s.totals;
 }
 
 }  // namespace efdem::coarse

@@ -5,14 +5,12 @@
 /// rejects and redoes a jump whose error exceeds the tolerance (docs/error_control.md).
 ///
 /// One step, adaptive (the stepper is at the end of the last accepted burst, X_n):
-///   1. plan DT: the largest DT whose predicted error (statistical + truncation, from the
-///      slopes measured so far) is at most safety x tolerance, then the limits: growth over the
-///      last DT, dt_max, the first jump at most one burst if no curvature is known yet (see
-///      below), the end of the run, the stability monitor; below dt_min no jump is worth its error:
-///      run one burst directly instead (status burst_only, the record says why);
+///   1. StepSizeController::plan(): DT from the predicted error (statistical + truncation,
+///      from the slopes measured so far) and the caps (step_size_controller.hpp); DT = 0: one
+///      burst of direct simulation instead (status burst_only, the record says why);
 ///   2. keep the micro state, project X_n + sum_k W_k s_k, repair, lift;
 ///   3. run the next burst (provisional samples) and measure its slope;
-///   4. judge the jump a posteriori with the curvature that slope shows: accept (samples
+///   4. StepSizeController::judge() with the curvature that slope shows: accept (samples
 ///      final, the slope joins the history) or reject (back to the kept state, the next step
 ///      tries a smaller DT; status rejected).
 /// The very first step of a run runs one burst only (its slope is the first jump's). No lift
@@ -40,19 +38,9 @@
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/projective_integrator.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
+#include "coarse/equation_free/projective/step_size_controller.hpp"
 
 namespace efdem::coarse {
-
-/// The step-size controller's settings. Times in sqrt(d_p/g); tolerance in the coarse
-/// vector's unit (d_p for the ICDF), RMS over its components.
-struct StepSizeSettings {
-    double tolerance = 0.05;  ///< error one jump may add (> 0)
-    double dt_min = 10.0;     ///< smallest jump worth making (> 0)
-    double dt_max = 160.0;    ///< largest jump (>= dt_min)
-    double safety = 0.8;      ///< DT is planned for safety x tolerance (in (0, 1])
-    double growth = 2.0;      ///< DT_next <= growth x DT_last (> 1)
-    int max_rejections = 4;   ///< consecutive rejections after which a jump is kept anyway
-};
 
 /// A decision forced on one jump attempt (tests only: reject it, or halve its planned DT).
 struct ForcedDecision {
@@ -61,11 +49,12 @@ struct ForcedDecision {
 };
 
 struct MultistepSettings {
-    double healing = 10.0;  ///< start of each burst left out of the slope (>= 0)
-    double window = 10.0;   ///< estimation window after healing (> 0)
-    int steps = 1;          ///< q: 1 forward Euler, 2 Adams-Bashforth 2
-    bool adaptive = true;   ///< DT by the controller; false: `dt` for every jump
-    double dt = 80.0;       ///< adaptive = false: the projective step (>= 0)
+    /// Healing and window of every burst (burst.stability is not consulted: adaptive DT is
+    /// always shortened until stable, a fixed DT is not assessed).
+    BurstSettings burst;
+    int steps = 1;         ///< q: 1 forward Euler, 2 Adams-Bashforth 2
+    bool adaptive = true;  ///< DT by the controller; false: `dt` for every jump
+    double dt = 80.0;      ///< adaptive = false: the projective step (>= 0)
     /// adaptive: the first jump is at most this; NaN: planned from the tolerance when the first
     /// burst measured a curvature (healing >= window), else one burst, but at least dt_min.
     double first_dt = std::numeric_limits<double>::quiet_NaN();
@@ -73,19 +62,18 @@ struct MultistepSettings {
     /// adaptive: DT is rounded down to a whole multiple of this (the sampling interval, so
     /// that bursts stay on the sampling grid and the run ends at its end time; 0: no rounding).
     double dt_quantum = 0.0;
-    /// adaptive = false: what a flagged DT does (adaptive always shortens DT until stable).
-    StabilityPolicy stability_policy = StabilityPolicy::warn;
     ForcedDecision force;
     /// adaptive: a burst whose phase signal drifts faster than this (and beyond its noise) is
     /// still in a fast transient: no jump from it (phase_drift.hpp) [unit per sqrt(d_p/g)].
-    /// Infinite: no check.
+    /// Infinite: no check. From a scene: steady_drift_rate() (cpi_settings.hpp).
     double drift_rate = std::numeric_limits<double>::infinity();
 };
 
 class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
   public:
-    /// \pre healing >= 0, window > 0, steps in {1, 2}; adaptive: 0 < dt_min <= dt_max finite,
-    ///      tolerance > 0, safety in (0, 1], growth > 1, max_rejections >= 0; else dt >= 0.
+    /// \pre burst.healing >= 0, burst.window > 0, steps in {1, 2}; adaptive: 0 < dt_min <=
+    ///      dt_max finite, tolerance > 0, safety in (0, 1], growth > 1, max_rejections >= 0;
+    ///      else dt >= 0.
     explicit MultistepProjectiveIntegrator(const MultistepSettings& settings,
                                            RepairHook repair = {});
 
@@ -93,20 +81,15 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// Adaptive: needs stepper.can_keep_state() and a stepper with members (slope standard
     /// errors); without members the step ends invalid_burst and says so.
     ProjectiveStepRecord step(CoarseStepper& stepper) override;
-    void save_state(std::vector<double>& reals, std::string& text) const override;
-    void restore_state(const std::vector<double>& reals, const std::string& text) override;
+    /// Always a state (also before the first burst: an empty history).
+    IntegratorState save_state() const override;
+    /// nullopt (a checkpoint written by a single-step integrator, or of format 1): the state
+    /// of a new integrator.
+    void restore_state(const IntegratorState& state) override;
 
     const MultistepSettings& settings() const { return settings_; }
     /// Totals since the start of the run (saved with the state).
-    struct Totals {
-        long attempts = 0;  ///< jumps tried
-        long accepted = 0;  ///< jumps kept
-        long rejected = 0;  ///< jumps redone
-        long direct = 0;    ///< bursts run without a jump because the tolerance allowed < dt_min
-        double dt_taken = 0, dt_tolerance = 0, dt_tolerance_2r = 0,
-               dt_tolerance_4r = 0;              ///< sums over kept jumps
-        double statistical = 0, truncation = 0;  ///< sums over kept jumps
-    };
+    using Totals = MultistepTotals;
     const Totals& totals() const { return totals_; }
     /// Adaptive: the run's controller in a few lines for the log and the run file: jumps kept,
     /// rejected, direct bursts, mean DT, the statistical share of the error, and the mean DT
@@ -121,8 +104,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         double t_end = 0.0;
         Eigen::VectorXd x_end;
         DecayRateEstimate decay;
-        /// Why no jump may start from this burst (empty: it may), and its short kind.
-        std::string hold, hold_kind;
+        /// Why no jump may start from this burst (empty: it may), and its kind (none: it may).
+        std::string hold;
+        DtLimit hold_kind = DtLimit::none;
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
@@ -134,6 +118,7 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// The method's nodes (q_eff of them) and the error model of the next jump.
     std::vector<SlopeNode> method_nodes() const;
     double prior_curvature() const;
+    /// Asks the controller for the next DT and writes its plan into `rec`; returns DT.
     double plan_dt(ProjectiveStepRecord& rec) const;
 
     MultistepSettings settings_;
@@ -141,14 +126,12 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     std::deque<SlopeNode> history_;  ///< accepted slopes, oldest first (at most steps + 1)
     /// history_.front() is the first burst's earlier window: for the curvature, not projected from.
     bool curvature_only_front_ = false;
-    double t_end_ = 0.0;       ///< end of the last accepted burst
-    Eigen::VectorXd x_end_;    ///< X there
-    DecayRateEstimate decay_;  ///< from the last accepted burst
-    std::string hold_;         ///< why no jump may start from it (empty: one may)
-    std::string hold_kind_;    ///< "fast transient" or "in-phase wave"
-    double dt_last_ = std::numeric_limits<double>::quiet_NaN();  ///< last kept DT
-    double dt_cap_ = std::numeric_limits<double>::infinity();    ///< set by a rejection
-    long consecutive_rejections_ = 0;
+    double t_end_ = 0.0;                 ///< end of the last accepted burst
+    Eigen::VectorXd x_end_;              ///< X there
+    DecayRateEstimate decay_;            ///< from the last accepted burst
+    std::string hold_;                   ///< why no jump may start from it (empty: one may)
+    DtLimit hold_kind_ = DtLimit::none;  ///< fast_transient or in_phase_wave (none: one may)
+    StepSizeController controller_;      ///< every rule on DT: plan, caps, accept/reject, redo
     Totals totals_;
 };
 

@@ -32,8 +32,8 @@ PeriodEstimate post_healing_period(const BurstSamples& b, double t_window,
 PeriodProjectiveEuler::PeriodProjectiveEuler(const PeriodProjectiveEulerSettings& settings,
                                              RepairHook repair, const PeriodSettings& period)
     : settings_(settings), repair_(std::move(repair)), period_(period) {
-    EFDEM_EXPECTS(std::isfinite(settings.healing) && settings.healing >= 0.0);
-    EFDEM_EXPECTS(std::isfinite(settings.window) && settings.window > 0.0);
+    EFDEM_EXPECTS(std::isfinite(settings.burst.healing) && settings.burst.healing >= 0.0);
+    EFDEM_EXPECTS(std::isfinite(settings.burst.window) && settings.burst.window > 0.0);
     EFDEM_EXPECTS(settings.periods_per_step >= 0);
     EFDEM_EXPECTS(std::isfinite(settings.max_extension) && settings.max_extension >= 0.0);
     EFDEM_EXPECTS(std::isfinite(settings.extension_step) && settings.extension_step > 0.0);
@@ -43,10 +43,10 @@ PeriodProjectiveEuler::PeriodProjectiveEuler(const PeriodProjectiveEulerSettings
 ProjectiveStepRecord PeriodProjectiveEuler::step(CoarseStepper& stepper) {
     ProjectiveStepRecord rec;
     rec.t_start = stepper.time();
-    rec.healing = settings_.healing;
-    rec.burst_length = settings_.healing + settings_.window;
+    rec.healing = settings_.burst.healing;
+    rec.burst_length = settings_.burst.healing + settings_.burst.window;
     stepper.run(rec.burst_length, rec.burst);
-    const double t_window = rec.t_start + settings_.healing;
+    const double t_window = rec.t_start + settings_.burst.healing;
 
     double extension = 0.0;
     PeriodEstimate period;
@@ -92,14 +92,14 @@ ProjectiveStepRecord PeriodProjectiveEuler::step(CoarseStepper& stepper) {
 
     JumpPlan plan;
     plan.cycle = {SlopeEstimator::period_mean, rec.t_end - rec.t_start, rec.period, 0.0};
-    plan.policy = settings_.stability_policy;
+    plan.policy = settings_.burst.stability;
     plan.decay = estimate_decay_rate_periodic(t, x, rec.period, t_window, rec.t_end);
     for (int k = settings_.periods_per_step; k > 0; k /= 2)
         plan.dt_candidates.push_back(k * rec.period);
     plan.dt_candidates.push_back(0.0);
     // A burst is at least healing + window (its extensions are not known in advance).
-    plan.dt_max =
-        jump_limit(rec.t_end, plan.dt_candidates.front(), settings_.healing + settings_.window);
+    plan.dt_max = jump_limit(rec.t_end, plan.dt_candidates.front(),
+                             settings_.burst.healing + settings_.burst.window);
     project_and_lift(rec, stepper, plan, repair_);
     rec.periods_per_step = static_cast<int>(std::lround(rec.dt / rec.period));
     return rec;

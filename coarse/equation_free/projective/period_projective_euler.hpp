@@ -11,16 +11,15 @@
 
 namespace efdem::coarse {
 
-/// Settings of PeriodProjectiveEuler; times in sqrt(d_p/g). Scalars only, so that designated
-/// initializers may omit any of them (g++ 12 warns about an omitted class-type member); the
-/// period estimator's own settings are a separate constructor argument.
+/// Settings of PeriodProjectiveEuler; times in sqrt(d_p/g). The period estimator's own
+/// settings are a separate constructor argument.
 struct PeriodProjectiveEulerSettings {
-    double healing = 10.0;        ///< start of each burst left out (>= 0)
-    double window = 20.0;         ///< initial estimation window after healing (> 0)
+    /// Healing, the initial estimation window after it, what a flagged DT does (halve_step
+    /// halves k).
+    BurstSettings burst{.healing = 10.0, .window = 20.0};
     int periods_per_step = 2;     ///< k in DT = k T (>= 0; 0 = burst only)
     double max_extension = 30.0;  ///< most the burst may be lengthened to see enough periods
     double extension_step = 5.0;  ///< length of each extension (> 0)
-    StabilityPolicy stability_policy = StabilityPolicy::warn;
 };
 
 /**
@@ -37,13 +36,13 @@ struct PeriodProjectiveEulerSettings {
  * (three periods needed; otherwise not assessed); halve_step halves k.
  *
  * \code
- * PeriodProjectiveEuler cpi({.healing = 6, .window = 24, .periods_per_step = 2});
+ * PeriodProjectiveEuler cpi({.burst = {.healing = 6, .window = 24}, .periods_per_step = 2});
  * const ProjectiveStepRecord rec = cpi.step(stepper);   // rec.period, rec.dt = 2 rec.period
  * \endcode
  */
 class PeriodProjectiveEuler final : public ProjectiveIntegrator {
   public:
-    /// \pre healing >= 0, window > 0, periods_per_step >= 0, max_extension >= 0,
+    /// \pre burst.healing >= 0, burst.window > 0, periods_per_step >= 0, max_extension >= 0,
     ///      extension_step > 0 (all finite); period.min_periods >= 2.
     explicit PeriodProjectiveEuler(const PeriodProjectiveEulerSettings& settings,
                                    RepairHook repair = {}, const PeriodSettings& period = {});

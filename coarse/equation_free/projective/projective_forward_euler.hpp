@@ -12,10 +12,8 @@ namespace efdem::coarse {
 
 /// Settings of ProjectiveForwardEuler; times in sqrt(d_p/g). Defaults: paper case (a).
 struct ProjectiveEulerSettings {
-    double healing = 10.0;  ///< start of each burst left out of the slope (>= 0)
-    double window = 10.0;   ///< estimation window after healing (> 0); burst = healing + window
+    BurstSettings burst;    ///< healing, window, what a flagged DT does
     double dt = 80.0;       ///< projective step DT (>= 0; 0 = burst only)
-    StabilityPolicy stability_policy = StabilityPolicy::warn;
     int max_halvings = 10;  ///< halve_step: DT/2, ..., DT/2^max_halvings, then 0
 };
 
@@ -30,7 +28,7 @@ struct ProjectiveEulerSettings {
  * projective forward Euler of Gear & Kevrekidis with M = DT/h (physics.md §11.1).
  *
  * \code
- * ProjectiveForwardEuler pfe({.healing = 10, .window = 10, .dt = 80},
+ * ProjectiveForwardEuler pfe({.burst = {.healing = 10, .window = 10}, .dt = 80},
  *                            [&](Eigen::VectorXd& x) { return repair_monotone(x, z_lo, z_hi); });
  * const ProjectiveStepRecord rec = pfe.step(stepper);
  * if (!rec.advanced()) log::warn("{}: {}", to_string(rec.status), rec.message);
@@ -38,7 +36,7 @@ struct ProjectiveEulerSettings {
  */
 class ProjectiveForwardEuler final : public ProjectiveIntegrator {
   public:
-    /// \pre healing >= 0, window > 0, dt >= 0 (all finite), max_halvings >= 0.
+    /// \pre burst.healing >= 0, burst.window > 0, dt >= 0 (all finite), max_halvings >= 0.
     explicit ProjectiveForwardEuler(const ProjectiveEulerSettings& settings,
                                     RepairHook repair = {});
 

@@ -48,15 +48,8 @@ void CoarseStepper::confirm_kept_state() {
     EFDEM_EXPECTS(can_keep_state());
 }
 
-void ProjectiveIntegrator::save_state(std::vector<double>& reals, std::string& text) const {
-    reals.clear();
-    text.clear();
-}
-
-void ProjectiveIntegrator::restore_state([[maybe_unused]] const std::vector<double>& reals,
-                                         const std::string& text) {
-    (void)text;
-    EFDEM_EXPECTS(reals.empty());
+void ProjectiveIntegrator::restore_state([[maybe_unused]] const IntegratorState& state) {
+    EFDEM_EXPECTS(!state.has_value());
 }
 
 double ProjectiveIntegrator::jump_limit(double t_after_burst, double dt, double burst) const {

@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -17,7 +18,9 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/projective/multistep_state.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
+#include "coarse/equation_free/projective/step_size_controller.hpp"
 #include "coarse/equation_free/repair_report.hpp"
 
 namespace efdem::coarse {
@@ -38,6 +41,18 @@ enum class StepStatus {
 
 std::string_view to_string(StepStatus status);
 
+/// The burst every integrator runs before a jump, shared by their settings
+/// (ProjectiveEulerSettings, PeriodProjectiveEulerSettings, MultistepSettings). Times in
+/// sqrt(d_p/g).
+struct BurstSettings {
+    double healing = 10.0;  ///< start of each burst left out of the slope (>= 0)
+    double window = 10.0;   ///< estimation window after healing (> 0); burst = healing + window
+    /// What a DT the stability monitor flags does (fixed DT and DT = k T; the adaptive
+    /// controller always shortens DT until stable, and the multistep integrator with a fixed DT
+    /// does not consult the monitor).
+    StabilityPolicy stability = StabilityPolicy::warn;
+};
+
 /// What the step-size controller of the multistep integrator measured and decided for one
 /// jump (docs/error_control.md). Errors are RMS over the coarse vector's components [d_p for
 /// the ICDF]; per-component vectors in the same unit.
@@ -56,7 +71,8 @@ struct ControllerRecord {
     /// Largest DT the tolerance allows with the realizations run, and with 2 and 4 times as
     /// many (standard errors / sqrt(2), / 2): what more realizations would buy.
     double dt_tolerance = nan, dt_tolerance_2r = nan, dt_tolerance_4r = nan;
-    std::string limited_by;  ///< what set DT: "tolerance", "growth", "first jump", ...
+    /// What set DT (the run file and the log hold its text: to_string(DtLimit)).
+    DtLimit limited_by = DtLimit::none;
     double error() const { return statistical + truncation; }
 };
 
@@ -110,6 +126,10 @@ struct ProjectiveStepRecord {
 /// otherwise +infinity (also for an infinite t_end). Times compared to time_tolerance(t_end).
 double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, double burst);
 
+/// An integrator's own state between two steps, for a checkpoint: only the multistep
+/// integrator has one (nullopt for the single-step integrators).
+using IntegratorState = std::optional<MultistepState>;
+
 /// A macro integrator: advances a CoarseStepper by one outer step.
 class ProjectiveIntegrator {
   public:
@@ -126,16 +146,17 @@ class ProjectiveIntegrator {
     double end_time() const { return end_time_; }
 
     /// The integrator's own state between two steps (slope history, step-size controller), for
-    /// a checkpoint; integrators without one save nothing. restore_state() takes what
-    /// save_state() wrote, so that the next step is bit for bit the one the saved run made.
-    virtual void save_state(std::vector<double>& reals, std::string& text) const;
+    /// a checkpoint; integrators without one save nothing (nullopt). restore_state() takes what
+    /// save_state() returned, so that the next step is bit for bit the one the saved run made.
+    virtual IntegratorState save_state() const { return std::nullopt; }
     /// What the integrator did over the run, in a few lines for the log and the run file
     /// (`realizations`: the ensemble's R); empty for integrators with nothing to add.
     virtual std::string summary(int realizations) const {
         (void)realizations;
         return {};
     }
-    virtual void restore_state(const std::vector<double>& reals, const std::string& text);
+    /// \pre state is what this kind of integrator saves (nullopt for those without a state).
+    virtual void restore_state(const IntegratorState& state);
 
   protected:
     /// end_of_run_jump_limit() for this integrator's end time.

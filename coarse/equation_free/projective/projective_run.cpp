@@ -46,20 +46,20 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
     // From here on the fallback is the coarse variable when the primary one failed, now or
     // before the checkpoint this run resumed from.
     use(state_.fell_back && fallback_ ? *fallback_ : primary_);
-    if (resume) integrator_->restore_state(state_.integrator, state_.integrator_text);
+    if (resume) integrator_->restore_state(state_.integrator);
     ProjectiveRunOutcome out;
     out.end_status = "completed";
     if ((settings_.warmup > 0 || settings_.warmup_until_steady) && !state_.warmed_up) {
         // The initial state (a packed bed at rest) is far from the slow manifold: run it
         // directly until the fast transients are gone before the first projection.
-        integrator_->save_state(state_.integrator, state_.integrator_text);
+        state_.integrator = integrator_->save_state();
         for (auto* o : observers_) o->between_steps(*this);
         warm_up();
         for (auto* o : observers_) o->warmup_done(*this);
     }
     state_.warmed_up = true;
     while (stepper_.time() < t_end_ - tol) {
-        integrator_->save_state(state_.integrator, state_.integrator_text);
+        state_.integrator = integrator_->save_state();
         for (auto* o : observers_) o->between_steps(*this);
         // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
         // plus one burst (or one whose period bursts were extended) can be left with less.
@@ -141,12 +141,15 @@ void ProjectiveRun::warm_up() {
     }
     const double length = std::min(std::max(settings_.warmup, burst), room);
     if (length > 0) stepper_.run(length, w);
-    // On until the phase signal's drift over the last burst length is within its noise.
+    // On until the phase signal's drift over the last burst length is within its noise, or
+    // slower than warmup_drift_rate = steady_drift_rate(cpi.tolerance, burst) (adaptive; a
+    // derivation, see cpi_settings.hpp), i.e. cpi.tolerance per burst.
     const double window = settings_.window();
     const double t_limit = std::min(t0 + settings_.warmup + settings_.warmup_max, t0 + room);
     const double tol = time_tolerance(t_end_);
     while (true) {
-        const PhaseDrift d = phase_drift(w, stepper_.time() - burst - tol, settings_.drift_rate);
+        const PhaseDrift d =
+            phase_drift(w, stepper_.time() - burst - tol, settings_.warmup_drift_rate);
         if (!d.measured) {
             log::warn(
                 "warm-up: {:.4g} time units; the drift of the phase signal cannot be measured (no "

@@ -58,10 +58,9 @@ struct ProjectiveRunState {
     /// The warm-up is done (false in a state saved before or during it: a run resumed from
     /// there does the warm-up from the start).
     bool warmed_up = false;
-    /// The integrator's own state (ProjectiveIntegrator::save_state(); empty for the
+    /// The integrator's own state (ProjectiveIntegrator::save_state(); nullopt for the
     /// single-step integrators).
-    std::vector<double> integrator;
-    std::string integrator_text;
+    IntegratorState integrator;
 };
 
 /// A coarse variable the loop can integrate: how projected vectors are repaired, how the

@@ -1,0 +1,61 @@
+#pragma once
+/// \file
+/// MultistepState: everything the multistep integrator carries from one step to the next, by
+/// name — what a checkpoint stores (each field a named HDF5 dataset under /driver/integrator,
+/// checkpoint format 4: mpi_driver/checkpoint/checkpoint_format.hpp) and what
+/// ProjectiveIntegrator::save_state/restore_state exchange. Checkpoint formats 2 and 3 stored it
+/// as a positional vector and three lines of text (from_layout() reads them).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/projective/multistep_projection.hpp"
+#include "coarse/equation_free/projective/stability_monitor.hpp"
+#include "coarse/equation_free/projective/step_size_controller.hpp"
+
+namespace efdem::coarse {
+
+/// The multistep integrator's totals since the start of the run.
+struct MultistepTotals {
+    long attempts = 0;  ///< jumps tried
+    long accepted = 0;  ///< jumps kept
+    long rejected = 0;  ///< jumps redone
+    long direct = 0;    ///< bursts run without a jump because the tolerance allowed < dt_min
+    double dt_taken = 0, dt_tolerance = 0, dt_tolerance_2r = 0,
+           dt_tolerance_4r = 0;              ///< sums over kept jumps
+    double statistical = 0, truncation = 0;  ///< sums over kept jumps
+};
+
+struct MultistepState {
+    double t_end = 0.0;              ///< end of the last accepted burst
+    Eigen::VectorXd x_end;           ///< X there (empty before the first burst)
+    std::vector<SlopeNode> history;  ///< accepted slopes, oldest first (at most steps + 1)
+    /// history.front() is the first burst's earlier window: for the curvature, not projected
+    /// from.
+    bool curvature_only_front = false;
+    DecayRateEstimate decay;            ///< from the last accepted burst
+    DtLimit hold_kind = DtLimit::none;  ///< fast_transient or in_phase_wave: no jump from it
+    std::string hold;                   ///< why (empty: a jump may start there)
+    StepSizeState controller;           ///< last kept DT, the rejection cap, rejections in a row
+    MultistepTotals totals;
+
+    /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
+    bool operator==(const MultistepState& other) const;
+
+    /**
+     * \brief The state from the positional layout checkpoint formats 2 and 3 stored
+     *        (/driver/integrator, /driver/integrator_text), layouts 2 and 3 (3 added
+     *        curvature_only_front as the last value).
+     *
+     * reals: [layout, n, m, t_end, dt_last, dt_cap, consecutive_rejections, decay ok, rate,
+     * ratio, delay], x_end (m), n x (tau, slope (m), se (m)), totals (attempts, accepted,
+     * rejected, direct, dt_taken, dt_tolerance, dt_tolerance_2r, dt_tolerance_4r, statistical,
+     * truncation), layout 3: curvature_only_front. text: decay message, hold kind, hold (three
+     * lines). Throws std::invalid_argument on a malformed layout.
+     */
+    static MultistepState from_layout(const std::vector<double>& reals, const std::string& text);
+};
+
+}  // namespace efdem::coarse
