@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
-#include "mpi_driver/ensemble/mpi_broadcast.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 
 namespace efdem::mpi_driver {
 

@@ -1,4 +1,4 @@
-#include "mpi_driver/ensemble/mpi_session.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 
 #include <cstdio>
 #include <cstdlib>
