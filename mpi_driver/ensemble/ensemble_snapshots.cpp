@@ -45,13 +45,13 @@ EnsembleSnapshot EnsembleSnapshots::go_back() {
     return out;
 }
 
-void EnsembleSnapshots::mark(EnsembleSnapshot snapshot) {
+void EnsembleSnapshots::set_resume_point(EnsembleSnapshot snapshot) {
     EFDEM_EXPECTS(!kept_);
     resume_ = std::move(snapshot);
     release();
 }
 
-void EnsembleSnapshots::back_to_resume() {
+void EnsembleSnapshots::back_to_resume_point() {
     EFDEM_EXPECTS(resume_.has_value());
     kept_.reset();
     held_.clear();

@@ -10,7 +10,7 @@
 ///                 jump; return_to_kept_state() goes back to it when the jump is rejected,
 ///                 confirm_kept_state() drops it when the jump is kept.
 ///   resume point  cpi, stops and failures. mark_resume_point() takes it between coarse steps
-///                 (every mark replaces the last; a rebuild after a failure takes it again);
+///                 (each one replaces the last; a rebuild after a failure takes it again);
 ///                 checkpoint_resume_point() writes it when a signal stops the run;
 ///                 rebuild_after_failure() goes back to it.
 ///
@@ -23,18 +23,22 @@
 ///     failures survived
 ///   stepper: lifting streams, warm starts of     root    yes          yes
 ///     the observables (meaningless elsewhere)
-///   last_sample, coarse (its coarse vector)      root    yes          yes
+///   last_sample, coarse (its coarse vector)      root    yes (*)      yes
 ///   driver: the run loop's state                 root    no (empty)   yes
 ///
+/// (*) return_to_kept_state() puts the last sample back but keeps the coarse vector of the
+/// rejected burst's last sample, as the stepper did before this class existed (it matters only
+/// to a rebuild that follows a resume point taken right after a rejection).
+///
 /// Phases: a kept state exists from keep_state() to confirm_kept_state() or
-/// return_to_kept_state(), always inside one coarse step: there is none at a mark, a checkpoint
-/// or a rebuild. A resume point exists from the first mark of a cpi run to its end (a direct run
-/// has none).
+/// return_to_kept_state(), always inside one coarse step: there is none at a new resume point, a
+/// checkpoint or a rebuild. A resume point exists from the first one of a cpi run to its end (a
+/// direct run has none).
 ///
 /// Samples: while a snapshot exists, a sample taken after it may still be taken back. The root
 /// holds such samples (one list, in the order taken) and gives them to the sink when they can
-/// no longer be: at the next mark, at confirm_kept_state() when there is no resume point, or
-/// before a checkpoint or the end of the run (release()); return_to_kept_state() drops those
+/// no longer be: at the next resume point, at confirm_kept_state() when there is no resume point,
+/// or before a checkpoint or the end of the run (release()); return_to_kept_state() drops those
 /// taken after the kept state, rebuild_after_failure() all of them.
 
 #include <optional>
@@ -79,11 +83,11 @@ class EnsembleSnapshots {
     void keep(EnsembleSnapshot snapshot);
     void confirm();
     EnsembleSnapshot go_back();
-    /// The resume point: mark() replaces it (no kept state) and releases every held sample;
-    /// back_to_resume() drops the kept state and every held sample (the caller restores
-    /// get(Use::resume)).
-    void mark(EnsembleSnapshot snapshot);
-    void back_to_resume();
+    /// The resume point: set_resume_point() replaces it (no kept state) and releases every held
+    /// sample; back_to_resume_point() drops the kept state and every held sample (the caller
+    /// restores get(Use::resume)).
+    void set_resume_point(EnsembleSnapshot snapshot);
+    void back_to_resume_point();
 
     /// Root: a sample, to the sink at once when no snapshot can take it back, else held.
     void record(const SampleRecord& sample);

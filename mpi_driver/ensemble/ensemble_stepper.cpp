@@ -130,8 +130,8 @@ void EnsembleStepper::set_parameter(double value) {
 
 void EnsembleStepper::mark_resume_point(const DriverState& driver) {
     EFDEM_EXPECTS(!snapshots_.has(Use::kept));
-    broadcast({Command::mark, 0.0, false});
-    do_mark(driver);
+    broadcast({Command::resume_point, 0.0, false});
+    do_mark_resume_point(driver);
 }
 
 std::filesystem::path EnsembleStepper::checkpoint(long sequence, const DriverState& driver) {
@@ -148,7 +148,7 @@ std::filesystem::path EnsembleStepper::checkpoint_resume_point() {
     EFDEM_EXPECTS(writer_ != nullptr && has_resume_point());
     const EnsembleSnapshot& resume = snapshots_.get(Use::resume);
     const long sequence = resume.driver.coarse_steps;
-    broadcast({Command::checkpoint_mark, static_cast<double>(sequence), false});
+    broadcast({Command::checkpoint_resume_point, static_cast<double>(sequence), false});
     CheckpointHeader header;
     header.stepper = resume.stepper;
     header.driver = resume.driver;
@@ -189,10 +189,10 @@ void EnsembleStepper::serve() {
             case Command::confirm:
                 do_confirm();
                 break;
-            case Command::mark:
-                do_mark(DriverState{});
+            case Command::resume_point:
+                do_mark_resume_point(DriverState{});
                 break;
-            case Command::checkpoint_mark:
+            case Command::checkpoint_resume_point:
                 do_checkpoint(std::lround(m.value), nullptr, true);
                 break;
             case Command::rebuild:
@@ -341,10 +341,10 @@ void EnsembleStepper::do_confirm() {
     snapshots_.confirm();
 }
 
-void EnsembleStepper::do_mark(const DriverState& driver) {
+void EnsembleStepper::do_mark_resume_point(const DriverState& driver) {
     EnsembleSnapshot s = snapshot("between coarse steps");
     s.driver = driver;
-    snapshots_.mark(std::move(s));
+    snapshots_.set_resume_point(std::move(s));
 }
 
 void EnsembleStepper::do_set_parameter(double value) {
@@ -357,7 +357,7 @@ void EnsembleStepper::do_rebuild(bool top_half) {
     // 1. Every realization back to where the interrupted coarse step began; the samples since
     //    then are dropped.
     const EnsembleSnapshot& resume = snapshots_.get(Use::resume);
-    snapshots_.back_to_resume();
+    snapshots_.back_to_resume_point();
     return_to(resume, "the resume point after a failure", true);
     sampler_.set_last(resume.last_sample, resume.coarse);
     // 2. Drop, or rebuild from the next healthy realization (before the first coarse step, at
@@ -385,7 +385,7 @@ void EnsembleStepper::do_rebuild(bool top_half) {
     // 4. The rebuilt ensemble is the new resume point (a stop now checkpoints it), with the
     //    loop's state of the old one.
     const DriverState driver = resume.driver;
-    do_mark(driver);
+    do_mark_resume_point(driver);
 }
 
 StepperState EnsembleStepper::saved_state() const {

@@ -36,7 +36,7 @@
 ///
 /// Resume points (cpi): mark_resume_point() keeps every realization's state and the loop's state
 /// in memory between coarse steps and holds the samples taken after it back from the sink
-/// until the next mark; checkpoint_resume_point() writes that state as a checkpoint. So a stop
+/// until the next one; checkpoint_resume_point() writes that state as a checkpoint. So a stop
 /// in the middle of a coarse step is checkpointed where the step began, and the restarted run
 /// redoes the step exactly as the uninterrupted run did it.
 
@@ -212,8 +212,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
         keep = 5,
         go_back = 6,
         confirm = 7,
-        mark = 8,
-        checkpoint_mark = 9,
+        resume_point = 8,
+        checkpoint_resume_point = 9,
         rebuild = 10,
         set_parameter = 11,
         lift_members = 12  ///< a lift that moves each realization by the same increment
@@ -239,7 +239,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     void do_go_back();
     void do_confirm();
     /// `driver`: the loop's state (root; the workers keep none).
-    void do_mark(const DriverState& driver);
+    void do_mark_resume_point(const DriverState& driver);
     void do_rebuild(bool top_half);
     void do_set_parameter(double value);
 

@@ -333,19 +333,19 @@ TEST_CASE("samples are held back from the sink while a snapshot may take them ba
     snapshots.confirm();  // kept, no resume point: sample 2 goes out
     EnsembleSnapshot resume;
     resume.time = 2.0;
-    snapshots.mark(resume);
+    snapshots.set_resume_point(resume);
     snapshots.record(sample(3));  // after the resume point: held
     snapshots.keep({});
     snapshots.record(sample(4));
     snapshots.release();  // what the kept state cannot take back: sample 3
     snapshots.go_back();  // sample 4 dropped
     snapshots.record(sample(5));
-    snapshots.back_to_resume();  // a failure: back to the resume point, sample 5 dropped
+    snapshots.back_to_resume_point();  // a failure: back to the resume point, sample 5 dropped
     CHECK(snapshots.has(EnsembleSnapshots::Use::resume));
     CHECK(!snapshots.has(EnsembleSnapshots::Use::kept));
     CHECK(snapshots.get(EnsembleSnapshots::Use::resume).time == 2.0);
     snapshots.record(sample(6));
-    snapshots.mark(resume);  // the next mark: sample 6 goes out
+    snapshots.set_resume_point(resume);  // the next mark: sample 6 goes out
     if (world.is_root())
         CHECK(times() == std::vector<double>{0, 2, 3, 6});
     else
