@@ -201,7 +201,6 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     Overhead overhead() const {
         return {sampler_.seconds(), lifting_.seconds(), sampler_.count(), lifting_.count()};
     }
-    Realizations& local() { return local_; }
 
   private:
     enum class Command : int {
