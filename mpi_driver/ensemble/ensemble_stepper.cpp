@@ -239,7 +239,9 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
         if (failures_.pending()) return s;  // cpi: the step is redone from its resume point
         if (const SampleRecord* rec =
                 sampler_.take(local_, failures_.active(), time(), top_half, out)) {
+            const double start = MPI_Wtime();
             snapshots_.record(*rec);
+            record_seconds_ += MPI_Wtime() - start;  // recording counts as restriction
             if (progress_) progress_->update(rec->time, particle_steps_, "");
         }
         ++samples_taken_;

@@ -199,7 +199,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
         long lifts = 0;
     };
     Overhead overhead() const {
-        return {sampler_.seconds(), lifting_.seconds(), sampler_.count(), lifting_.count()};
+        return {sampler_.seconds() + record_seconds_, lifting_.seconds(), sampler_.count(),
+                lifting_.count()};
     }
 
   private:
@@ -268,7 +269,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     double particle_steps_ = 0;
     double micro_time_ = 0;
     double total_particles_ = 0;
-    int interrupted_ = 0;  ///< every rank: the agreed stop signal
+    double record_seconds_ = 0;  ///< root: wall time giving samples to the sink
+    int interrupted_ = 0;        ///< every rank: the agreed stop signal
     int finish_code_ = 0;
     bool injected_fired_ = false;  ///< the injected failure happens once
 };
