@@ -18,8 +18,8 @@
 #include "core/rng.hpp"
 #include "dem/system.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
-#include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/parallel/ensemble_layout.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;

@@ -46,6 +46,11 @@ void write_rank_error(const std::string& message) {
     std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", g_rank, g_n_ranks, message.c_str());
     std::fflush(stderr);
 }
+void write_rank_warn(const std::string& message) {
+    std::fprintf(stderr, "efdem: [rank %d of %d] warning: %s\n", g_rank, g_n_ranks,
+                 message.c_str());
+    std::fflush(stderr);
+}
 void write_output(const std::string& text) {
     std::fputs(text.c_str(), stdout);
     std::fflush(stdout);

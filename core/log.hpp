@@ -6,8 +6,8 @@
 /// * warn(): printed by whichever rank calls it, prefixed with the rank when there are several
 ///   (to stderr), so that a warning seen on one rank only is not lost.
 /// * error(): the final message of a failing run (stderr), always printed.
-/// * rank_error(): a failure only this rank sees (a realization's), "efdem: [rank r of n]
-///   error: ..." on stderr, always printed, whatever the rank count.
+/// * rank_error(), rank_warn(): what only this rank sees (a realization's failure), "efdem:
+///   [rank r of n] error: ..." (warning: ...) on stderr, always printed, whatever the rank count.
 /// * notice(): the final message of a run that ends without failing but unfinished (a stop
 ///   signal: where it was saved, how to continue), "efdem: ..." on stderr, always printed.
 /// * output(): what a command prints as its answer (--help, --list-effects, --check, ...):
@@ -33,6 +33,7 @@ void write_error(const std::string& message);
 void write_debug(const std::string& message);
 void write_notice(const std::string& message);
 void write_rank_error(const std::string& message);
+void write_rank_warn(const std::string& message);
 void write_output(const std::string& message);
 
 template <class... Args>
@@ -51,6 +52,10 @@ void warn(fmt::format_string<Args...> f, Args&&... args) {
 template <class... Args>
 void rank_error(fmt::format_string<Args...> f, Args&&... args) {
     write_rank_error(fmt::format(f, std::forward<Args>(args)...));
+}
+template <class... Args>
+void rank_warn(fmt::format_string<Args...> f, Args&&... args) {
+    write_rank_warn(fmt::format(f, std::forward<Args>(args)...));
 }
 template <class... Args>
 void notice(fmt::format_string<Args...> f, Args&&... args) {

@@ -11,13 +11,15 @@
 #       steady/          -> the seam, estimators/, krylov/ (not projective/)
 #     demixing/          -> no coarse/dem_adapters/
 #   coarse/dem_adapters  -> coarse, dem, core       (no MPI)
-#   mpi_driver           -> everything, in rooms:
-#     output/            -> no ensemble/, checkpoint/, run/; no mpi.h (HDF5 brings it)
-#     ensemble/          -> no run/; of checkpoint/ only the format headers
-#                           (checkpoint_format.hpp, realization_state.hpp); no HDF5
-#     checkpoint/        -> no run/; its format files (checkpoint_format, realization_state,
-#                           checkpoint_settings) no HDF5, no MPI, no output/, ensemble/
-#     run/, main.cpp     -> no HDF5 header of their own (HDF5 only in output/, checkpoint/)
+#   mpi_driver           -> everything, in rooms (one CMake target each; mpi_driver/CMakeLists.txt):
+#     parallel/          -> no other mpi_driver/ room; no HDF5 (MPI plumbing only)
+#     checkpoint_data/   -> no other mpi_driver/ room; no MPI, no HDF5 (data only)
+#     output/            -> no other mpi_driver/ room; no mpi.h (HDF5 brings it)
+#     ensemble/          -> parallel/, checkpoint_data/, output/ but not its recorders (samples
+#                           leave through output/sample_sink.hpp); no checkpoint/, run/, HDF5
+#     checkpoint/        -> parallel/, checkpoint_data/, output/; no ensemble/, run/
+#     run/, main.cpp     -> everything above; no HDF5 header of their own (HDF5 only in
+#                           output/, checkpoint/)
 #
 # and, between the rooms of dem/ (one target; dem/CMakeLists.txt):
 #
@@ -108,14 +110,16 @@ check_tree() {
     forbid $ef/krylov "$ef/(projective|steady|estimators)/" "projective/, steady/ or estimators/ (krylov stands on the seam)"
     forbid $ef/projective "$ef/steady/" "$ef/steady/ (the two methods know nothing of each other)"
     forbid $ef/steady "$ef/projective/" "$ef/projective/ (the two methods know nothing of each other)"
-    forbid mpi_driver/output 'mpi_driver/(ensemble|checkpoint|run)/|mpi\.h' \
-        "mpi_driver/ensemble/, checkpoint/, run/ or MPI (recorders only record)"
-    forbid mpi_driver/ensemble 'mpi_driver/run/|mpi_driver/checkpoint/(checkpoint_writer|checkpoint_reader|checkpoint_settings|restart_check|restart_loader)|hdf5\.h|H5[A-Za-z_]*\.h' \
-        "mpi_driver/run/, HDF5 or the checkpoint I/O (only checkpoint_format.hpp and realization_state.hpp)"
-    forbid mpi_driver/checkpoint 'mpi_driver/run/' "mpi_driver/run/"
-    forbid_files mpi_driver '^mpi_driver/checkpoint/(checkpoint_format|realization_state|checkpoint_settings)\.' \
-        'hdf5\.h|H5[A-Za-z_]*\.h|mpi\.h|mpi_driver/(ensemble|output|run)/' \
-        "the checkpoint format files (checkpoint_format, realization_state, checkpoint_settings) are data only: no HDF5, MPI, ensemble/, output/ or run/"
+    local md=mpi_driver
+    forbid $md/parallel "$md/(checkpoint_data|output|ensemble|checkpoint|run)/|hdf5\\.h|H5[A-Za-z_]*\\.h" \
+        "another mpi_driver/ room or HDF5 (MPI plumbing only)"
+    forbid $md/checkpoint_data "$md/(parallel|output|ensemble|checkpoint|run)/|mpi\\.h|hdf5\\.h|H5[A-Za-z_]*\\.h" \
+        "another mpi_driver/ room, MPI or HDF5 (what a checkpoint holds: data only)"
+    forbid $md/output "$md/(parallel|checkpoint_data|ensemble|checkpoint|run)/|mpi\\.h" \
+        "another mpi_driver/ room or MPI (recorders only record)"
+    forbid $md/ensemble "$md/(checkpoint|run)/|$md/output/(run_recorder|recorder_list|hdf5_recorder|csv_recorder|h5_file|run_file_schema)\\.|hdf5\\.h|H5[A-Za-z_]*\\.h" \
+        "mpi_driver/checkpoint/ (I/O), run/, the recorders (samples leave through output/sample_sink.hpp) or HDF5"
+    forbid $md/checkpoint "$md/(ensemble|run)/" "mpi_driver/ensemble/ or run/"
     forbid_files mpi_driver '^mpi_driver/(run/|main\.cpp$)' 'hdf5\.h|H5[A-Za-z_]*\.h' \
         "mpi_driver/run/ and main.cpp include no HDF5 header (HDF5 only in output/ and checkpoint/)"
     return $status
@@ -126,7 +130,7 @@ if [ "${1:-}" = "--self-test" ]; then
     trap 'rm -rf "$scratch"' EXIT
     mkdir -p "$scratch"/{core,dem/{contact,gas,body_forces,beds,settling,io},coarse/{dem_adapters,demixing}} \
              "$scratch"/coarse/equation_free/{projective,estimators,steady,krylov} \
-             "$scratch"/mpi_driver/{output,ensemble,checkpoint,run}
+             "$scratch"/mpi_driver/{parallel,checkpoint_data,output,ensemble,checkpoint,run}
     echo '#include "core/vec3.hpp"' > "$scratch/dem/ok.cpp"
     # What the rooms of dem/ may include (the exceptions of the rules must not be flagged).
     printf '#include "dem/%s"\n' realization_builder.hpp settling/settling.hpp beds/bed_builder.hpp \
@@ -150,13 +154,20 @@ if [ "${1:-}" = "--self-test" ]; then
         krylov/gmres.hpp > "$scratch/coarse/equation_free/steady/ok.cpp"
     printf '#include "coarse/equation_free/%s"\n' coarse_stepper.hpp estimators/phase_drift.hpp \
         > "$scratch/coarse/equation_free/projective/ok.cpp"
-    printf '#include "%s"\n' mpi_driver/checkpoint/checkpoint_format.hpp mpi_driver/checkpoint/realization_state.hpp \
-        mpi_driver/output/run_recorder.hpp '<mpi.h>' > "$scratch/mpi_driver/ensemble/ok.cpp"
-    printf '#include %s\n' '<hdf5.h>' '"mpi_driver/ensemble/ensemble_layout.hpp"' '"mpi_driver/output/h5_file.hpp"' \
-        > "$scratch/mpi_driver/checkpoint/checkpoint_writer.cpp"
+    # What the rooms of mpi_driver/ may include.
+    printf '#include %s\n' '<mpi.h>' '"core/error.hpp"' '"mpi_driver/parallel/mpi_session.hpp"' \
+        > "$scratch/mpi_driver/parallel/ensemble_layout.cpp"
+    printf '#include "%s"\n' dem/contact/contact_history.hpp coarse/equation_free/projective/projective_run.hpp \
+        mpi_driver/checkpoint_data/realization_state.hpp > "$scratch/mpi_driver/checkpoint_data/checkpoint_format.cpp"
+    printf '#include "%s"\n' core/vec3.hpp mpi_driver/output/sample_sink.hpp > "$scratch/mpi_driver/output/csv_recorder.cpp"
+    printf '#include "%s"\n' mpi_driver/checkpoint_data/checkpoint_format.hpp mpi_driver/checkpoint_data/realization_state.hpp \
+        mpi_driver/output/sample_sink.hpp mpi_driver/output/progress.hpp mpi_driver/parallel/ensemble_layout.hpp \
+        '<mpi.h>' > "$scratch/mpi_driver/ensemble/ok.cpp"
+    printf '#include %s\n' '<hdf5.h>' '"mpi_driver/parallel/ensemble_layout.hpp"' '"mpi_driver/output/h5_file.hpp"' \
+        '"mpi_driver/checkpoint_data/checkpoint_format.hpp"' > "$scratch/mpi_driver/checkpoint/checkpoint_writer.cpp"
     echo '#include <hdf5.h>' > "$scratch/mpi_driver/output/h5_file.hpp"
     printf '#include "%s"\n' mpi_driver/checkpoint/checkpoint_writer.hpp mpi_driver/ensemble/ensemble_stepper.hpp \
-        > "$scratch/mpi_driver/run/driver.cpp"
+        mpi_driver/parallel/stop_signal.hpp mpi_driver/output/run_recorder.hpp > "$scratch/mpi_driver/run/driver.cpp"
     check_tree "$scratch" > /dev/null || { echo "self-test: a clean tree was flagged"; exit 1; }
     for bad in "dem/a.cpp:#include <mpi.h>" "dem/b.hpp:#include \"coarse/demixing/quantiles.hpp\"" \
                "coarse/c.cpp:#include \"dem/system.hpp\"" "coarse/d.hpp:  #  include <mpi.h>" \
@@ -179,13 +190,21 @@ if [ "${1:-}" = "--self-test" ]; then
                "coarse/equation_free/projective/n4.cpp:#include \"coarse/equation_free/steady/coarse_map.hpp\"" \
                "coarse/equation_free/steady/n5.cpp:#include \"coarse/equation_free/projective/projective_jump.hpp\"" \
                "mpi_driver/output/o.cpp:#include \"mpi_driver/ensemble/ensemble_stepper.hpp\"" \
+               "mpi_driver/output/o2.cpp:#include \"mpi_driver/parallel/ensemble_layout.hpp\"" \
                "mpi_driver/output/p.cpp:#include <mpi.h>" \
+               "mpi_driver/parallel/v.cpp:#include \"mpi_driver/ensemble/realization.hpp\"" \
+               "mpi_driver/parallel/w.cpp:#include \"mpi_driver/output/progress.hpp\"" \
+               "mpi_driver/parallel/w2.hpp:#include <hdf5.h>" \
                "mpi_driver/ensemble/q.cpp:#include <hdf5.h>" \
                "mpi_driver/ensemble/r.cpp:#include \"mpi_driver/checkpoint/checkpoint_writer.hpp\"" \
+               "mpi_driver/ensemble/r2.hpp:#include \"mpi_driver/output/run_recorder.hpp\"" \
                "mpi_driver/ensemble/s.cpp:#include \"mpi_driver/run/run_settings.hpp\"" \
                "mpi_driver/checkpoint/t.cpp:#include \"mpi_driver/run/driver.hpp\"" \
-               "mpi_driver/checkpoint/checkpoint_format.cpp:#include <H5Fpublic.h>" \
-               "mpi_driver/checkpoint/realization_state.hpp:#include \"mpi_driver/ensemble/realization.hpp\"" \
+               "mpi_driver/checkpoint/t2.cpp:#include \"mpi_driver/ensemble/ensemble_stepper.hpp\"" \
+               "mpi_driver/checkpoint_data/checkpoint_format.cpp:#include <H5Fpublic.h>" \
+               "mpi_driver/checkpoint_data/x.cpp:#include <mpi.h>" \
+               "mpi_driver/checkpoint_data/realization_state.hpp:#include \"mpi_driver/ensemble/realization.hpp\"" \
+               "mpi_driver/checkpoint_data/y.hpp:#include \"mpi_driver/parallel/ensemble_layout.hpp\"" \
                "mpi_driver/run/u.cpp:#include <hdf5.h>" \
                "mpi_driver/main.cpp:#include <hdf5.h>"; do
         file=${bad%%:*}; line=${bad#*:}

@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
 
 namespace efdem::mpi_driver {
 

@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
-#include "mpi_driver/checkpoint/checkpoint_settings.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
-#include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_settings.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
+#include "mpi_driver/parallel/ensemble_layout.hpp"
 
 namespace efdem::mpi_driver {
 

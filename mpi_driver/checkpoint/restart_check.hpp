@@ -12,7 +12,7 @@
 #include <string>
 
 #include "core/param_table.hpp"
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 
 namespace efdem::mpi_driver {
 

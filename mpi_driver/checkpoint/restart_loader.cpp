@@ -102,24 +102,4 @@ void restore_outputs(const CheckpointHeader& header, const std::filesystem::path
     }
 }
 
-Agreement restore_realizations(MPI_Comm comm, const RestartData& restart,
-                               std::vector<std::unique_ptr<Realization>>& local) {
-    int code = kExitOk;
-    std::string message;
-    try {
-        const auto& active = restart.header.stepper.active;
-        for (std::size_t j = 0; j < local.size(); ++j) {
-            const auto r = static_cast<std::size_t>(local[j]->index());
-            // A realization dropped after a failure stays as built: it is never advanced again.
-            if (!active.empty() && active[r] == 0) continue;
-            local[j]->restore_state(restart.local[j]);
-        }
-    } catch (const std::exception& e) {
-        code = kExitInputError;
-        message = fmt::format("{}: checkpoint does not fit the scene: {}", restart.path.string(),
-                              e.what());
-    }
-    return agree_on_failure(comm, code, message);
-}
-
 }  // namespace efdem::mpi_driver

@@ -10,11 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
-#include "mpi_driver/ensemble/mpi_broadcast.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
-#include "mpi_driver/ensemble/realization.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -29,13 +28,6 @@ struct RestartData {
 Agreement load_restart(const MpiComm& mpi, const std::filesystem::path& path,
                        const std::string& parameters, int per_rank, bool allow_physics_change,
                        RestartData& out);
-
-/// Collective: puts this rank's realizations into the checkpoint's states (a realization
-/// dropped after a failure stays as built: it is never advanced again). A state that does not
-/// fit the scene's realizations (another bed) is an input error: exit code 2, with the root's
-/// message naming the checkpoint.
-Agreement restore_realizations(MPI_Comm comm, const RestartData& restart,
-                               std::vector<std::unique_ptr<Realization>>& local);
 
 /// Root: puts the run's output files back as they were at the checkpoint, so that the
 /// recorders continue them (RuntimeFailure if a file cannot be written).

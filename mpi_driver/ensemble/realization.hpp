@@ -8,6 +8,7 @@
 /// LiftPayloads between ranks without knowing which.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,7 +18,7 @@
 #include "coarse/demixing/probability_grid.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
-#include "mpi_driver/checkpoint/realization_state.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -84,6 +85,9 @@ class Realization {
         throw RuntimeFailure("this realization type cannot be restored from a checkpoint");
     }
 };
+
+/// A rank's realizations, in global index order (EnsembleLayout: k per rank).
+using Realizations = std::vector<std::unique_ptr<Realization>>;
 
 /// Root side of lifting: a pure function of the target, the realization's report and its
 /// lifting stream, so the root can lift realizations it does not own.

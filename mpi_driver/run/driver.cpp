@@ -9,7 +9,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 
-#include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/parallel/stop_signal.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
 #include "mpi_driver/run/progress_observer.hpp"
 #include "mpi_driver/run/step_report_observer.hpp"

@@ -15,7 +15,7 @@
 #include <optional>
 
 #include "coarse/demixing/ensemble_observable.hpp"
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "mpi_driver/output/progress.hpp"
 #include "mpi_driver/output/run_recorder.hpp"

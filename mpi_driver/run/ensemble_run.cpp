@@ -14,10 +14,11 @@
 #include "core/version.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
-#include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "mpi_driver/output/csv_recorder.hpp"
 #include "mpi_driver/output/recorder_list.hpp"
+#include "mpi_driver/parallel/ensemble_layout.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/run/driver.hpp"
 #include "mpi_driver/run/run_end.hpp"
 #include "mpi_driver/run/run_observables.hpp"
@@ -29,6 +30,32 @@
 #endif
 
 namespace efdem::mpi_driver {
+
+namespace {
+/// Collective: puts this rank's realizations into the restart's states (a realization dropped
+/// after a failure stays as built: it is never advanced again); the stepper's own state is put
+/// back by EnsembleStepper::restore_state. A state that does not fit the scene's realizations
+/// (another bed) is an input error: exit code 2, with the root's message naming the checkpoint.
+Agreement restore_checkpointed_states(MPI_Comm comm, const RestartData& restart,
+                                      std::vector<std::unique_ptr<Realization>>& local) {
+    int code = kExitOk;
+    std::string message;
+    try {
+        const auto& active = restart.header.stepper.active;
+        for (std::size_t j = 0; j < local.size(); ++j) {
+            const auto r = static_cast<std::size_t>(local[j]->index());
+            // A realization dropped after a failure stays as built: it is never advanced again.
+            if (!active.empty() && active[r] == 0) continue;
+            local[j]->restore_state(restart.local[j]);
+        }
+    } catch (const std::exception& e) {
+        code = kExitInputError;
+        message = fmt::format("{}: checkpoint does not fit the scene: {}", restart.path.string(),
+                              e.what());
+    }
+    return agree_on_failure(comm, code, message);
+}
+}  // namespace
 
 int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettings& s,
                  std::vector<dem::System> systems, const RestartData* restart,
@@ -66,7 +93,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
     if (resume) {
-        const Agreement agreed = restore_realizations(mpi.comm(), *restart, local);
+        const Agreement agreed = restore_checkpointed_states(mpi.comm(), *restart, local);
         if (agreed.exit_code != kExitOk) {
             if (mpi.is_root()) log::error("{}", agreed.message);
             return agreed.exit_code;

@@ -11,7 +11,7 @@
 #include "core/param_table.hpp"
 #include "dem/system.hpp"
 #include "mpi_driver/checkpoint/restart_loader.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 #include "mpi_driver/run/setup.hpp"
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 
 namespace efdem::mpi_driver {
 

@@ -6,8 +6,8 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "mpi_driver/ensemble/stop_signal.hpp"
 #include "mpi_driver/output/progress.hpp"
+#include "mpi_driver/parallel/stop_signal.hpp"
 
 namespace efdem::mpi_driver {
 

@@ -9,8 +9,8 @@
 #include "core/param_table.hpp"
 #include "dem/beds/bed_observation.hpp"
 #include "dem/system.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 
 namespace efdem::mpi_driver {

@@ -4,7 +4,7 @@
 /// Each room reads its own keys and RunSettings gathers them: the coarse layer its cpi.* keys
 /// (coarse/equation_free/projective/cpi_settings.hpp; cpi.observable from the table of
 /// coarse/demixing/observable_table.hpp), the checkpoint room checkpoint.* and restart.*
-/// (mpi_driver/checkpoint/checkpoint_settings.hpp). Times are in sqrt(d_p/g); every time is
+/// (mpi_driver/checkpoint_data/checkpoint_settings.hpp). Times are in sqrt(d_p/g); every time is
 /// checked against the time step it must be a multiple of, so that samples fall exactly on
 /// DEM steps.
 ///
@@ -58,7 +58,7 @@
 #include "coarse/equation_free/steady/steady_run_settings.hpp"
 #include "core/param_table.hpp"
 #include "dem/scene.hpp"
-#include "mpi_driver/checkpoint/checkpoint_settings.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_settings.hpp"
 #include "mpi_driver/ensemble/failure_policy.hpp"
 #include "mpi_driver/ensemble/injected_failure.hpp"
 

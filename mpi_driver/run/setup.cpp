@@ -11,7 +11,7 @@
 #include "dem/realization_builder.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
-#include "mpi_driver/ensemble/scene_input.hpp"
+#include "mpi_driver/parallel/scene_input.hpp"
 #include "mpi_driver/run/output_guard.hpp"
 #include "mpi_driver/run/settling_progress.hpp"
 #if EFDEM_HAVE_HDF5

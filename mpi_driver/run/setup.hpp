@@ -12,9 +12,9 @@
 
 #include "core/param_table.hpp"
 #include "dem/system.hpp"
-#include "mpi_driver/ensemble/mpi_broadcast.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 #include "mpi_driver/run/run_options.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 

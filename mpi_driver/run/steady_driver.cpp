@@ -7,7 +7,7 @@
 #include "coarse/demixing/icdf_gap_coordinates.hpp"
 #include "coarse/equation_free/steady/steady_run.hpp"
 #include "core/log.hpp"
-#include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/parallel/stop_signal.hpp"
 #include "mpi_driver/run/driver.hpp"
 
 namespace efdem::mpi_driver {

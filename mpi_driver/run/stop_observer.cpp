@@ -1,6 +1,6 @@
 #include "mpi_driver/run/stop_observer.hpp"
 
-#include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/parallel/stop_signal.hpp"
 
 namespace efdem::mpi_driver {
 

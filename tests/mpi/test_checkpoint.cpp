@@ -8,8 +8,8 @@
 #include "core/error.hpp"
 #include "core/param_table.hpp"
 #include "dem/realization_builder.hpp"
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
 
 using namespace efdem;

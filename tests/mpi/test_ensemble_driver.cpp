@@ -8,8 +8,8 @@
 
 #include "coarse/demixing/ensemble_observable.hpp"
 #include "coarse/equation_free/projective/projective_forward_euler.hpp"
-#include "mpi_driver/ensemble/ensemble_layout.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/parallel/ensemble_layout.hpp"
 #include "mpi_driver/run/driver.hpp"
 #include "tests/mpi/toy_realization.hpp"
 

@@ -2,7 +2,9 @@
 // A linear toy micro-model for the ensemble driver: x' = A x integrated by forward Euler with
 // step h; it reports its state as its "ICDF" and is lifted by setting its state to the target.
 // Through EnsembleStepper it exercises the whole driver path (commands, gathers, averages,
-// lifts, scatters) with an exactly known coarse dynamics.
+// lifts, scatters) with an exactly known coarse dynamics. Its state (x, t, steps) is saved and
+// restored exactly (one Vec3 (x_i, 0, 0) per component), so the kept state, the resume point and
+// a rebuild from a donor work on it as on a DEM realization.
 #include <Eigen/Core>
 
 #include "mpi_driver/ensemble/realization.hpp"
@@ -23,6 +25,7 @@ class ToyRealization final : public mpi_driver::Realization {
             x_ += h_ * (a_ * x_);
             t_ += h_;
         }
+        steps_ += steps;
     }
     mpi_driver::Observation observe(const coarse::ProbabilityGrid&, bool) const override {
         mpi_driver::Observation o;
@@ -42,7 +45,22 @@ class ToyRealization final : public mpi_driver::Realization {
         x_ = Eigen::Map<const Eigen::VectorXd>(p.reals.data(),
                                                static_cast<Eigen::Index>(p.reals.size()));
     }
+    mpi_driver::RealizationState save_state() const override {
+        mpi_driver::RealizationState s;
+        s.index = index_;
+        s.time = t_;
+        s.step = steps_;
+        for (Eigen::Index i = 0; i < x_.size(); ++i) s.x.push_back(Vec3{x_[i], 0.0, 0.0});
+        return s;
+    }
+    void restore_state(const mpi_driver::RealizationState& s) override {
+        x_.resize(static_cast<Eigen::Index>(s.x.size()));
+        for (std::size_t i = 0; i < s.x.size(); ++i) x_[static_cast<Eigen::Index>(i)] = s.x[i].x;
+        t_ = s.time;
+        steps_ = s.step;
+    }
     const Eigen::VectorXd& state() const { return x_; }
+    long steps() const { return steps_; }
 
   private:
     long index_;
@@ -50,6 +68,7 @@ class ToyRealization final : public mpi_driver::Realization {
     Eigen::VectorXd x_;
     double h_;
     double t_ = 0;
+    long steps_ = 0;
 };
 
 /// Lifting of the toy: the state becomes the target exactly.

@@ -2,7 +2,7 @@
 /// \file
 /// MultistepState: everything the multistep integrator carries from one step to the next, by
 /// name — what a checkpoint stores (each field a named HDF5 dataset under /driver/integrator,
-/// checkpoint format 4: mpi_driver/checkpoint/checkpoint_format.hpp) and what
+/// checkpoint format 4: mpi_driver/checkpoint_data/checkpoint_format.hpp) and what
 /// ProjectiveIntegrator::save_state/restore_state exchange. Checkpoint formats 2 and 3 stored it
 /// as a positional vector and three lines of text (from_layout() reads them).
 

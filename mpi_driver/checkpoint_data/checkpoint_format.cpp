@@ -1,10 +1,10 @@
-#include "mpi_driver/checkpoint/checkpoint_format.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 
 #include <cctype>
 
 #include <fmt/format.h>
 
-#include "mpi_driver/checkpoint/realization_state.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
 
 namespace efdem::mpi_driver {
 

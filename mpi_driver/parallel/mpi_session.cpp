@@ -1,11 +1,11 @@
-#include "mpi_driver/ensemble/mpi_session.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 
-#include <cstdio>
 #include <cstdlib>
 
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -15,8 +15,7 @@ MpiComm::MpiComm(MPI_Comm comm) : comm_(comm) {
 }
 
 void MpiComm::abort(const std::string& message, int exit_code) const {
-    std::fprintf(stderr, "efdem: [rank %d of %d] error: %s\n", rank_, size_, message.c_str());
-    std::fflush(stderr);
+    log::rank_error("{}", message);
     MPI_Abort(comm_, exit_code);
     std::exit(exit_code);  // not reached
 }
@@ -26,6 +25,8 @@ MpiSession::MpiSession(int* argc, char*** argv) {
     // A failing MPI call ends the job (the default for MPI_COMM_WORLD, made explicit).
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_ARE_FATAL);
     world_.emplace(MPI_COMM_WORLD);
+    // Messages name this rank from the start (the driver may change the level later).
+    log::configure(world_->rank(), world_->size(), log::level());
 }
 
 MpiSession::~MpiSession() {

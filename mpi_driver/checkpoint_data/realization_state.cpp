@@ -1,4 +1,4 @@
-#include "mpi_driver/checkpoint/realization_state.hpp"
+#include "mpi_driver/checkpoint_data/realization_state.hpp"
 
 #include <cstring>
 #include <type_traits>

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/param_table.hpp"
-#include "mpi_driver/ensemble/mpi_session.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 
 namespace efdem::mpi_driver {
 

@@ -1,4 +1,4 @@
-#include "mpi_driver/ensemble/stop_signal.hpp"
+#include "mpi_driver/parallel/stop_signal.hpp"
 
 #include <unistd.h>
 #include <csignal>

@@ -12,7 +12,7 @@
 
 #include <Eigen/Core>
 
-#include "mpi_driver/ensemble/mpi_session.hpp"
+#include "mpi_driver/parallel/mpi_session.hpp"
 
 namespace efdem::mpi_driver {
 

@@ -1,8 +1,8 @@
-#include "mpi_driver/ensemble/scene_input.hpp"
+#include "mpi_driver/parallel/scene_input.hpp"
 
 #include <filesystem>
 
-#include "mpi_driver/ensemble/mpi_broadcast.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
 
 namespace efdem::mpi_driver {
 

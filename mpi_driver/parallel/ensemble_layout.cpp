@@ -1,4 +1,4 @@
-#include "mpi_driver/ensemble/ensemble_layout.hpp"
+#include "mpi_driver/parallel/ensemble_layout.hpp"
 
 #include <cstdint>
 #include <numeric>

@@ -1,4 +1,4 @@
-#include "mpi_driver/checkpoint/checkpoint_settings.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_settings.hpp"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "mpi_driver/ensemble/mpi_broadcast.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
 
 #include <vector>
 

@@ -1,0 +1,154 @@
+#include "mpi_driver/ensemble/ensemble_sampler.hpp"
+
+#include <limits>
+
+#include <mpi.h>
+
+#include "core/contracts.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+/// The rows of `all` listed in `rows` (all rows when every realization is in the ensemble).
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Index>& rows) {
+    if (all.size() == 0 || static_cast<Eigen::Index>(rows.size()) == all.rows()) return all;
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), all.cols());
+    for (std::size_t k = 0; k < rows.size(); ++k)
+        out.row(static_cast<Eigen::Index>(k)) = all.row(rows[k]);
+    return out;
+}
+
+/// Rows of packed dem::BedObservation, as the recorders see them.
+BedRecord bed_record(const Eigen::MatrixXd& packed, const dem::BedObservationSettings& settings) {
+    const Eigen::Index n = packed.rows();
+    BedRecord b;
+    b.pressure_drop.resize(n);
+    b.pressure_drop_ratio.resize(n);
+    b.height.resize(n);
+    b.mixing_index.resize(n);
+    b.species_height.resize(n, static_cast<Eigen::Index>(settings.species));
+    b.solid_fraction.resize(n, static_cast<Eigen::Index>(settings.profile_slabs));
+    for (Eigen::Index r = 0; r < n; ++r) {
+        const Eigen::VectorXd row = packed.row(r).transpose();
+        const dem::BedObservation o = dem::BedObservation::unpack(
+            {row.data(), static_cast<std::size_t>(row.size())}, settings);
+        b.pressure_drop[r] = o.pressure_drop;
+        b.pressure_drop_ratio[r] = o.pressure_drop_ratio;
+        b.height[r] = o.height;
+        b.mixing_index[r] = o.mixing_index;
+        b.species_height.row(r) =
+            Eigen::Map<const Eigen::RowVectorXd>(o.species_height.data(), b.species_height.cols());
+        b.solid_fraction.row(r) =
+            Eigen::Map<const Eigen::RowVectorXd>(o.solid_fraction.data(), b.solid_fraction.cols());
+    }
+    return b;
+}
+}  // namespace
+
+EnsembleSampler::EnsembleSampler(const EnsembleLayout& layout, const SamplingSettings& settings,
+                                 coarse::EnsembleObservable& observable)
+    : layout_(layout), settings_(settings), observable_(&observable), grid_(settings.quantiles) {}
+
+bool EnsembleSampler::needs_top_half() const {
+    return observable_->needs_top_half() ||
+           (settings_.recorded && settings_.recorded->needs_top_half());
+}
+
+const SampleRecord* EnsembleSampler::take(const Realizations& local,
+                                          const std::vector<char>& active, double time, bool top,
+                                          coarse::BurstSamples* out) {
+    EFDEM_EXPECTS(static_cast<int>(active.size()) == layout_.size());
+    const double start = MPI_Wtime();
+    const auto m = static_cast<Eigen::Index>(grid_.values().size());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const auto bed_width =
+        settings_.bed ? static_cast<Eigen::Index>(dem::BedObservation::packed_size(*settings_.bed))
+                      : 0;
+    std::vector<Eigen::VectorXd> icdf, top_icdf, scalars, bed;
+    for (const auto& r : local) {
+        if (!active[static_cast<std::size_t>(r->index())]) {
+            // Dropped: a row of NaN in the record, not in the means.
+            icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            scalars.push_back(Eigen::Vector4d::Constant(nan));
+            if (bed_width > 0) bed.push_back(Eigen::VectorXd::Constant(bed_width, nan));
+            continue;
+        }
+        Observation o = r->observe(grid_, top);
+        icdf.push_back(std::move(o.icdf));
+        if (top) top_icdf.push_back(std::move(o.top));
+        scalars.push_back(Eigen::Vector4d(o.com, o.z_min, o.z_max, o.mean_height));
+        if (bed_width > 0) {
+            EFDEM_ASSERT(static_cast<Eigen::Index>(o.bed.size()) == bed_width);
+            bed.push_back(Eigen::Map<const Eigen::VectorXd>(o.bed.data(), bed_width));
+        }
+    }
+    const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
+    const Eigen::MatrixXd all_top_rows = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+    const Eigen::MatrixXd all_scalar_rows = layout_.gather_rows(scalars);
+    const Eigen::MatrixXd all_bed_rows =
+        bed_width > 0 ? layout_.gather_rows(bed) : Eigen::MatrixXd();
+    if (!layout_.is_root()) {
+        seconds_ += MPI_Wtime() - start;
+        ++count_;
+        return nullptr;
+    }
+    std::vector<Eigen::Index> in;
+    for (std::size_t r = 0; r < active.size(); ++r)
+        if (active[r]) in.push_back(static_cast<Eigen::Index>(r));
+    const Eigen::MatrixXd used_icdf = rows_of(all_icdf, in);
+    const Eigen::MatrixXd all_top = rows_of(all_top_rows, in);
+    const Eigen::MatrixXd all_scalars = rows_of(all_scalar_rows, in);
+
+    SampleRecord& rec = last_;
+    rec.time = time;
+    rec.realizations = all_icdf;
+    rec.realizations_used = static_cast<int>(in.size());
+    rec.mean = coarse::ensemble_mean(used_icdf);
+    rec.variance = coarse::ensemble_variance(used_icdf, rec.mean);
+    rec.com = all_scalar_rows.col(0);
+    if (settings_.bed) {
+        rec.bed = bed_record(all_bed_rows, *settings_.bed);
+        rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(),
+                                  *settings_.bed);
+    }
+    rec.top_mean = top ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
+    height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
+    const Eigen::VectorXd x = observable_->restrict_ensemble(used_icdf, all_top);
+    last_x_ = x;
+    rec.compact = observable_->needs_top_half() ? x : Eigen::VectorXd();
+    rec.compact_status = observable_->status();
+    if (!observable_->needs_top_half() && settings_.recorded) {
+        rec.compact = settings_.recorded->restrict_ensemble(used_icdf, all_top);
+        rec.compact_status = settings_.recorded->status();
+    }
+    if (out) {
+        out->t.push_back(rec.time);
+        out->x.push_back(x);
+        out->phase_signal.push_back(coarse::ensemble_mean(all_scalars)[0]);
+        out->member_phase.push_back(all_scalars.col(0));
+        out->member_expansion.push_back(all_scalars.col(3));
+        // Rows in global realization order, as gathered: independent of the layout.
+        if (observable_->restricts_members())
+            out->members.push_back(observable_->restrict_members(used_icdf, all_top));
+    }
+    seconds_ += MPI_Wtime() - start;
+    ++count_;
+    return &rec;
+}
+
+void EnsembleSampler::save(StepperState& s) const {
+    s.height_lo = height_range_.first;
+    s.height_hi = height_range_.second;
+    s.observable = observable_->saved_state();
+    if (settings_.recorded) s.recorded = settings_.recorded->saved_state();
+}
+
+void EnsembleSampler::restore(const StepperState& s) {
+    height_range_ = {s.height_lo, s.height_hi};
+    if (!layout_.is_root()) return;
+    observable_->restore_state(s.observable);
+    if (settings_.recorded) settings_.recorded->restore_state(s.recorded);
+}
+
+}  // namespace efdem::mpi_driver
