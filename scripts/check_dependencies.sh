@@ -24,7 +24,7 @@
 # and, between the rooms of dem/ (one target; dem/CMakeLists.txt):
 #
 #   contact/ <-/-> gas/                  the two physics rooms know nothing of each other
-#   contact/, gas/, body_forces/             -> no beds/, settling/, io/, realization builder
+#   contact/, gas/, body_forces/         -> no beds/, settling/, io/, realization builder
 #                                           (forces come before preparing beds and writing)
 #   io/                                  -> no contact/, gas/, body_forces/, settling/, effect
 #                                           registry, realization builder (it reads a System)

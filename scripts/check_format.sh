@@ -13,11 +13,20 @@ command -v clang-format > /dev/null \
   || { echo "check_format: clang-format not found (apt-get install clang-format)"; exit 1; }
 
 check_tree() {  # check_tree ROOT: prints the unformatted files; status 1 if any
-    local root=$1 bad=()
-    while IFS= read -r -d '' f; do
-        clang-format --style=file --dry-run --Werror "$f" > /dev/null 2>&1 || bad+=("${f#"$root"/}")
-    done < <(find "$root" \( -name build -o -name 'build-*' -o -name .git -o -name runs \) -prune \
-                  -o -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) -print0)
+    local root=$1 files=() bad=()
+    while IFS= read -r -d '' f; do files+=("$f"); done \
+        < <(find "$root" \( -name build -o -name 'build-*' -o -name .git -o -name runs \) -prune \
+                 -o -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) -print0)
+    # One clang-format for all files; it names each file it would change ("FILE:LINE:COL:
+    # error: code should be clang-formatted"). Any other failure is reported as it is.
+    local out rc=0
+    out=$(clang-format --style=file --dry-run --Werror "${files[@]}" 2>&1) || rc=$?
+    mapfile -t bad < <(sed -n 's/^\(.*\):[0-9]*:[0-9]*: error: code should be clang-formatted.*/\1/p' <<< "$out" \
+                           | sort -u | sed "s|^$root/||")
+    if [ $rc -ne 0 ] && [ ${#bad[@]} -eq 0 ]; then
+        echo "check_format: clang-format failed (exit $rc):"; echo "$out" | head -20
+        return 1
+    fi
     if [ ${#bad[@]} -gt 0 ]; then
         echo "check_format: ${#bad[@]} file(s) differ from what clang-format would write:"
         printf '  %s\n' "${bad[@]}"
