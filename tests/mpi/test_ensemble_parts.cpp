@@ -71,6 +71,17 @@ struct ListSink final : SampleSink {
     void failure(const FailureRecord& f) override { failed.push_back(f); }
 };
 
+/// What the lifting cases start from: the toy ensemble spread out, lifted by the toy lifter
+/// with master seed 7.
+struct ToyLifting {
+    MpiComm world{MPI_COMM_WORLD};
+    EnsembleLayout layout{world, per_rank(world)};
+    Realizations local = toys(layout, spread_start);
+    coarse::IcdfObservable observable{3};
+    test::ToyLifter lifter;
+    EnsembleLifting lifting{layout, 3, 7, lifter};
+};
+
 SamplingSettings sampling3() {
     SamplingSettings s;
     s.quantiles = 3;  // the toy's state is its 3-node "ICDF"
@@ -147,12 +158,8 @@ TEST_CASE("sampling leaves a dropped realization out of the means, as a row of N
 
 TEST_CASE("lifting to the mean target puts every realization there; `only` lifts just those",
           "[mpi][ensemble][lifting]") {
-    const MpiComm world(MPI_COMM_WORLD);
-    const EnsembleLayout layout(world, per_rank(world));
-    Realizations local = toys(layout, spread_start);
-    coarse::IcdfObservable observable(3);
-    test::ToyLifter lifter;
-    EnsembleLifting lifting(layout, 3, 7, lifter);
+    ToyLifting f;
+    auto& [world, layout, local, observable, lifter, lifting] = f;
     const Eigen::VectorXd target = Eigen::Vector3d(2.0, -0.5, 0.25);
     EnsembleLifting::Request request;
     request.new_time = 3.5;
@@ -185,12 +192,8 @@ TEST_CASE("lifting to the mean target puts every realization there; `only` lifts
 
 TEST_CASE("lifting to members moves every realization by the same increment, keeping its offset",
           "[mpi][ensemble][lifting]") {
-    const MpiComm world(MPI_COMM_WORLD);
-    const EnsembleLayout layout(world, per_rank(world));
-    Realizations local = toys(layout, spread_start);
-    coarse::IcdfObservable observable(3);
-    test::ToyLifter lifter;
-    EnsembleLifting lifting(layout, 3, 7, lifter);
+    ToyLifting f;
+    auto& [world, layout, local, observable, lifter, lifting] = f;
     const Eigen::VectorXd target = Eigen::Vector3d(2.0, -0.5, 0.25);
     EnsembleLifting::Request request;
     request.new_time = 1.0;
