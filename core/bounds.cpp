@@ -14,4 +14,8 @@ std::string Bounds::describe() const {
     return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
 }
 
+std::string Bounds::interval() const {
+    return fmt::format("{}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+}
+
 }  // namespace efdem

@@ -41,6 +41,8 @@ struct Bounds {
     }
     /// "> 0", ">= 1", "in (0, 1]", or "" when unbounded.
     std::string describe() const;
+    /// The interval itself: "[0, 1000]", "(0, inf)".
+    std::string interval() const;
 };
 
 }  // namespace efdem

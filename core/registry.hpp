@@ -2,8 +2,9 @@
 /// \file
 /// Registry: a checked-in table of named factories (after LAMMPS' gran_sub_mod_register.cpp).
 ///
-/// One row per plug-in: its name, a factory and a one-line summary. No macros, no static
-/// initialisers: the table is an ordinary array that a reader can find and read.
+/// One row per plug-in: its name, a factory, a one-line summary and the keys a run may change.
+/// No macros, no self-registration: the table is an ordinary array that a reader can find and
+/// read (a row may call a function for its run parameters, so the table is made at start-up).
 
 #include <memory>
 #include <span>

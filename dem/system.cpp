@@ -69,8 +69,8 @@ void System::set_parameter(std::string_view key, double value) {
         throw RuntimeFailure(fmt::format(
             "{} cannot be set: the scene does not list {} in its effects", key, p->effect));
     if (!p->parameter.bounds.contains(value))
-        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: it must be {}",
-                                         key, value, p->parameter.bounds.describe()));
+        throw RuntimeFailure(fmt::format("{} = {:g} asked for by the coarse solver: outside {}",
+                                         key, value, p->parameter.bounds.interval()));
     effect->set_parameter(p->parameter.key, value);
 }
 

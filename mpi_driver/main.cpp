@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     if (setup.check) {
         if (options.action == RunOptions::Action::list_keys)
             print_keys(*setup.table);
-        else
+        else if (mpi.is_root())  // the report is the root's (log::output prints only there)
             log::output(
                 check_report(*setup.table, *setup.settings, setup.systems.front(), setup.ranks));
         return kExitOk;

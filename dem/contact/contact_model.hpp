@@ -5,21 +5,21 @@
 ///
 /// Scene keys, in the scope of the effect (`pair_contact.` or `wall_contact.`):
 ///
-// clang-format off: a table wider than the column limit
-/// | key                  | meaning                                              | default |
+// clang-format off
+/// | key                  | meaning                                              | default          |
 /// |----------------------|------------------------------------------------------|------------------|
-/// | normal               | `hooke` or `hertz`                                   | hooke | | kn |
-/// normal stiffness [rho_s g d_p^2] (hertz: per d_p^0.5)| required         | | damping |
-/// `restitution` (eta_n per pair, e exact for every     | restitution      | | | pair) or `gamma`
-/// (LAMMPS: one gamma_n for all pairs, |                  | |                      | eta_n = m_eff
-/// gamma_n; hooke only) or `none`         |                  | | restitution          | coefficient
-/// of restitution e in (0, 1]               | required if      | |                      | | damping
-/// = restitution | | gamma_n              | damping per unit effective mass [1/time]             |
-/// required if gamma | | tangential           | `history` (spring + dashpot + Coulomb) or `none` |
-/// history          | | kt                   | tangential stiffness | 2/7 kn           | |
-/// tangential_damping   | eta_t / eta_n (LAMMPS: gamma_t = gamma_n / 2)        | 0.5              |
-/// | mu                   | Coulomb friction coefficient                         | required if
-/// history |
+/// | normal               | `hooke` or `hertz`                                   | hooke            |
+/// | kn                   | normal stiffness [rho_s g d_p^2] (hertz: per d_p^0.5)| required         |
+/// | damping              | `restitution` (eta_n per pair, e exact for every     | restitution      |
+/// |                      | pair) or `gamma` (LAMMPS: one gamma_n for all pairs, |                  |
+/// |                      | eta_n = m_eff gamma_n; hooke only) or `none`         |                  |
+/// | restitution          | coefficient of restitution e in (0, 1]               | required if      |
+/// |                      |                                                      | damping = restitution |
+/// | gamma_n              | damping per unit effective mass [1/time]             | required if gamma |
+/// | tangential           | `history` (spring + dashpot + Coulomb) or `none`     | history          |
+/// | kt                   | tangential stiffness                                 | 2/7 kn           |
+/// | tangential_damping   | eta_t / eta_n (LAMMPS: gamma_t = gamma_n / 2)        | 0.5              |
+/// | mu                   | Coulomb friction coefficient                         | required if history |
 // clang-format on
 ///
 /// wall_contact reads the same keys; each key it does not set falls back to pair_contact's

@@ -4,18 +4,16 @@
 /// reads its own keys). They are read in every run, so that a scene with a checkpoint block is
 /// valid whether or not it checkpoints, and a restart may change them freely.
 ///
-// clang-format off: a table wider than the column limit
-/// | key                          | meaning                                              | default
-/// |
+// clang-format off
+/// | key                          | meaning                                              | default |
 /// |------------------------------|------------------------------------------------------|---------|
-/// | checkpoint.interval          | checkpoint every N coarse steps (cpi) or N samples   | 0 (off)
-/// | |                              | (direct: N x observe.interval of DEM time)           | | |
-/// checkpoint.keep              | K: how many of the newest checkpoints are kept       | 2       |
-/// | checkpoint.directory         | where checkpoints are written                        |
-/// output.directory | | restart.allow_physics_change | accept a restart whose scene changes physics
-/// keys    | false   | | debug.checkpoint_delay       | test only: seconds to sleep inside every
-/// checkpoint  | 0       | |                              | write (between the collective part and
-/// the marker)   |         |
+/// | checkpoint.interval          | checkpoint every N coarse steps (cpi) or N samples   | 0 (off) |
+/// |                              | (direct: N x observe.interval of DEM time)           |         |
+/// | checkpoint.keep              | K: how many of the newest checkpoints are kept       | 2       |
+/// | checkpoint.directory         | where checkpoints are written                        | output.directory |
+/// | restart.allow_physics_change | accept a restart whose scene changes physics keys    | false   |
+/// | debug.checkpoint_delay       | test only: seconds to sleep inside every checkpoint  | 0       |
+/// |                              | write (between the collective part and the marker)   |         |
 // clang-format on
 
 #include <filesystem>

@@ -8,46 +8,45 @@
 /// checked against the time step it must be a multiple of, so that samples fall exactly on
 /// DEM steps.
 ///
-// clang-format off: a table wider than the column limit
-/// | key                            | meaning                                             | default
-/// |
+// clang-format off
+/// | key                            | meaning                                             | default |
 /// |--------------------------------|-----------------------------------------------------|---------|
-/// | mode                           | `direct` (every realization runs the DEM), `cpi`,   | direct
-/// | |                                | `steady` or `continuation` (steady_run_settings.hpp) | | |
-/// seed                           | master seed of every random stream                  | 1       |
-/// | ensemble.realizations_per_rank | k: the ensemble has R = P x k realizations          | 1 | |
-/// ensemble.on_failure            | abort, drop or replace (cpi) a failing realization   | abort |
-/// |                                | (failure_policy.hpp)                                 | | |
-/// ensemble.max_failures          | failures a drop/replace run survives                 | R/4, >=
-/// 1 | | run.duration                   | simulated time to cover (cpi: until reached);       |
-/// required| |                                | steady, continuation: most DEM time after the | 0
-/// (none)| |                                | warm-up (per realization; 0: no limit)              |
-/// | | observe.interval               | time between ICDF samples (a multiple of dt)        | 0.5 |
-/// | observe.species                | species whose heights make the ICDF                 | first |
-/// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19 | |
-/// observe.compact                | also record (A,B,C,D) of y = Q_top - Q_L at every   | false   |
-/// |                                | sample (a direct reference for a compact CPI run)   | | |
-/// observe.bed                    | also record the bed quantities at every sample:     | false   |
-/// |                                | Delta P, H, species heights, Lacey index, phi(z)    | | |
-/// observe.profile_dz             | slab thickness of the recorded phi(z)                | 1 | |
-/// observe.profile_height         | top of the recorded phi(z) (0: 3 x the bed's solid  | 0       |
-/// |                                | height, dem::default_profile_slabs)                 | | |
-/// observe.mixing_layer           | layer thickness of the Lacey mixing index           | 2       |
-/// | cpi.observable                 | the coarse variable: `icdf` (the ICDF nodes) or     | icdf |
-/// |                                | `compact` ((A,B,C,D)); coarse/demixing/observable_table | |
-/// | cpi.lift                       | `mean`: every realization lifted to the projected X;| mean |
-/// |                                | `members`: each moved by the same increment         | | |
-/// cpi.*                          | the coarse run loop: projective/cpi_settings.hpp    |         |
-/// | output.directory               | where the run writes (relative: to the scene's      | . | |
-/// | folder; on the command line: to the working dir)    |         | | output.prefix | file stem of
-/// the run's files                        | efdem   | | output.vtk_interval            | time
-/// between VTK snapshots per realization (0: none)| 0       | | output.thermo_interval         |
-/// time between thermo lines per realization (0: none) | 0       | | output.overwrite | a new run
-/// may delete and replace the files an       | false   | |                                | earlier
-/// run left under output.prefix (output_guard) |         | | checkpoint.*, restart.*        |
-/// checkpoint/checkpoint_settings.hpp                  |         | | debug.fail_realization | test
-/// only: this realization fails ...               | -1      | | debug.fail_time                |
-/// ... at the first sample at or after this time       | 0       |
+/// | mode                           | `direct` (every realization runs the DEM), `cpi`,   | direct  |
+/// |                                | `steady` or `continuation` (steady_run_settings.hpp) |         |
+/// | seed                           | master seed of every random stream                  | 1       |
+/// | ensemble.realizations_per_rank | k: the ensemble has R = P x k realizations          | 1       |
+/// | ensemble.on_failure            | abort, drop or replace (cpi) a failing realization   | abort   |
+/// |                                | (failure_policy.hpp)                                 |         |
+/// | ensemble.max_failures          | failures a drop/replace run survives                 | R/4, >= 1 |
+/// | run.duration                   | simulated time to cover (cpi: until reached);       | required|
+/// |                                | steady, continuation: most DEM time after the       | 0 (none)|
+/// |                                | warm-up (per realization; 0: no limit)              |         |
+/// | observe.interval               | time between ICDF samples (a multiple of dt)        | 0.5     |
+/// | observe.species                | species whose heights make the ICDF                 | first   |
+/// | observe.quantiles              | m: nodes p_i = i/(m+1) of the ICDF                  | 19      |
+/// | observe.compact                | also record (A,B,C,D) of y = Q_top - Q_L at every   | false   |
+/// |                                | sample (a direct reference for a compact CPI run)   |         |
+/// | observe.bed                    | also record the bed quantities at every sample:     | false   |
+/// |                                | Delta P, H, species heights, Lacey index, phi(z)    |         |
+/// | observe.profile_dz             | slab thickness of the recorded phi(z)                | 1       |
+/// | observe.profile_height         | top of the recorded phi(z) (0: 3 x the bed's solid  | 0       |
+/// |                                | height, dem::default_profile_slabs)                 |         |
+/// | observe.mixing_layer           | layer thickness of the Lacey mixing index           | 2       |
+/// | cpi.observable                 | the coarse variable: `icdf` (the ICDF nodes) or     | icdf    |
+/// |                                | `compact` ((A,B,C,D)); coarse/demixing/observable_table |     |
+/// | cpi.lift                       | `mean`: every realization lifted to the projected X;| mean    |
+/// |                                | `members`: each moved by the same increment         |         |
+/// | cpi.*                          | the coarse run loop: projective/cpi_settings.hpp    |         |
+/// | output.directory               | where the run writes (relative: to the scene's      | .       |
+/// |                                | folder; on the command line: to the working dir)    |         |
+/// | output.prefix                  | file stem of the run's files                        | efdem   |
+/// | output.vtk_interval            | time between VTK snapshots per realization (0: none)| 0       |
+/// | output.thermo_interval         | time between thermo lines per realization (0: none) | 0       |
+/// | output.overwrite               | a new run may delete and replace the files an       | false   |
+/// |                                | earlier run left under output.prefix (output_guard) |         |
+/// | checkpoint.*, restart.*        | checkpoint_data/checkpoint_settings.hpp             |         |
+/// | debug.fail_realization         | test only: this realization fails ...               | -1      |
+/// | debug.fail_time                | ... at the first sample at or after this time       | 0       |
 // clang-format on
 
 #include <cstdint>

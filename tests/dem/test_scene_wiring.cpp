@@ -177,7 +177,7 @@ TEST_CASE("System::set_parameter changes an effect's key by name, within its bou
         FAIL("a negative U_s was accepted");
     } catch (const RuntimeFailure& f) {
         CHECK_THAT(f.what(), Catch::Contains("gas_drag.superficial_velocity = -0.01") &&
-                                 Catch::Contains("in [0, 1000]"));
+                                 Catch::Contains("outside [0, 1000]"));
     }
     CHECK(test::gas_effect(s).spec().superficial_velocity == 0.41);
 

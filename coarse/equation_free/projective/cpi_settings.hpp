@@ -5,26 +5,26 @@
 /// them is kept anywhere else). `cpi.observable` names the coarse variable and is read by the
 /// demixing room (coarse/demixing/observable_table.hpp). Times in sqrt(d_p/g).
 ///
-// clang-format off: a table wider than the column limit
+// clang-format off
 /// | key               | meaning                                                       | default |
 /// |-------------------|---------------------------------------------------------------|---------|
 /// | cpi.projection    | `fixed` (DT = cpi.dt), `periods` (DT = k T) or `adaptive`     | fixed   |
 /// | cpi.integrator    | `euler` or `adams_bashforth2` (fixed, adaptive)               | euler   |
 /// | cpi.warmup        | direct simulation before the first coarse step (lower bound)  | 0       |
-/// | cpi.warmup_until  | `time` (cpi.warmup exactly) or `steady`: on until the phase    |
-/// adaptive:| |                   | signal (bed centre of mass) no longer drifts (phase_drift.hpp)
-/// | steady  | | cpi.warmup_max    | steady: most time the warm-up may run beyond cpi.warmup | 10
-/// burst| | cpi.healing       | start of each burst left out of the slope                     | 10
-/// | | cpi.window        | estimation window after healing (>= 3 samples)                | 10 | |
-/// cpi.dt            | projective step DT (projection = fixed)                       | 80      | |
-/// cpi.periods       | k in DT = k T (projection = periods)                          | 2       | |
-/// cpi.max_extension | most a burst may be lengthened to see 2 periods               | 30      | |
-/// cpi.stability     | `warn`, `halve` or `stop` when DT is flagged                  | warn    | |
-/// cpi.tolerance     | adaptive: error one jump may add, RMS over the ICDF [d_p]     | required| |
-/// cpi.dt_min        | adaptive: shortest jump; below it a burst runs directly       | burst/2 | |
-/// cpi.dt_max        | adaptive: longest jump                                        | 8 burst | |
-/// cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     | |
-/// cpi.growth        | adaptive: DT_next <= growth x DT_last                         | 2       |
+/// | cpi.warmup_until  | `time` (cpi.warmup exactly) or `steady`: on until the phase    | adaptive:|
+/// |                   | signal (bed centre of mass) no longer drifts (phase_drift.hpp) | steady  |
+/// | cpi.warmup_max    | steady: most time the warm-up may run beyond cpi.warmup       | 10 burst|
+/// | cpi.healing       | start of each burst left out of the slope                     | 10      |
+/// | cpi.window        | estimation window after healing (>= 3 samples)                | 10      |
+/// | cpi.dt            | projective step DT (projection = fixed)                       | 80      |
+/// | cpi.periods       | k in DT = k T (projection = periods)                          | 2       |
+/// | cpi.max_extension | most a burst may be lengthened to see 2 periods               | 30      |
+/// | cpi.stability     | `warn`, `halve` or `stop` when DT is flagged                  | warn    |
+/// | cpi.tolerance     | adaptive: error one jump may add, RMS over the ICDF [d_p]     | required|
+/// | cpi.dt_min        | adaptive: shortest jump; below it a burst runs directly       | burst/2 |
+/// | cpi.dt_max        | adaptive: longest jump                                        | 8 burst |
+/// | cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     |
+/// | cpi.growth        | adaptive: DT_next <= growth x DT_last                         | 2       |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance

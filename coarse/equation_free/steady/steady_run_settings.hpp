@@ -5,35 +5,34 @@
 /// Times in sqrt(d_p/g), coarse-vector norms in the unit of the coarse vector (d_p for the
 /// ICDF).
 ///
-// clang-format off: a table wider than the column limit
-/// | key                       | meaning                                                     |
-/// default  |
+// clang-format off
+/// | key                       | meaning                                                     | default  |
 /// |---------------------------|-------------------------------------------------------------|----------|
-/// | steady.solver             | `newton` (Newton-GMRES, CRN derivatives) or `anderson`      |
-/// newton   | | steady.warmup             | direct simulation before the first evaluation; its last
-/// | 20       | |                           | sample is the initial guess |          | | steady.tau
-/// | micro time of one evaluation of Phi_tau                     | 20       | | steady.coordinates
-/// | `heights` (the ICDF nodes) or `gaps` (first node, log gaps) | heights  | |
-/// steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 6 x
-/// noise| | steady.tolerance          | absolute floor of the stopping rule on \|F\| | 1e-10    |
-/// | steady.noise_factor       | stop at \|F\| <= this x the noise of F                      | 2 |
-/// | steady.max_iterations     | Newton steps (newton) / iterations (anderson)               | 8 /
-/// 40   | | steady.max_krylov         | newton: GMRES products per Newton step | dim      | |
-/// steady.forcing            | newton: relative GMRES tolerance                            | 0.1 |
-/// | steady.max_backtracks     | newton: line-search halvings                                | 3 |
-/// | steady.depth              | anderson: depth m (0: damped iteration)                     | 3 |
-/// | steady.damping            | anderson: beta in (0, 1]                                    | 1 |
-/// | steady.eigenvalues        | leading coarse eigenvalues at the solution (0: none)        | 3 |
-/// | steady.eigenvalue_products| most J v products the Arnoldi process spends                | dim
-/// | | continuation.parameter    | the scene key continued in                                  |
-/// required | | continuation.end          | the other end of the parameter range (start: the
-/// scene's)  | required | | continuation.step         | parameter change of the first predictor |
-/// range/4  | | continuation.max_step     | most parameter change of any predictor | step     | |
-/// continuation.scale        | parameter change that weighs as 1 unit of the coarse vector | 0.01 |
-/// |                           | in the arclength                                            | | |
-/// continuation.max_points   | branch points, the first included                           | 12 |
-/// | continuation.predictor_fallback | |G| at the predictor above this x the stopping        | 2 |
-/// |                           | threshold: try the last point, the parameter held there     | |
+/// | steady.solver             | `newton` (Newton-GMRES, CRN derivatives) or `anderson`      | newton   |
+/// | steady.warmup             | direct simulation before the first evaluation; its last     | 20       |
+/// |                           | sample is the initial guess                                 |          |
+/// | steady.tau                | micro time of one evaluation of Phi_tau                     | 20       |
+/// | steady.coordinates        | `heights` (the ICDF nodes) or `gaps` (first node, log gaps) | heights  |
+/// | steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 6 x noise|
+/// | steady.tolerance          | absolute floor of the stopping rule on \|F\|                | 1e-10    |
+/// | steady.noise_factor       | stop at \|F\| <= this x the noise of F                      | 2        |
+/// | steady.max_iterations     | Newton steps (newton) / iterations (anderson)               | 8 / 40   |
+/// | steady.max_krylov         | newton: GMRES products per Newton step                      | dim      |
+/// | steady.forcing            | newton: relative GMRES tolerance                            | 0.1      |
+/// | steady.max_backtracks     | newton: line-search halvings                                | 3        |
+/// | steady.depth              | anderson: depth m (0: damped iteration)                     | 3        |
+/// | steady.damping            | anderson: beta in (0, 1]                                    | 1        |
+/// | steady.eigenvalues        | leading coarse eigenvalues at the solution (0: none)        | 3        |
+/// | steady.eigenvalue_products| most J v products the Arnoldi process spends                | dim      |
+/// | continuation.parameter    | the scene key continued in                                  | required |
+/// | continuation.end          | the other end of the parameter range (start: the scene's)  | required |
+/// | continuation.step         | parameter change of the first predictor                     | range/4  |
+/// | continuation.max_step     | most parameter change of any predictor                      | step     |
+/// | continuation.scale        | parameter change that weighs as 1 unit of the coarse vector | 0.01     |
+/// |                           | in the arclength                                            |          |
+/// | continuation.max_points   | branch points, the first included                           | 12       |
+/// | continuation.predictor_fallback | |G| at the predictor above this x the stopping        | 2        |
+/// |                           | threshold: try the last point, the parameter held there     |          |
 // clang-format on
 ///
 /// Newton-only keys are refused with steady.solver = anderson and the other way round;
