@@ -11,7 +11,7 @@ std::string Bounds::describe() const {
     if (!has_lo && !has_hi) return "";
     if (has_lo && !has_hi) return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
     if (!has_lo && has_hi) return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
-    return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+    return "in " + interval();
 }
 
 std::string Bounds::interval() const {
