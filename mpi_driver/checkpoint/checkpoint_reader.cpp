@@ -62,13 +62,25 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
     if (!hold_kind) refuse(path, "names an unknown " + g + "hold_kind '" + kind + "'");
     s.hold_kind = *hold_kind;
     s.hold = f.read_text(g + "hold");
-    const std::vector<double> tau = f.read_doubles(g + "history/tau");
-    const std::size_t n = tau.size(), mm = x.size();
-    const std::vector<double> slope = values("history/slope", n * mm),
-                              se = values("history/se", n * mm);
-    for (std::size_t i = 0; i < n; ++i)
-        s.history.push_back({tau[i], Eigen::Map<const Eigen::VectorXd>(slope.data() + i * mm, m),
+    // Slope nodes from their three arrays: tau (n), slope and se (n x m).
+    auto read_nodes = [&](const std::string& group) {
+        const std::vector<double> tau = f.read_doubles(g + group + "/tau");
+        const std::size_t n = tau.size(), mm = x.size();
+        const std::vector<double> slope = values(group + "/slope", n * mm),
+                                  se = values(group + "/se", n * mm);
+        std::vector<coarse::SlopeNode> nodes;
+        for (std::size_t i = 0; i < n; ++i)
+            nodes.push_back({tau[i], Eigen::Map<const Eigen::VectorXd>(slope.data() + i * mm, m),
                              Eigen::Map<const Eigen::VectorXd>(se.data() + i * mm, m)});
+        return nodes;
+    };
+    s.history = read_nodes("history");
+    if (f.exists(g + "pool/tau")) {  // written since cpi.slope = pooled
+        std::vector<coarse::SlopeNode> nodes = read_nodes("pool");
+        const std::vector<double> commitment = values("pool/commitment", nodes.size());
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+            s.pool.push_back({std::move(nodes[i]), commitment[i]});
+    }
     s.decay.ok = integer("decay/ok") != 0;
     s.decay.rate = real("decay/rate");
     s.decay.ratio = real("decay/ratio");

@@ -37,17 +37,29 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
     integer("curvature_only_front", s.curvature_only_front ? 1 : 0);
     f.write_text(g + "hold_kind", std::string(coarse::to_string(s.hold_kind)));
     f.write_text(g + "hold", s.hold);
-    std::vector<double> tau, slope, se;
-    for (const auto& n : s.history) {
-        EFDEM_ASSERT(static_cast<std::size_t>(n.slope.size()) == m &&
-                     static_cast<std::size_t>(n.se.size()) == m);
-        tau.push_back(n.tau);
-        slope.insert(slope.end(), n.slope.data(), n.slope.data() + m);
-        se.insert(se.end(), n.se.data(), n.se.data() + m);
-    }
-    f.write(g + "history/tau", std::span<const double>(tau), {tau.size()});
-    f.write(g + "history/slope", std::span<const double>(slope), {tau.size(), m});
-    f.write(g + "history/se", std::span<const double>(se), {tau.size(), m});
+    // Slope nodes as three arrays: tau (n), slope and se (n x m).
+    auto write_nodes = [&](const std::string& group, auto&& node_of, const auto& list) {
+        std::vector<double> tau, slope, se;
+        for (const auto& item : list) {
+            const coarse::SlopeNode& n = node_of(item);
+            EFDEM_ASSERT(static_cast<std::size_t>(n.slope.size()) == m &&
+                         static_cast<std::size_t>(n.se.size()) == m);
+            tau.push_back(n.tau);
+            slope.insert(slope.end(), n.slope.data(), n.slope.data() + m);
+            se.insert(se.end(), n.se.data(), n.se.data() + m);
+        }
+        f.write(g + group + "/tau", std::span<const double>(tau), {tau.size()});
+        f.write(g + group + "/slope", std::span<const double>(slope), {tau.size(), m});
+        f.write(g + group + "/se", std::span<const double>(se), {tau.size(), m});
+    };
+    write_nodes(
+        "history", [](const coarse::SlopeNode& n) -> const auto& { return n; }, s.history);
+    f.create_group(g + "pool");
+    write_nodes(
+        "pool", [](const coarse::PooledBurst& b) -> const auto& { return b.node; }, s.pool);
+    std::vector<double> commitment;
+    for (const coarse::PooledBurst& b : s.pool) commitment.push_back(b.commitment);
+    f.write(g + "pool/commitment", std::span<const double>(commitment), {commitment.size()});
     integer("decay/ok", s.decay.ok ? 1 : 0);
     real("decay/rate", s.decay.rate);
     real("decay/ratio", s.decay.ratio);

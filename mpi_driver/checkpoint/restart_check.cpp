@@ -2,6 +2,7 @@
 
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -19,6 +20,21 @@ std::map<std::string, std::string> parse_lines(const std::string& text) {
         if (eq != std::string::npos) out[line.substr(0, eq)] = line.substr(eq + 3);
     }
     return out;
+}
+
+/// Keys added after checkpoints were first written, with the value that does what a run did
+/// before the key existed: a checkpoint that does not list the key was written with that value.
+// clang-format off
+constexpr std::pair<const char*, const char*> kAddedKeys[] = {
+    {"cpi.slope", "burst"},  // cpi.slope = pooled (issue 33)
+    {"cpi.pool", "4"},       // read only with cpi.slope = pooled
+};
+// clang-format on
+
+bool as_before_the_key(const std::string& key, const std::string& value) {
+    for (const auto& [k, v] : kAddedKeys)
+        if (key == k) return value == v;
+    return false;
 }
 }  // namespace
 
@@ -48,10 +64,12 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
     for (const auto& [key, value] : now) {
         if (may_change_on_restart(key)) continue;
         const auto it = then.find(key);
-        if (it == then.end())
-            changes.push_back(fmt::format("{} = {} (not in the checkpoint)", key, value));
-        else if (it->second != value)
+        if (it == then.end()) {
+            if (!as_before_the_key(key, value))
+                changes.push_back(fmt::format("{} = {} (not in the checkpoint)", key, value));
+        } else if (it->second != value) {
             changes.push_back(fmt::format("{} = {} (checkpoint: {})", key, value, it->second));
+        }
     }
     for (const auto& [key, value] : then)
         if (!may_change_on_restart(key) && !now.contains(key))

@@ -49,6 +49,14 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
     for (double d : {t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r, t.dt_tolerance_4r,
                      t.statistical, t.truncation})
         h = hash_value(d, h);
+    if (s.pool.empty()) return h;  // written before the pool: the checksum it was written with
+    h = hash_value(static_cast<std::uint64_t>(s.pool.size()), h);
+    for (const coarse::PooledBurst& b : s.pool) {
+        h = hash_value(b.node.tau, h);
+        h = hash_vector(b.node.slope, h);
+        h = hash_vector(b.node.se, h);
+        h = hash_value(b.commitment, h);
+    }
     return h;
 }
 }  // namespace

@@ -20,7 +20,9 @@
 ///                           controller/{dt_last, dt_cap, consecutive_rejections};
 ///                           totals/{attempts, accepted, rejected, direct, dt_taken,
 ///                           dt_tolerance, dt_tolerance_2r, dt_tolerance_4r, statistical,
-///                           truncation} (coarse::MultistepState)
+///                           truncation}; pool/{tau, slope, se, commitment} (n, n x m,
+///                           n x m, n: the slope pool; absent in files written before it)
+///                           (coarse::MultistepState)
 ///   /driver/integrator, /driver/integrator_text   formats 2 and 3: the same state as a
 ///                           positional vector and three lines of text
 ///   /output/<suffix>        the run's output files (HDF5, CSV) as they were at the checkpoint,

@@ -268,6 +268,9 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
         const std::pair<const char*, double> reals[] = {
             {"tolerance", c.tolerance},
             {"error_statistical", c.statistical},
+            {"error_statistical_jump", c.statistical_jump},
+            {"error_statistical_burst", c.statistical_burst},
+            {"error_statistical_pool", c.statistical_pool},
             {"error_truncation", c.truncation},
             {"predicted_truncation", c.predicted_truncation},
             {"dt_tolerance", c.dt_tolerance},
@@ -277,6 +280,9 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
             scalar(fmt::format("controller/{}", name).c_str(), value);
         series("/cpi/controller/limited_by", {}, T::text)
             .append_text(std::string(coarse::to_string(c.limited_by)));
+        series("/cpi/controller/slope", {}, T::text)
+            .append_text(std::string(coarse::to_string(c.slope_source)));
+        integer("controller/pooled_bursts", c.pooled_bursts);
         vec("controller/error_statistical_nodes", c.statistical_nodes);
         vec("controller/error_truncation_nodes", c.truncation_nodes);
     }

@@ -29,6 +29,13 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
     else if (c.active && r.lifted)
         s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})",
                          c.error(), c.statistical, c.truncation);
+    if (const coarse::ControllerRecord& c = r.controller;
+        c.active && r.lifted && c.slope_source == coarse::SlopeSource::pooled)
+        s += fmt::format(
+            ", slope pooled over {} burst{} (its own statistical error {:.3g}; one burst's "
+            "{:.3g}, the whole pool's {:.3g})",
+            c.pooled_bursts, c.pooled_bursts == 1 ? "" : "s", c.statistical_jump,
+            c.statistical_burst, c.statistical_pool);
     if (!r.message.empty()) s += " [" + r.message + "]";
     return s;
 }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -134,7 +135,7 @@ TEST_CASE("the divided difference's norm removes the slopes' noise", "[unit][coa
 
 TEST_CASE("largest_dt_within returns the DT whose error is the target",
           "[unit][coarse][multistep]") {
-    JumpErrorModel m{{node(0.0, Eigen::VectorXd::Constant(3, 1.0), 0.01)}, 5.0, 1e-3, 1.0};
+    JumpErrorModel m{{node(0.0, Eigen::VectorXd::Constant(3, 1.0), 0.01)}, 5.0, 1e-3, 1.0, {}};
     const double dt = largest_dt_within(m, 0.5, 1000.0);
     CHECK(jump_error(m, dt).total() == Approx(0.5).epsilon(1e-5));
     CHECK(jump_error(m, 2.0 * dt).total() > 0.5);
@@ -294,20 +295,30 @@ TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the sh
 TEST_CASE("an adaptive run resumed from the saved integrator state continues bit for bit",
           "[unit][coarse][multistep]") {
     // Saved after six steps, and right after the first burst with healing = window (the history
-    // then holds the curvature-only node of the first burst's earlier window).
+    // then holds the curvature-only node of the first burst's earlier window); Adams-Bashforth 2,
+    // and forward Euler from pooled slopes (the pool and its commitments are saved too).
     const Eigen::VectorXd k = rates19();
-    for (const auto& [healing, before] : {std::pair{2.0, 6}, std::pair{4.0, 1}}) {
-        INFO("healing " << healing << ", saved after " << before << " step(s)");
+    for (const auto& [healing, before, pooled] :
+         {std::tuple{2.0, 6, false}, std::tuple{4.0, 1, false}, std::tuple{2.0, 6, true}}) {
+        INFO("healing " << healing << ", saved after " << before << " step(s), pooled " << pooled);
         MultistepSettings s;
         s.burst.healing = healing;
         s.burst.window = 4.0;
-        s.steps = 2;
+        s.steps = pooled ? 1 : 2;
+        s.slope = pooled ? SlopeSource::pooled : SlopeSource::burst;
         s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 60.0};
-        test::OuEnsembleStepper toy(k, 0.05, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
+        // Pooled: a slower decay, so that jumps from the pool's lagging slope are kept.
+        const Eigen::VectorXd rates = pooled ? Eigen::VectorXd(k / 10.0) : k;
+        test::OuEnsembleStepper toy(rates, 0.05, 4, 0.1, Eigen::VectorXd::Constant(19, 3.0), 5);
         MultistepProjectiveIntegrator a(s);
         a.set_end_time(300.0);
         for (int i = 0; i < before; ++i) REQUIRE(a.step(toy).advanced());
         const IntegratorState saved = a.save_state();
+        if (pooled) {
+            REQUIRE(saved->pool.size() == 4);
+            CHECK(std::any_of(saved->pool.begin(), saved->pool.end(),
+                              [](const PooledBurst& b) { return b.commitment > 0.0; }));
+        }
         test::OuEnsembleStepper copy = toy;
         MultistepProjectiveIntegrator b(s);
         b.restore_state(saved);

@@ -32,8 +32,8 @@ run() {  # run NP LOG ARGS...
   timeout 300 "$mpiexec" -n "$np" "$@" > "$log" 2>&1 || { echo "FAIL: run failed ($log):"; cat "$log"; exit 1; }
 }
 
-same_output() {  # same_output PREFIX_A PREFIX_B
-  /usr/bin/python3 "$here/compare_runs.py" "$work/$1.h5" "$work/$2.h5"
+same_output() {  # same_output PREFIX_A PREFIX_B [--ignore DATASET...]
+  /usr/bin/python3 "$here/compare_runs.py" "$work/$1.h5" "$work/$2.h5" "${@:3}"
   for csv in _mean_icdf.csv _cpi_steps.csv; do
     [ -f "$work/$1$csv" ] || continue
     cmp -s "$work/$1$csv" "$work/$2$csv" \
@@ -105,6 +105,11 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
   run 2 "$work/$kind-f$version.log" "$@" "$efdem" "$scene" "${overrides[@]}" ensemble.realizations_per_rank=2 \
     output.directory="$work" output.prefix=$kind-f$version restart="$file"
   grep -q "restarted from" "$work/$kind-f$version.log" || { echo "FAIL: no restart in $kind-f$version.log"; exit 1; }
-  same_output $kind-ref $kind-f$version
+  # The slope pool's records (issue 33) came after formats 1-3: the run file stored in such a
+  # checkpoint has no rows of them before the restart.
+  ignore=()
+  [ "$version" = 4 ] || ignore=(--ignore cpi/controller/error_statistical_jump cpi/controller/error_statistical_burst
+                                cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts)
+  same_output $kind-ref $kind-f$version "${ignore[@]}"
   echo "PASS: $kind run restarted from a format-$version checkpoint ($(basename "$file")) equals the uninterrupted run"
 done

@@ -4,7 +4,9 @@ p-grid and the scene text must be identical (NaN equal to NaN). Attributes that 
 run was executed rather than what it computed (ranks, realizations_per_rank, date, wall time,
 overrides) are not compared.
 
-    /usr/bin/python3 compare_runs.py A.h5 B.h5     exit 0 if identical, 1 with the differences
+    /usr/bin/python3 compare_runs.py A.h5 B.h5 [--ignore DATASET...]
+        exit 0 if identical, 1 with the differences; --ignore leaves out datasets (by path
+        without the leading /), e.g. ones a restart's older checkpoint did not record yet
 """
 import sys
 
@@ -28,10 +30,13 @@ def same(a, b):
     return np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b
 
 
-def main(a_path, b_path):
+def main(a_path, b_path, ignore=()):
     problems = []
     with h5py.File(a_path, "r") as a, h5py.File(b_path, "r") as b:
         da, db = datasets(a), datasets(b)
+        for name in ignore:
+            da.pop(name, None)
+            db.pop(name, None)
         for name in sorted(set(da) | set(db)):
             if name not in da or name not in db:
                 problems.append(f"{name}: only in {'B' if name not in da else 'A'}")
@@ -56,6 +61,6 @@ def main(a_path, b_path):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) < 3 or (len(sys.argv) > 3 and sys.argv[3] != "--ignore"):
         sys.exit(__doc__)
-    sys.exit(main(sys.argv[1], sys.argv[2]))
+    sys.exit(main(sys.argv[1], sys.argv[2], sys.argv[4:]))

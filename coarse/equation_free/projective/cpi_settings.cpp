@@ -78,6 +78,20 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
     m.adaptive = adaptive;
     m.dt = s.fixed.dt;
     m.dt_quantum = sample_interval;
+    m.slope = cpi.get_or_choice("slope", "burst", {"burst", "pooled"}) == "pooled"
+                  ? SlopeSource::pooled
+                  : SlopeSource::burst;
+    m.pool = static_cast<std::size_t>(cpi.get_or<int>("pool", 4, Bounds::closed(1, 64)));
+    if (m.slope == SlopeSource::pooled && s.steps == 2)
+        cpi.fail("slope",
+                 "pooled pools the bursts' slopes into one forward-Euler slope; it does not "
+                 "combine with cpi.integrator = adams_bashforth2",
+                 "burst with adams_bashforth2; pooled with cpi.integrator = euler");
+    if (m.slope == SlopeSource::pooled && s.projection == Projection::periods)
+        cpi.fail("slope",
+                 "pooled is read with cpi.projection = fixed or adaptive; periods takes period "
+                 "means over bursts of varying length",
+                 "burst with cpi.projection = periods");
     if (adaptive) {
         const double burst = healing + window;
         StepSizeSettings& c = m.control;
@@ -140,7 +154,8 @@ double CpiSettings::window() const {
 }
 
 std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {
-    if (projection == Projection::adaptive || (projection == Projection::fixed && steps == 2))
+    if (projection == Projection::adaptive ||
+        (projection == Projection::fixed && (steps == 2 || multistep.slope == SlopeSource::pooled)))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
     if (projection == Projection::fixed)
         return std::make_unique<ProjectiveForwardEuler>(fixed, std::move(repair));

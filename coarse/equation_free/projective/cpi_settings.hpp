@@ -25,6 +25,10 @@
 /// | cpi.dt_max        | adaptive: longest jump                                        | 8 burst |
 /// | cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     |
 /// | cpi.growth        | adaptive: DT_next <= growth x DT_last                         | 2       |
+/// | cpi.slope         | `burst` (the last burst's slope) or `pooled` (the weighted     | burst   |
+/// |                   | mean of the last cpi.pool bursts', estimators/slope_pool.hpp; |         |
+/// |                   | euler, fixed or adaptive)                                     |         |
+/// | cpi.pool          | pooled: the last bursts one slope pools (1..64)               | 4       |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance

@@ -28,14 +28,9 @@
 
 #include <Eigen/Core>
 
-namespace efdem::coarse {
+#include "coarse/equation_free/estimators/slope_node.hpp"
 
-/// One measured slope: where it belongs in time, its value and its standard error.
-struct SlopeNode {
-    double tau = 0.0;       ///< centre of the estimation window
-    Eigen::VectorXd slope;  ///< s [unit of X per sqrt(d_p/g)]
-    Eigen::VectorXd se;     ///< standard error of s per component (same unit)
-};
+namespace efdem::coarse {
 
 /**
  * \brief W_k = integral_{t0}^{t0+dt} L_k(t) dt for the Lagrange basis L_k of `nodes`' tau.

@@ -59,10 +59,13 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
                                 .first_dt = settings.first_dt,
                                 .dt_quantum = settings.dt_quantum,
                                 .burst = settings.burst.healing + settings.burst.window,
-                                .window = settings.burst.window}) {
+                                .window = settings.burst.window}),
+      pool_(std::max<std::size_t>(settings.pool, 1)) {
     EFDEM_EXPECTS(std::isfinite(settings.burst.healing) && settings.burst.healing >= 0.0);
     EFDEM_EXPECTS(std::isfinite(settings.burst.window) && settings.burst.window > 0.0);
     EFDEM_EXPECTS(settings.steps == 1 || settings.steps == 2);
+    EFDEM_EXPECTS(settings.pool >= 1);
+    EFDEM_EXPECTS(settings.slope == SlopeSource::burst || settings.steps == 1);
 }
 
 std::string_view MultistepProjectiveIntegrator::name() const {
@@ -135,6 +138,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
 
 void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
     history_.push_back(m.node);
+    pool_.add(m.node);
     while (history_.size() > static_cast<std::size_t>(settings_.steps) + 1) {
         history_.pop_front();
         curvature_only_front_ = false;
@@ -166,8 +170,39 @@ double MultistepProjectiveIntegrator::direct_burst_length(const CoarseStepper& s
     return left < 2.0 * burst - time_tolerance(end_time()) ? left : burst;
 }
 
-double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec) const {
-    const DtPlan p = controller_.plan({.model = {method_nodes(), t_end_, prior_curvature(), 1.0},
+MultistepProjectiveIntegrator::JumpBasis MultistepProjectiveIntegrator::jump_basis() const {
+    JumpBasis b;
+    // Until the pool holds a burst (a restart from a checkpoint written before pooling), the
+    // last burst's slope.
+    if (settings_.slope != SlopeSource::pooled || pool_.size() == 0) {
+        b.nodes = method_nodes();
+        return b;
+    }
+    b.pooled = pool_.estimate(pool_.size());  // the last cpi.pool bursts (fewer at the start)
+    b.nodes = {b.pooled.node};
+    b.committed = b.pooled.committed;
+    return b;
+}
+
+void MultistepProjectiveIntegrator::record_statistical(ControllerRecord& c, const JumpBasis& basis,
+                                                       double dt) const {
+    const std::vector<double> w = projection_weights(basis.nodes, t_end_, dt);
+    c.statistical_nodes = basis.committed.size()
+                              ? charged_error(basis.nodes[0].se, basis.committed, w[0])
+                              : statistical_error(basis.nodes, w);
+    c.statistical = rms(c.statistical_nodes);
+    c.statistical_jump = rms(statistical_error(basis.nodes, w));
+    c.slope_source = settings_.slope;
+    c.pooled_bursts = basis.committed.size() ? static_cast<int>(basis.pooled.bursts()) : 1;
+    if (settings_.steps == 1 && pool_.size() > 0) {
+        c.statistical_burst = dt * rms(pool_.bursts().back().node.se);
+        c.statistical_pool = dt * rms(pool_.estimate(pool_.size()).node.se);
+    }
+}
+
+double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec,
+                                              const JumpBasis& basis) const {
+    const DtPlan p = controller_.plan({.model = basis.model(t_end_, prior_curvature()),
                                        .decay = decay_,
                                        .hold = hold_kind_,
                                        .hold_message = hold_,
@@ -218,9 +253,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     // The jump starts from the end of the last accepted burst, with its slope(s).
     rec.t_end = t_end_;
     rec.x_end = x_end_;
-    rec.slope = history_.back().slope;
-    rec.slope_standard_error = history_.back().se;
-    const std::vector<SlopeNode> nodes = method_nodes();
+    const JumpBasis basis = jump_basis();
+    const std::vector<SlopeNode>& nodes = basis.nodes;
+    rec.slope = nodes.back().slope;
+    rec.slope_standard_error = nodes.back().se;
     c.steps = static_cast<int>(nodes.size());
     const long attempt = totals_.attempts + totals_.direct + 1;
     const bool forced_shrink =
@@ -228,10 +264,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     const bool forced_reject =
         settings_.force.kind == ForcedDecision::Kind::reject && settings_.force.attempt == attempt;
 
-    rec.dt_requested = plan_dt(rec);
+    rec.dt_requested = plan_dt(rec, basis);
     if (forced_shrink) {  // as if a jump of the planned DT had been rejected (tests)
         controller_.jump_failed(rec.dt_requested);
-        rec.dt_requested = plan_dt(rec);
+        rec.dt_requested = plan_dt(rec, basis);
         append_message(rec, "DT halved (forced)");
     }
     rec.dt = rec.dt_requested;
@@ -247,11 +283,8 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     ++totals_.attempts;
 
     const std::vector<double> w = projection_weights(nodes, t_end_, rec.dt);
-    const JumpErrorModel prior{nodes, t_end_, prior_curvature(), 1.0};
-    c.predicted_truncation = jump_error(prior, rec.dt).truncation;
-    const Eigen::VectorXd stat = statistical_error(nodes, w);
-    c.statistical_nodes = stat;
-    c.statistical = rms(stat);
+    c.predicted_truncation = jump_error(basis.model(t_end_, prior_curvature()), rec.dt).truncation;
+    record_statistical(c, basis, rec.dt);
     Eigen::VectorXd x = x_end_ + projected_increment(nodes, w);
     if (!repair_projection(rec, x, repair_)) {
         controller_.jump_failed(rec.dt);  // the next attempt jumps less far
@@ -283,13 +316,19 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     c.truncation = d.norm * omega;
     c.truncation_nodes = d.value.cwiseAbs() * omega;
 
-    const JumpErrorModel posterior{nodes, t_end_, d.norm, 1.0};
+    const JumpErrorModel posterior = basis.model(t_end_, d.norm);
     const JumpVerdict verdict =
         controller_.judge(rec.dt, {c.statistical, c.truncation}, posterior, forced_reject);
     if (verdict.accepted) {
         if (settings_.adaptive) stepper.confirm_kept_state();
         if (!verdict.message.empty()) append_message(rec, verdict.message);
         c.accepted = true;
+        // The jump's slope noise is now in the state (before the new burst joins the pool).
+        if (basis.committed.size()) {
+            pool_.commit(basis.pooled, rec.dt);
+        } else if (settings_.steps == 1 && pool_.size() > 0) {
+            pool_.commit(pool_.estimate(1), rec.dt);
+        }
         accept_burst(m);
         ++totals_.accepted;
         totals_.dt_taken += rec.dt;
@@ -347,12 +386,14 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.hold = hold_;
     s.controller = controller_.state();
     s.totals = totals_;
+    s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
     return s;
 }
 
 void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) {
     history_.clear();
     curvature_only_front_ = false;
+    pool_.restore({});
     if (!state) return;  // nothing saved: as new
     const MultistepState& s = *state;
     EFDEM_EXPECTS(s.history.size() <= static_cast<std::size_t>(settings_.steps) + 1);
@@ -365,6 +406,10 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     hold_ = s.hold;
     controller_.restore(s.controller);
     totals_ = s.totals;
+    // A restart with a smaller cpi.pool keeps the newest bursts.
+    const std::size_t skip =
+        s.pool.size() > pool_.capacity() ? s.pool.size() - pool_.capacity() : 0;
+    pool_.restore({s.pool.begin() + static_cast<std::ptrdiff_t>(skip), s.pool.end()});
 }
 
 }  // namespace efdem::coarse

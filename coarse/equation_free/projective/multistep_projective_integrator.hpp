@@ -35,6 +35,7 @@
 #include <string_view>
 #include <vector>
 
+#include "coarse/equation_free/estimators/slope_pool.hpp"
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/projective_integrator.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
@@ -67,11 +68,18 @@ struct MultistepSettings {
     /// still in a fast transient: no jump from it (phase_drift.hpp) [unit per sqrt(d_p/g)].
     /// Infinite: no check. From a scene: steady_drift_rate() (cpi_settings.hpp).
     double drift_rate = std::numeric_limits<double>::infinity();
+    /// Where the jump's slope comes from (cpi.slope): the last burst's, or pooled over the last
+    /// `pool` accepted bursts (fewer at the start; slope_pool.hpp; forward Euler only), its
+    /// statistical error charged as the growth of the accumulated error (the pooled jumps'
+    /// errors are correlated).
+    SlopeSource slope = SlopeSource::burst;
+    std::size_t pool = 4;  ///< cpi.pool: bursts a pooled slope uses (>= 1)
 };
 
 class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
   public:
-    /// \pre burst.healing >= 0, burst.window > 0, steps in {1, 2}; adaptive: 0 < dt_min <=
+    /// \pre burst.healing >= 0, burst.window > 0, steps in {1, 2}, pooled slopes with steps = 1
+    ///      and pool >= 1; adaptive: 0 < dt_min <=
     ///      dt_max finite, tolerance > 0, safety in (0, 1], growth > 1, max_rejections >= 0;
     ///      else dt >= 0.
     explicit MultistepProjectiveIntegrator(const MultistepSettings& settings,
@@ -118,8 +126,22 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// The method's nodes (q_eff of them) and the error model of the next jump.
     std::vector<SlopeNode> method_nodes() const;
     double prior_curvature() const;
+    /// What the next jump projects from: the method's nodes (cpi.slope = burst), or one pooled
+    /// node with the covariance of its noise with the state's (pooled).
+    struct JumpBasis {
+        std::vector<SlopeNode> nodes;
+        Eigen::VectorXd committed;  ///< empty: no burst reused
+        PooledSlope pooled;         ///< the estimate it was made from (pooled.bursts() = m)
+        JumpErrorModel model(double t0, double curvature) const {
+            return {nodes, t0, curvature, 1.0, committed};
+        }
+    };
+    JumpBasis jump_basis() const;
     /// Asks the controller for the next DT and writes its plan into `rec`; returns DT.
-    double plan_dt(ProjectiveStepRecord& rec) const;
+    double plan_dt(ProjectiveStepRecord& rec, const JumpBasis& basis) const;
+    /// The record's statistical parts of a jump of `dt`: charged, the jump's own, and what one
+    /// burst's slope and the whole pool would have given (ControllerRecord).
+    void record_statistical(ControllerRecord& c, const JumpBasis& basis, double dt) const;
 
     MultistepSettings settings_;
     RepairHook repair_;
@@ -132,6 +154,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     std::string hold_;                   ///< why no jump may start from it (empty: one may)
     DtLimit hold_kind_ = DtLimit::none;  ///< fast_transient or in_phase_wave (none: one may)
     StepSizeController controller_;      ///< every rule on DT: plan, caps, accept/reject, redo
+    /// The accepted bursts' slopes and their commitments (kept with cpi.slope = burst too, to
+    /// record what pooling would have given).
+    SlopePool pool_;
     Totals totals_;
 };
 

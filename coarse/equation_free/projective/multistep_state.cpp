@@ -9,13 +9,18 @@ namespace {
 bool same(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     return a.size() == b.size() && (a.array() == b.array()).all();
 }
+
+bool same(const SlopeNode& a, const SlopeNode& b) {
+    return a.tau == b.tau && same(a.slope, b.slope) && same(a.se, b.se);
+}
 }  // namespace
 
 bool MultistepState::operator==(const MultistepState& o) const {
-    if (history.size() != o.history.size()) return false;
+    if (history.size() != o.history.size() || pool.size() != o.pool.size()) return false;
     for (std::size_t i = 0; i < history.size(); ++i)
-        if (history[i].tau != o.history[i].tau || !same(history[i].slope, o.history[i].slope) ||
-            !same(history[i].se, o.history[i].se))
+        if (!same(history[i], o.history[i])) return false;
+    for (std::size_t i = 0; i < pool.size(); ++i)
+        if (!same(pool[i].node, o.pool[i].node) || pool[i].commitment != o.pool[i].commitment)
             return false;
     const DecayRateEstimate &d = decay, &e = o.decay;
     const MultistepTotals &t = totals, &u = o.totals;

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "coarse/equation_free/estimators/slope_pool.hpp"
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
@@ -40,6 +41,10 @@ struct MultistepState {
     std::string hold;                   ///< why (empty: a jump may start there)
     StepSizeState controller;           ///< last kept DT, the rejection cap, rejections in a row
     MultistepTotals totals;
+    /// The slope pool (slope_pool.hpp): the last accepted bursts' slopes, oldest first, and how
+    /// much of each one's noise the kept jumps put into the state. Empty in checkpoints written
+    /// before it (formats 1-3 and early format 4): pooling then starts afresh.
+    std::vector<PooledBurst> pool;
 
     /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
     bool operator==(const MultistepState& other) const;

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/estimators/slope_pool.hpp"
 #include "coarse/equation_free/projective/multistep_state.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
@@ -58,12 +59,22 @@ struct BurstSettings {
 /// the ICDF]; per-component vectors in the same unit.
 struct ControllerRecord {
     static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-    bool active = false;                ///< the step was made by the multistep integrator
-    bool adaptive = false;              ///< DT chosen by the controller (else fixed)
-    int steps = 0;                      ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
-    double tolerance = nan;             ///< cpi.tolerance (NaN when fixed)
-    bool accepted = false;              ///< the jump was kept
-    double statistical = nan;           ///< projection noise of the jump
+    bool active = false;     ///< the step was made by the multistep integrator
+    bool adaptive = false;   ///< DT chosen by the controller (else fixed)
+    int steps = 0;           ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
+    double tolerance = nan;  ///< cpi.tolerance (NaN when fixed)
+    bool accepted = false;   ///< the jump was kept
+    /// Projection noise the budget charges: the growth of the accumulated error's standard
+    /// deviation (slope_pool.hpp; with the last burst's slope, DT x its standard error).
+    double statistical = nan;
+    /// The jump's own scatter, DT x the standard error of the slope it used (RMS); equal to
+    /// `statistical` unless a pooled slope reused bursts earlier jumps used.
+    double statistical_jump = nan;
+    /// What the last burst's slope alone, and the whole pool (cpi.pool bursts, inverse-variance
+    /// weights), would have given as the jump's own scatter at the same DT (RMS).
+    double statistical_burst = nan, statistical_pool = nan;
+    SlopeSource slope_source = SlopeSource::burst;  ///< cpi.slope of the jump
+    int pooled_bursts = 0;                          ///< bursts the slope used (1: the last one)
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
     Eigen::VectorXd statistical_nodes;  ///< per component

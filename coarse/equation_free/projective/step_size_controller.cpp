@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "coarse/equation_free/estimators/slope_estimators.hpp"
+#include "coarse/equation_free/estimators/slope_pool.hpp"
 #include "coarse/equation_free/projective/projective_integrator.hpp"
 #include "coarse/equation_free/projective/projective_stability.hpp"
 #include "core/contracts.hpp"
@@ -18,7 +19,14 @@ JumpError jump_error(const JumpErrorModel& model, double dt) {
     EFDEM_EXPECTS(dt >= 0.0 && !model.nodes.empty());
     const std::vector<double> w = projection_weights(model.nodes, model.t0, dt);
     JumpError e;
-    e.statistical = model.se_scale * rms(statistical_error(model.nodes, w));
+    if (model.committed.size() == 0) {
+        e.statistical = model.se_scale * rms(statistical_error(model.nodes, w));
+    } else {
+        EFDEM_EXPECTS(model.nodes.size() == 1 &&
+                      model.committed.size() == model.nodes.front().se.size());
+        e.statistical =
+            model.se_scale * rms(charged_error(model.nodes.front().se, model.committed, w[0]));
+    }
     if (std::isfinite(model.curvature))
         e.truncation = model.curvature * omega_integral(model.nodes, model.t0, dt);
     return e;

@@ -22,6 +22,8 @@
 #include <string_view>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 
@@ -37,11 +39,15 @@ struct JumpErrorModel {
     double curvature = std::numeric_limits<double>::quiet_NaN();
     /// Factor on every standard error: 1/sqrt(k) for k times the realizations.
     double se_scale = 1.0;
+    /// A pooled slope (one node, slope_pool.hpp): c, the covariance per unit DT of its noise
+    /// with the noise earlier jumps put into the state; the statistical part is then the
+    /// growth of the accumulated error, sqrt(DT^2 se^2 + 2 DT c). Empty: no reuse (c = 0).
+    Eigen::VectorXd committed;
 };
 
 /// The two parts of a jump's error (RMS over components).
 struct JumpError {
-    double statistical = 0.0;  ///< RMS of sqrt(sum_k W_k^2 se_k^2)
+    double statistical = 0.0;  ///< RMS of sqrt(sum_k W_k^2 se_k^2 (+ 2 W c, pooled))
     double truncation = 0.0;   ///< |D| |integral omega|
     double total() const { return statistical + truncation; }
 };
