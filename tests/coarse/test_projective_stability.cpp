@@ -4,10 +4,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "coarse/equation_free/projective/projective_stability.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
+#include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem::coarse;
 
@@ -170,4 +172,47 @@ TEST_CASE("the monitor flags a decaying mode inside case (a)'s unstable band", "
     CHECK_FALSE(unknown.assessed);
     CHECK(unknown.stable);
     CHECK_THAT(unknown.message, Catch::Contains("not assessed"));
+}
+
+namespace {
+/// Over `bursts` bursts of length 10 of the OU toy (8 members, 19 components, sampled every
+/// 0.1), the share whose window-half decay rate is negative, and the share of those resolved
+/// above the members' noise.
+std::pair<double, double> decay_shares(double rate, int bursts) {
+    const Eigen::VectorXd k = Eigen::VectorXd::Constant(19, rate);
+    efdem::test::OuEnsembleStepper toy(k, 0.05, 8, 0.1, Eigen::VectorXd::Constant(19, 3.0), 7);
+    int negative = 0, resolved = 0;
+    for (int b = 0; b < bursts; ++b) {
+        BurstSamples s;
+        const double t0 = toy.time();
+        toy.run(10.0, s);
+        const DecayRateEstimate d = estimate_decay_rate(s.t, s.x, t0);
+        if (!d.ok || d.rate >= 0.0) continue;
+        ++negative;
+        const DecayResolution r = decay_resolution(s.t, s.members, t0);
+        REQUIRE(r.measured);
+        resolved += r.resolved;
+    }
+    return {static_cast<double>(negative) / bursts,
+            negative ? static_cast<double>(resolved) / negative : 0.0};
+}
+}  // namespace
+
+TEST_CASE("a decay rate read from the members' noise is not resolved; a real transient is",
+          "[unit][coarse][stability]") {
+    // Noise alone (k = 1e-4: the mean's slope is constant over a burst): the two halves' slopes
+    // differ by chance, so about half of the bursts show a "decaying" rate (which would halve
+    // DT). chi2/n over 19 components exceeds 1 + 3 sqrt(2/19) by chance rarely (3 standard
+    // deviations; the members' standard errors from 8 members fatten the tail): at most 8 %.
+    const auto [noise_negative, noise_resolved] = decay_shares(1e-4, 200);
+    INFO("noise: negative rate in " << noise_negative << ", resolved " << noise_resolved);
+    CHECK(noise_negative > 0.25);
+    CHECK(noise_resolved < 0.08);
+    // A real transient, dX/dt = -0.1 X from X = 3: the slope falls by e^(-0.5) across the
+    // halves, 0.06 per unit time against a noise of ~0.01: resolved in (almost) every burst
+    // while it lasts (the first 10 bursts; later the mean has decayed into the noise).
+    const auto [fast_negative, fast_resolved] = decay_shares(0.1, 3);
+    INFO("transient: negative rate in " << fast_negative << ", resolved " << fast_resolved);
+    CHECK(fast_negative == 1.0);
+    CHECK(fast_resolved == 1.0);
 }

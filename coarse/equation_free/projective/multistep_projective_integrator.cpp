@@ -115,6 +115,18 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     }
     out.node.tau = slope.t_mean;
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
+    if (settings_.adaptive && out.decay.ok && out.decay.rate < 0.0) {
+        // A decay rate read from noise would halve DT for nothing (the slope's halves differ by
+        // chance): only a change of slope beyond the members' spread counts.
+        const DecayResolution res = decay_resolution(rec.burst.t, rec.burst.members, t_window);
+        if (res.measured && !res.resolved) {
+            out.decay.ok = false;
+            out.decay.message = fmt::format(
+                "the slope's change between the window's halves is within the realizations' "
+                "noise (chi2/n = {:.3g} <= {:.3g}): the decay rate {:.3g} is not resolved",
+                res.chi2, res.threshold, out.decay.rate);
+        }
+    }
     if (settings_.adaptive && std::isfinite(settings_.drift_rate)) {
         // No jump from a slope that is not the slow dynamics': a fast transient, or a wave
         // the realizations share that the window does not average out.

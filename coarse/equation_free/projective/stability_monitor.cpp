@@ -1,6 +1,8 @@
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -32,30 +34,79 @@ DecayRateEstimate decay_rate_from_slopes(const Eigen::VectorXd& early, const Eig
     return est;
 }
 
+namespace {
+/// The two halves of the window t >= t_start: [t_first, t_mid] (samples before early_end) and
+/// [t_mid, t_last]; a sample at t_mid belongs to both. Not ok with fewer than 4 samples.
+struct Halves {
+    bool ok = false;
+    std::size_t first = 0, early_end = 0;
+    double t_mid = 0.0;
+};
+
+Halves window_halves(std::span<const double> t, double t_start) {
+    Halves h;
+    h.first = first_sample_at_or_after(t, t_start);
+    if (t.size() < h.first + 4) return h;
+    h.t_mid = 0.5 * (t[h.first] + t.back());
+    const std::size_t late_first = first_sample_at_or_after(t, h.t_mid);
+    h.early_end = t[late_first] <= h.t_mid + time_tolerance(h.t_mid) ? late_first + 1 : late_first;
+    h.ok = true;
+    return h;
+}
+}  // namespace
+
 DecayRateEstimate estimate_decay_rate(std::span<const double> t, std::span<const Eigen::VectorXd> x,
                                       double t_start) {
     EFDEM_EXPECTS(x.size() == t.size());
-    const std::size_t first = first_sample_at_or_after(t, t_start);
+    const Halves h = window_halves(t, t_start);
     DecayRateEstimate est;
-    if (t.size() < first + 4) {
+    if (!h.ok) {
         est.message =
             fmt::format("the window t >= {:.6g} holds {} samples; the decay-rate estimate needs 4",
-                        t_start, t.size() - first);
+                        t_start, t.size() - std::min(h.first, t.size()));
         return est;
     }
-    const double t_mid = 0.5 * (t[first] + t.back());
-    // Halves [t_first, t_mid] and [t_mid, t_last]; a sample at t_mid belongs to both.
-    const std::size_t late_first = first_sample_at_or_after(t, t_mid);
-    const std::size_t early_end =
-        t[late_first] <= t_mid + time_tolerance(t_mid) ? late_first + 1 : late_first;
     const SlopeEstimate early =
-        least_squares_slope(t.first(early_end), x.first(early_end), t_start);
-    const SlopeEstimate late = least_squares_slope(t, x, t_mid);
+        least_squares_slope(t.first(h.early_end), x.first(h.early_end), t_start);
+    const SlopeEstimate late = least_squares_slope(t, x, h.t_mid);
     if (!early.ok || !late.ok) {
         est.message = !early.ok ? early.message : late.message;
         return est;
     }
-    return decay_rate_from_slopes(early.slope, late.slope, t_mid - t[first]);
+    return decay_rate_from_slopes(early.slope, late.slope, h.t_mid - t[h.first]);
+}
+
+DecayResolution decay_resolution(std::span<const double> t,
+                                 std::span<const Eigen::MatrixXd> members, double t_start) {
+    DecayResolution r;
+    const Halves h = window_halves(t, t_start);
+    if (!h.ok || members.size() != t.size()) return r;
+    const Eigen::MatrixXd early =
+        member_least_squares_slopes(t.first(h.early_end), members.first(h.early_end), t_start);
+    const Eigen::MatrixXd late = member_least_squares_slopes(t, members, h.t_mid);
+    if (early.rows() < 2 || late.rows() != early.rows()) return r;
+    // Each member's change of slope between the halves; the ensemble's change and its standard
+    // error from the members' spread.
+    const Eigen::MatrixXd change = late - early;
+    const Eigen::VectorXd mean = change.colwise().mean().transpose();
+    const Eigen::VectorXd se = slope_standard_error(change);
+    double chi2 = 0.0;
+    for (Eigen::Index i = 0; i < mean.size(); ++i) {
+        if (se[i] > 0.0) {
+            chi2 += (mean[i] / se[i]) * (mean[i] / se[i]);
+        } else if (mean[i] != 0.0) {  // no noise at all: any change is resolved
+            r.measured = true;
+            r.resolved = true;
+            r.chi2 = std::numeric_limits<double>::infinity();
+            return r;
+        }
+    }
+    const auto n = static_cast<double>(mean.size());
+    r.measured = true;
+    r.chi2 = chi2 / n;
+    r.threshold = 1.0 + 3.0 * std::sqrt(2.0 / n);
+    r.resolved = r.chi2 > r.threshold;
+    return r;
 }
 
 DecayRateEstimate estimate_decay_rate_periodic(std::span<const double> t,

@@ -60,6 +60,28 @@ DecayRateEstimate decay_rate_from_slopes(const Eigen::VectorXd& early, const Eig
 DecayRateEstimate estimate_decay_rate(std::span<const double> t, std::span<const Eigen::VectorXd> x,
                                       double t_start);
 
+/// Whether the change of slope between the window's halves, which estimate_decay_rate() turns
+/// into lambda, stands above the realizations' noise.
+struct DecayResolution {
+    bool measured = false;  ///< false: no members, or too few samples (nothing said)
+    bool resolved = false;
+    /// Mean over the components of (change / its standard error)^2: ~1 for noise alone.
+    double chi2 = std::numeric_limits<double>::quiet_NaN();
+    /// 1 + 3 sqrt(2/n): three standard deviations of chi2/n for noise alone (n components).
+    double threshold = std::numeric_limits<double>::quiet_NaN();
+};
+
+/**
+ * \brief Every member's least-squares slopes over the same two halves of the window t >= t_start
+ *        as estimate_decay_rate(); the ensemble's change of slope s_late - s_early per component
+ *        against its standard error from the members' own changes. Resolved when
+ *        chi2 = mean_i (change_i / se_i)^2 exceeds 1 + 3 sqrt(2/n); a rate from an unresolved
+ *        change is the noise's, and must not shorten DT (docs/stability.md).
+ * \pre t strictly increasing; members one R x dim matrix per sample (else not measured).
+ */
+DecayResolution decay_resolution(std::span<const double> t,
+                                 std::span<const Eigen::MatrixXd> members, double t_start);
+
 /**
  * \brief lambda from period-mean slopes of the last two and the two periods before, for
  *        oscillating bursts: delay = T. Needs three periods in [t_start, t_end]; not ok
