@@ -123,8 +123,8 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
             out.decay.ok = false;
             out.decay.message = fmt::format(
                 "the slope's change between the window's halves is within the realizations' "
-                "noise (chi2/n = {:.3g} <= {:.3g}): the decay rate {:.3g} is not resolved",
-                res.chi2, res.threshold, out.decay.rate);
+                "noise (S = {:.3g} <= {:.3g}): the decay rate {:.3g} is not resolved",
+                res.statistic, res.threshold, out.decay.rate);
         }
     }
     if (settings_.adaptive && std::isfinite(settings_.drift_rate)) {

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/equation_free/estimators/mean_significance.hpp"
 #include "coarse/equation_free/estimators/slope_estimators.hpp"
 #include "core/contracts.hpp"
 
@@ -85,27 +86,13 @@ DecayResolution decay_resolution(std::span<const double> t,
         member_least_squares_slopes(t.first(h.early_end), members.first(h.early_end), t_start);
     const Eigen::MatrixXd late = member_least_squares_slopes(t, members, h.t_mid);
     if (early.rows() < 2 || late.rows() != early.rows()) return r;
-    // Each member's change of slope between the halves; the ensemble's change and its standard
-    // error from the members' spread.
-    const Eigen::MatrixXd change = late - early;
-    const Eigen::VectorXd mean = change.colwise().mean().transpose();
-    const Eigen::VectorXd se = slope_standard_error(change);
-    double chi2 = 0.0;
-    for (Eigen::Index i = 0; i < mean.size(); ++i) {
-        if (se[i] > 0.0) {
-            chi2 += (mean[i] / se[i]) * (mean[i] / se[i]);
-        } else if (mean[i] != 0.0) {  // no noise at all: any change is resolved
-            r.measured = true;
-            r.resolved = true;
-            r.chi2 = std::numeric_limits<double>::infinity();
-            return r;
-        }
-    }
-    const auto n = static_cast<double>(mean.size());
-    r.measured = true;
-    r.chi2 = chi2 / n;
-    r.threshold = 1.0 + 3.0 * std::sqrt(2.0 / n);
-    r.resolved = r.chi2 > r.threshold;
+    // Each member's change of slope between the halves: is the ensemble's change above the
+    // members' scatter?
+    const MeanSignificance m = mean_significance(late - early);
+    r.measured = m.measured;
+    r.resolved = m.resolved;
+    r.statistic = m.statistic;
+    r.threshold = m.threshold;
     return r;
 }
 

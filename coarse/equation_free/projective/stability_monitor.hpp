@@ -65,18 +65,17 @@ DecayRateEstimate estimate_decay_rate(std::span<const double> t, std::span<const
 struct DecayResolution {
     bool measured = false;  ///< false: no members, or too few samples (nothing said)
     bool resolved = false;
-    /// Mean over the components of (change / its standard error)^2: ~1 for noise alone.
-    double chi2 = std::numeric_limits<double>::quiet_NaN();
-    /// 1 + 3 sqrt(2/n): three standard deviations of chi2/n for noise alone (n components).
+    /// sum_i change_i^2 / sum_i se_i^2 (estimators/mean_significance.hpp): ~1 for noise alone.
+    double statistic = std::numeric_limits<double>::quiet_NaN();
+    /// Three standard deviations above 1 for noise alone (mean_significance.hpp).
     double threshold = std::numeric_limits<double>::quiet_NaN();
 };
 
 /**
  * \brief Every member's least-squares slopes over the same two halves of the window t >= t_start
- *        as estimate_decay_rate(); the ensemble's change of slope s_late - s_early per component
- *        against its standard error from the members' own changes. Resolved when
- *        chi2 = mean_i (change_i / se_i)^2 exceeds 1 + 3 sqrt(2/n); a rate from an unresolved
- *        change is the noise's, and must not shorten DT (docs/stability.md).
+ *        as estimate_decay_rate(); the ensemble's change of slope s_late - s_early against its
+ * standard error from the members' own changes (mean_significance()). A rate from an unresolved
+ *        change is the noise's, and must not shorten DT (docs/error_control.md §4).
  * \pre t strictly increasing; members one R x dim matrix per sample (else not measured).
  */
 DecayResolution decay_resolution(std::span<const double> t,
