@@ -75,7 +75,8 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
         return nodes;
     };
     s.history = read_nodes("history");
-    if (f.exists(g + "pool/tau")) {  // written since cpi.slope = pooled
+    if (f.exists(g + "healing")) s.healing = real("healing");  // since cpi.healing_auto
+    if (f.exists(g + "pool/tau")) {                            // written since cpi.slope = pooled
         std::vector<coarse::SlopeNode> nodes = read_nodes("pool");
         const std::vector<double> commitment = values("pool/commitment", nodes.size());
         for (std::size_t i = 0; i < nodes.size(); ++i)

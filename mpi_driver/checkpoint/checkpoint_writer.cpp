@@ -79,6 +79,7 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
     real("totals/dt_tolerance_4r", t.dt_tolerance_4r);
     real("totals/statistical", t.statistical);
     real("totals/truncation", t.truncation);
+    real("healing", s.healing);
 }
 }  // namespace
 

@@ -28,6 +28,7 @@ std::map<std::string, std::string> parse_lines(const std::string& text) {
 constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.slope", "burst"},  // cpi.slope = pooled (issue 33)
     {"cpi.pool", "4"},       // read only with cpi.slope = pooled
+    {"cpi.healing_auto", "false"},
 };
 // clang-format on
 

@@ -1,5 +1,7 @@
 #include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 
+#include <cmath>
+
 #include <cctype>
 
 #include <fmt/format.h>
@@ -49,7 +51,9 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
     for (double d : {t.dt_taken, t.dt_tolerance, t.dt_tolerance_2r, t.dt_tolerance_4r,
                      t.statistical, t.truncation})
         h = hash_value(d, h);
-    if (s.pool.empty()) return h;  // written before the pool: the checksum it was written with
+    // Written before cpi.healing_auto / the pool: the checksum such a file was written with.
+    if (!std::isnan(s.healing)) h = hash_value(s.healing, h);
+    if (s.pool.empty()) return h;
     h = hash_value(static_cast<std::uint64_t>(s.pool.size()), h);
     for (const coarse::PooledBurst& b : s.pool) {
         h = hash_value(b.node.tau, h);

@@ -21,7 +21,8 @@
 ///                           totals/{attempts, accepted, rejected, direct, dt_taken,
 ///                           dt_tolerance, dt_tolerance_2r, dt_tolerance_4r, statistical,
 ///                           truncation}; pool/{tau, slope, se, commitment} (n, n x m,
-///                           n x m, n: the slope pool; absent in files written before it)
+///                           n x m, n: the slope pool; absent in files written before it);
+///                           healing (the next burst's, cpi.healing_auto; absent before it)
 ///                           (coarse::MultistepState)
 ///   /driver/integrator, /driver/integrator_text   formats 2 and 3: the same state as a
 ///                           positional vector and three lines of text

@@ -272,6 +272,8 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
             {"error_statistical_burst", c.statistical_burst},
             {"error_statistical_pool", c.statistical_pool},
             {"error_truncation", c.truncation},
+            {"transient", c.transient},
+            {"transient_threshold", c.transient_threshold},
             {"predicted_truncation", c.predicted_truncation},
             {"dt_tolerance", c.dt_tolerance},
             {"dt_tolerance_2r", c.dt_tolerance_2r},

@@ -36,8 +36,24 @@ same_output() {  # same_output PREFIX_A PREFIX_B [--ignore DATASET...]
   /usr/bin/python3 "$here/compare_runs.py" "$work/$1.h5" "$work/$2.h5" "${@:3}"
   for csv in _mean_icdf.csv _cpi_steps.csv; do
     [ -f "$work/$1$csv" ] || continue
-    cmp -s "$work/$1$csv" "$work/$2$csv" \
-      || { echo "FAIL: $2$csv differs from $1$csv"; exit 1; }
+    if [ $# -gt 2 ] && [ "$csv" = _cpi_steps.csv ]; then
+      # The CSV columns of the ignored datasets (cpi/NAME -> column NAME) are left out.
+      /usr/bin/python3 - "$work/$1$csv" "$work/$2$csv" "${@:4}" <<'EOF' \
+        || { echo "FAIL: $2$csv differs from $1$csv beyond the ignored columns"; exit 1; }
+import csv, sys
+drop = {name.split("/")[-1] for name in sys.argv[3:]}
+def rows(path):
+    with open(path) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    table = list(csv.reader(lines))
+    keep = [i for i, name in enumerate(table[0]) if name not in drop]
+    return [[row[i] for i in keep] for row in table]
+sys.exit(0 if rows(sys.argv[1]) == rows(sys.argv[2]) else 1)
+EOF
+    else
+      cmp -s "$work/$1$csv" "$work/$2$csv" \
+        || { echo "FAIL: $2$csv differs from $1$csv"; exit 1; }
+    fi
   done
 }
 
@@ -69,9 +85,15 @@ checks = {
     "controller/dt_last": same(g["controller/dt_last"][()], [r[4]]),
     "controller/dt_cap": same(g["controller/dt_cap"][()], [r[5]]),
     "controller/consecutive_rejections": int(g["controller/consecutive_rejections"][0]) == r[6],
-    "decay/ok": int(g["decay/ok"][0]) == r[7],
     "decay/rate,ratio,delay": same([g["decay/rate"][0], g["decay/ratio"][0], g["decay/delay"][0]], r[8:11]),
-    "decay/message": g["decay/message"][()].decode() == decay_message,
+}
+# Since 15fd576 a decay rate within the realizations' noise is kept but marked not ok (it no longer
+# halves DT); the format-3 file was written before that. Same rate: the flag and message agree, or
+# the new one says why the rate is not used.
+new_message = g["decay/message"][()].decode()
+checks["decay/ok, message"] = (int(g["decay/ok"][0]) == r[7] and new_message == decay_message) or \
+    (int(g["decay/ok"][0]) == 0 and r[7] == 1 and "is not resolved" in new_message)
+checks |= {
     "hold_kind": g["hold_kind"][()].decode() == hold_kind,
     "hold": g["hold"][()].decode() == hold,
     "x_end": same(g["x_end"][()], r[11:11 + m]),
@@ -105,11 +127,16 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
   run 2 "$work/$kind-f$version.log" "$@" "$efdem" "$scene" "${overrides[@]}" ensemble.realizations_per_rank=2 \
     output.directory="$work" output.prefix=$kind-f$version restart="$file"
   grep -q "restarted from" "$work/$kind-f$version.log" || { echo "FAIL: no restart in $kind-f$version.log"; exit 1; }
-  # The slope pool's records (issue 33) came after formats 1-3: the run file stored in such a
-  # checkpoint has no rows of them before the restart.
+  # The slope pool's and the healing evidence's records (issue 33) came after formats 1-3: the run
+  # file stored in such a checkpoint has no rows of them before the restart. And a format-3 state
+  # carries the decay verdict of the code that wrote it (before 15fd576), which assesses the
+  # first step's stability from a rate the current code counts as noise: that step's stability
+  # record differs, its DT and every sample do not (compared).
   ignore=()
   [ "$version" = 4 ] || ignore=(--ignore cpi/controller/error_statistical_jump cpi/controller/error_statistical_burst
-                                cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts)
+                                cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts
+                                cpi/controller/transient cpi/controller/transient_threshold
+                                cpi/stability_assessed cpi/stability_rate cpi/stability_amplification)
   same_output $kind-ref $kind-f$version "${ignore[@]}"
   echo "PASS: $kind run restarted from a format-$version checkpoint ($(basename "$file")) equals the uninterrupted run"
 done

@@ -87,6 +87,17 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                  "pooled pools the bursts' slopes into one forward-Euler slope; it does not "
                  "combine with cpi.integrator = adams_bashforth2",
                  "burst with adams_bashforth2; pooled with cpi.integrator = euler");
+    m.healing_auto = cpi.get_or<bool>("healing_auto", false);
+    if (m.healing_auto && s.projection == Projection::periods)
+        cpi.fail("healing_auto",
+                 "is read with cpi.projection = fixed or adaptive; periods sizes its bursts by the "
+                 "period",
+                 "false with cpi.projection = periods");
+    // The shortest healing: a tenth of the burst, on the sampling grid, at least one sample.
+    m.healing_min = std::min(
+        healing,
+        std::max(sample_interval,
+                 std::floor(0.1 * (healing + window) / sample_interval + 1e-9) * sample_interval));
     if (m.slope == SlopeSource::pooled && s.projection == Projection::periods)
         cpi.fail("slope",
                  "pooled is read with cpi.projection = fixed or adaptive; periods takes period "
@@ -155,7 +166,8 @@ double CpiSettings::window() const {
 
 std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {
     if (projection == Projection::adaptive ||
-        (projection == Projection::fixed && (steps == 2 || multistep.slope == SlopeSource::pooled)))
+        (projection == Projection::fixed &&
+         (steps == 2 || multistep.slope == SlopeSource::pooled || multistep.healing_auto)))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
     if (projection == Projection::fixed)
         return std::make_unique<ProjectiveForwardEuler>(fixed, std::move(repair));

@@ -29,6 +29,8 @@
 /// |                   | mean of the last cpi.pool bursts', estimators/slope_pool.hpp; |         |
 /// |                   | euler, fixed or adaptive)                                     |         |
 /// | cpi.pool          | pooled: the last bursts one slope pools (1..64)               | 4       |
+/// | cpi.healing_auto  | heal for cpi.healing only while bursts after a lift show a    | false   |
+/// |                   | transient, else for a tenth of the burst (post_lift_transient) |         |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance

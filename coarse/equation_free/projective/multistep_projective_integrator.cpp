@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "coarse/equation_free/estimators/phase_drift.hpp"
+#include "coarse/equation_free/estimators/post_lift_transient.hpp"
 #include "coarse/equation_free/estimators/slope_estimators.hpp"
 #include "coarse/equation_free/projective/projective_jump.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
@@ -60,12 +61,30 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
                                 .dt_quantum = settings.dt_quantum,
                                 .burst = settings.burst.healing + settings.burst.window,
                                 .window = settings.burst.window}),
-      pool_(std::max<std::size_t>(settings.pool, 1)) {
+      pool_(std::max<std::size_t>(settings.pool, 1)),
+      healing_(settings.burst.healing) {
     EFDEM_EXPECTS(std::isfinite(settings.burst.healing) && settings.burst.healing >= 0.0);
     EFDEM_EXPECTS(std::isfinite(settings.burst.window) && settings.burst.window > 0.0);
     EFDEM_EXPECTS(settings.steps == 1 || settings.steps == 2);
     EFDEM_EXPECTS(settings.pool >= 1);
     EFDEM_EXPECTS(settings.slope == SlopeSource::burst || settings.steps == 1);
+    EFDEM_EXPECTS(!settings.healing_auto ||
+                  (settings.healing_min >= 0.0 && settings.healing_min <= settings.burst.healing));
+}
+
+double MultistepProjectiveIntegrator::window() const {
+    return settings_.burst.healing + settings_.burst.window - healing_;
+}
+
+void MultistepProjectiveIntegrator::judge_healing(const BurstSamples& burst, double t_lift,
+                                                  ControllerRecord& c) {
+    if (!settings_.healing_auto) return;
+    const MeanSignificance e = post_lift_transient(burst.t, burst.members, t_lift);
+    c.transient = e.statistic;
+    c.transient_threshold = e.threshold;
+    if (!e.measured) return;
+    // A transient measured: the whole healing; none: the shortest (its lower bound).
+    healing_ = e.resolved ? settings_.burst.healing : settings_.healing_min;
 }
 
 std::string_view MultistepProjectiveIntegrator::name() const {
@@ -91,8 +110,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     rec.t_end = origin_t;
     rec.x_end = std::move(origin_x);
     if (!valid) return false;
-    const double t_window =
-        t_start + length - settings_.burst.window;  // the last `window` of the burst
+    const double t_window = t_start + length - window();  // the last `window` of the burst
     WindowFit fit = fit_window(rec.burst, t_window, rec.burst.t.size());
     const SlopeEstimate& slope = fit.slope;
     if (!slope.ok) {
@@ -135,13 +153,13 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         if (d.drifting) {
             out.hold_kind = DtLimit::fast_transient;
             out.hold = "still in a fast transient (" + d.message + ")";
-        } else if (w.in_phase && settings_.burst.window <
-                                     2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
+        } else if (w.in_phase &&
+                   window() < 2.0 * w.period * (1.0 - 1e-9)) {  // in_phase: period measured
             out.hold_kind = DtLimit::in_phase_wave;
             out.hold = fmt::format(
                 "{}: a least-squares slope over cpi.window = {:.3g} (< two periods) is biased "
                 "by the common wave beyond its standard error; use cpi.window >= {:.3g}",
-                w.message, settings_.burst.window, 2.0 * w.period);
+                w.message, window(), 2.0 * w.period);
         }
     }
     rec.window = slope.t_last - slope.t_first;
@@ -232,7 +250,7 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec,
 ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper) {
     ProjectiveStepRecord rec;
     rec.t_start = stepper.time();
-    rec.healing = settings_.burst.healing;
+    rec.healing = healing_;
     rec.burst_length = settings_.burst.healing + settings_.burst.window;
     ControllerRecord& c = rec.controller;
     c.active = true;
@@ -308,7 +326,11 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     ProjectiveStepRecord after;  // the burst that judges the jump
     after.t_start = stepper.time();
-    if (!measure_burst(stepper, after, m)) {
+    const bool measured = measure_burst(stepper, after, m);
+    // Whatever the verdict on the jump, the burst says whether lifts leave a transient: the
+    // healing of the bursts to come.
+    judge_healing(after.burst, after.t_start, c);
+    if (!measured) {
         if (settings_.adaptive) stepper.return_to_kept_state();
         rec.status = StepStatus::invalid_burst;
         rec.burst = std::move(after.burst);
@@ -399,6 +421,7 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.controller = controller_.state();
     s.totals = totals_;
     s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
+    s.healing = healing_;
     return s;
 }
 
@@ -406,6 +429,7 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     history_.clear();
     curvature_only_front_ = false;
     pool_.restore({});
+    healing_ = settings_.burst.healing;
     if (!state) return;  // nothing saved: as new
     const MultistepState& s = *state;
     EFDEM_EXPECTS(s.history.size() <= static_cast<std::size_t>(settings_.steps) + 1);
@@ -422,6 +446,8 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     const std::size_t skip =
         s.pool.size() > pool_.capacity() ? s.pool.size() - pool_.capacity() : 0;
     pool_.restore({s.pool.begin() + static_cast<std::ptrdiff_t>(skip), s.pool.end()});
+    // Checkpoints before cpi.healing_auto have no healing: the configured one.
+    healing_ = std::isnan(s.healing) ? settings_.burst.healing : s.healing;
 }
 
 }  // namespace efdem::coarse

@@ -74,6 +74,12 @@ struct MultistepSettings {
     /// errors are correlated).
     SlopeSource slope = SlopeSource::burst;
     std::size_t pool = 4;  ///< cpi.pool: bursts a pooled slope uses (>= 1)
+    /// cpi.healing_auto: every burst that follows a lift is tested for a post-lift transient
+    /// (estimators/post_lift_transient.hpp); the bursts after it heal for burst.healing when
+    /// one is measured and for healing_min when none is, the window filling the rest of the
+    /// burst (whose length, burst.healing + burst.window, never changes).
+    bool healing_auto = false;
+    double healing_min = 0.0;  ///< the shortest healing (0 <= healing_min <= burst.healing)
 };
 
 class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
@@ -123,6 +129,11 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// run when one burst would leave less than one more (the run then ends at its end time).
     double direct_burst_length(const CoarseStepper& stepper) const;
     void accept_burst(const Measured& m);
+    /// The estimation window of the bursts now: the burst less the current healing.
+    double window() const;
+    /// cpi.healing_auto: the healing of the next bursts from the burst after a lift at t_lift;
+    /// the evidence goes into `c`.
+    void judge_healing(const BurstSamples& burst, double t_lift, ControllerRecord& c);
     /// The method's nodes (q_eff of them) and the error model of the next jump.
     std::vector<SlopeNode> method_nodes() const;
     double prior_curvature() const;
@@ -157,6 +168,7 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// The accepted bursts' slopes and their commitments (kept with cpi.slope = burst too, to
     /// record what pooling would have given).
     SlopePool pool_;
+    double healing_;  ///< the healing of the next burst (cpi.healing_auto: from the evidence)
     Totals totals_;
 };
 

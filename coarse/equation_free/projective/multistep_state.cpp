@@ -1,5 +1,6 @@
 #include "coarse/equation_free/projective/multistep_state.hpp"
 
+#include <cmath>
 #include <optional>
 #include <stdexcept>
 
@@ -33,7 +34,8 @@ bool MultistepState::operator==(const MultistepState& o) const {
            t.attempts == u.attempts && t.accepted == u.accepted && t.rejected == u.rejected &&
            t.direct == u.direct && t.dt_taken == u.dt_taken && t.dt_tolerance == u.dt_tolerance &&
            t.dt_tolerance_2r == u.dt_tolerance_2r && t.dt_tolerance_4r == u.dt_tolerance_4r &&
-           t.statistical == u.statistical && t.truncation == u.truncation;
+           t.statistical == u.statistical && t.truncation == u.truncation &&
+           (healing == o.healing || (std::isnan(healing) && std::isnan(o.healing)));
 }
 
 MultistepState MultistepState::from_layout(const std::vector<double>& r, const std::string& text) {

@@ -6,6 +6,7 @@
 /// ProjectiveIntegrator::save_state/restore_state exchange. Checkpoint formats 2 and 3 stored it
 /// as a positional vector and three lines of text (from_layout() reads them).
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct MultistepState {
     /// much of each one's noise the kept jumps put into the state. Empty in checkpoints written
     /// before it (formats 1-3 and early format 4): pooling then starts afresh.
     std::vector<PooledBurst> pool;
+    /// The healing of the next burst (cpi.healing_auto changes it); NaN in checkpoints written
+    /// before it: the configured cpi.healing.
+    double healing = std::numeric_limits<double>::quiet_NaN();
 
     /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
     bool operator==(const MultistepState& other) const;

@@ -75,6 +75,9 @@ struct ControllerRecord {
     double statistical_burst = nan, statistical_pool = nan;
     SlopeSource slope_source = SlopeSource::burst;  ///< cpi.slope of the jump
     int pooled_bursts = 0;                          ///< bursts the slope used (1: the last one)
+    /// cpi.healing_auto: the post-lift transient statistic of the burst after the jump and its
+    /// threshold (estimators/post_lift_transient.hpp); NaN when not tested.
+    double transient = nan, transient_threshold = nan;
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
     Eigen::VectorXd statistical_nodes;  ///< per component
