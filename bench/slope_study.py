@@ -16,6 +16,7 @@ estimator's, not the seeds'):
   burst_h10w10     cpi.slope = burst, healing 10 + window 10 (the studies so far)
   burst_h2w18      cpi.slope = burst, healing 2 + window 18 (the same burst, the slope from 90 % of it)
   pooled_h10w10    cpi.slope = pooled, cpi.pool = 4, healing 10 + window 10
+  auto_h10w10      cpi.healing_auto = true, burst 20 (healing 10 while a post-lift transient shows, else 2)
 
 Error of a CPI run against the direct ensembles: e_j = RMS(X - D_j) over the CPI run's samples and
 the 19 nodes; e^2 = mean_j e_j^2. The floor: RMS(D_i - D_j) for the three pairs (mean, and the
@@ -54,10 +55,11 @@ CPI = (
     ("burst_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10}),
     ("burst_h2w18", {**ADAPTIVE, "cpi.healing": 2, "cpi.window": 18}),
     ("pooled_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10, "cpi.slope": "pooled", "cpi.pool": 4}),
+    ("auto_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10, "cpi.healing_auto": "true"}),
 )
 # Made in this order: the first direct ensemble, the two burst variants (the most informative
-# pair), the second direct, pooled, the third direct.
-ORDER = ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "pooled_h10w10", "direct_c")
+# pair), the second direct, pooled, evidence-sized healing, the third direct.
+ORDER = ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "pooled_h10w10", "auto_h10w10", "direct_c")
 
 
 def specs(realizations, np_):
