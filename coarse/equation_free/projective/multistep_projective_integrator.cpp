@@ -390,6 +390,14 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
         "{}: {} jumps kept, {} rejected, {} bursts run directly (tolerance allowed DT < "
         "cpi.dt_min)",
         name(), t.accepted, t.rejected, t.direct);
+    // Every rejected jump cost a burst of DEM time that bought nothing.
+    if (t.rejected > 0)
+        s += fmt::format(
+            "; {:.0f} % of the jumps tried were rejected",
+            100.0 * static_cast<double>(t.rejected) / static_cast<double>(t.accepted + t.rejected));
+    if (settings_.slope == SlopeSource::pooled)
+        s += fmt::format("; slopes pooled over up to {} bursts", settings_.pool);
+    if (settings_.healing_auto) s += fmt::format("; healing from evidence, now {:g}", healing_);
     if (t.accepted == 0) return s;
     const double n = static_cast<double>(t.accepted);
     const double err = t.statistical + t.truncation;
