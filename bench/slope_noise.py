@@ -13,9 +13,11 @@ every member's least-squares slope per p-node in each, then reports:
   4. the slope (signal) against its noise per W;
   5. an emulated jump: the prediction X(t_k) + DT * (mean of the last m window slopes) against the
      realised change of the same ensemble and of the independent other one (pairs a, b), the
-     realised change's own noise measured from a - b and subtracted.
+     realised change's own noise measured from a - b and subtracted;
+  6. ranks in the whole bed r_i = F_bed(q_i) (files with bed/solid_fraction, --bed-files): their
+     slope noise against the heights' in a common unit, and the slopes' signal-to-noise.
 
-    /usr/bin/python3 bench/slope_noise.py [--out bench/results/slope_noise]
+    /usr/bin/python3 bench/slope_noise.py [--out bench/results/slope_noise] [--bed-files F.h5 ...]
 
 Writes slope_noise.md and slope_noise.png into --out; runs in seconds.
 """
@@ -169,6 +171,69 @@ def jump_study(ra, rb, start, W=10, dts=(20, 40, 80), mset=(1, 2, 4)):
     return rows
 
 
+# ---- 6. ranks in the whole bed (files written with observe.bed = true) ----------------------------
+STUDY_BED = [os.path.join(RES, "slope_study_r4", f"direct_{x}.h5") for x in "bc"]
+
+
+def load_bed(path):
+    """Every member's light ICDF q_i, its rank among all particles r_i = F_bed(q_i) and its bed
+    density f_bed = dF_bed/dz at the slab centres [1/d_p]. F_bed = cumulative solid fraction over
+    the slabs, normalised to 1, each slab's volume spread uniformly over the slab (so F_bed is
+    piecewise linear between the slab edges). F_bed weights sphere volume, q_i centres: a fixed
+    monotone map of heights, all a rank coordinate needs. None if the file has no profile."""
+    with h5py.File(path, "r") as f:
+        if "bed/solid_fraction" not in f:
+            return None
+        t, q, phi, z = (f[k][:] for k in ("samples/time", "samples/icdf", "bed/solid_fraction", "bed/z"))
+        dz = float(f["bed"].attrs.get("profile_dz", np.median(np.diff(z))))
+        par = dict(ln.split("[")[0].split("=", 1) for ln in f["parameters"][()].decode().splitlines() if "=" in ln)
+    ok = np.isfinite(q).all(axis=(1, 2)) & np.isfinite(phi).all(axis=(1, 2))  # rows with NaN ignored
+    t, q, phi = t[ok], q[ok], phi[ok]
+    C = np.concatenate([np.zeros(phi.shape[:2] + (1,)), np.cumsum(phi, axis=2)], axis=2)
+    C /= C[..., -1:]  # F_bed at the slab edges z[0] - dz/2 + j dz, j = 0..slabs
+    x = np.clip((q - (z[0] - dz / 2)) / dz, 0, phi.shape[2] - 1e-9)  # q in slab units from the bottom edge
+    j = x.astype(int)
+    lo, hi = np.take_along_axis(C, j, 2), np.take_along_axis(C, j + 1, 2)
+    dt = float(np.median(np.diff(t)))
+    tick = np.rint(t / dt).astype(int)
+    par = {k.strip(): v.strip() for k, v in par.items()}
+    return dict(path=path, dt=dt, pos={int(k): i for i, k in enumerate(tick)}, icdf=q, ranks=lo + (x - j) * (hi - lo),
+                dens=phi / (phi.sum(axis=2, keepdims=True) * dz), z=z, R=q.shape[1], T=float(t[-1]),
+                U=par.get("gas_drag.superficial_velocity", "?"), N=par.get("bed.count", "?"))
+
+
+def bed_stats(run, start):
+    """Per W: the members' slope-deviation variance sum_i Var_r(s_i), averaged over windows, in
+    heights [d_p^2/t^2], ranks [1/t^2] and ranks in height units (rank slope / f_bed(q_i), f_bed
+    the window's ensemble- and time-mean density profile, linear between slab centres, at the
+    window's mean q_i); the uniform-shift share of each (as section 3b: removed by subtracting
+    the node mean); S/N = RMS ensemble-mean slope / RMS SE."""
+    def var(S):
+        return S.var(axis=1, ddof=1).sum(axis=1).mean()
+
+    def unif(S):
+        return 1 - var(S - S.mean(axis=2, keepdims=True)) / var(S)
+
+    def snr(S):
+        return np.sqrt(ms(S.mean(axis=1)) / np.mean(se2(S)))
+
+    out = {}
+    for W in (10, 20):
+        Sh, ends = slopes(run, run["icdf"], W, start)
+        Sr = slopes(run, run["ranks"], W, start)[0]
+        if not len(Sh):
+            continue
+        n = int(round(W / run["dt"]))
+        win = [slice(e - n + 1, e + 1) for e in ends]  # a window's samples (consecutive: none missing)
+        f = np.array([np.interp(run["icdf"][w].mean(axis=(0, 1)), run["z"], run["dens"][w].mean(axis=(0, 1)))
+                      for w in win])  # (windows, nodes) [1/d_p]
+        Srh = Sr / f[:, None, :]
+        node = 1 - Srh.var(axis=1, ddof=1).mean(axis=0) / Sh.var(axis=1, ddof=1).mean(axis=0)
+        out[W] = dict(K=len(Sh), vh=var(Sh), vr=var(Sr), vrh=var(Srh), uh=unif(Sh), ur=unif(Srh),
+                      sh=snr(Sh), sr=snr(Sr), srh=snr(Srh), node=node, f=f.mean(axis=0))
+    return out
+
+
 def rt(x):
     return f"{np.sqrt(x):.3g}" if x >= 0 else f"-{np.sqrt(-x):.3g}"  # signed sqrt: negative MS = noise
 
@@ -177,6 +242,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default=os.path.join(RES, "slope_noise"))
     ap.add_argument("--start", type=float, default=30.0, help="skip the start-up transient")
+    ap.add_argument("--bed-files", nargs="*", default=[p for p in STUDY_BED if os.path.exists(p)],
+                    help="direct files with bed/solid_fraction for section 6 (default: slope_study_r4 "
+                         "direct_b/c.h5 when they exist)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     runs, stats, pairs, jumps = {}, {}, {}, {}
@@ -270,6 +338,44 @@ def main():
               f"{rt(r['eta'])} | "
               f"{rt(r['ref'])} | {rt(r['corr'])} | {rt(r['noise'])} | {rt(r['pred'])} | {rt(r['rw'])} | "
               f"{rt(r['bias'])} |" for r in rows]
+    L += ["", "## 6. Ranks in the whole bed", "",
+          "Each light quantile height q_i as its rank among all particles of the same member, r_i = F_bed(q_i), "
+          "F_bed the member's cumulative solid-fraction profile (`bed/solid_fraction`, observe.bed = true; each "
+          "slab's volume spread uniformly over it): a uniform shift or expansion of the whole bed cancels. Members' "
+          "least-squares slopes per window as above. Var = sum over nodes of Var_r(s), averaged over windows; "
+          "'ranks [d_p]' = rank slopes divided by f_bed = dF_bed/dz at the window's ensemble-mean q_i (the "
+          "window's mean density profile), so 'removed' = 1 - Var(ranks [d_p]) / Var(heights) compares in one "
+          "unit. uniform = share of that coordinate's Var removed by subtracting the node mean (section 3b's "
+          "measure: " + ", ".join(f"{k[0]} {k[1]} {s['rm_nodemean']:.0%}" for k, s in stats.items()
+                                   if k[0].startswith("demo U0.19")) + "); ranks remove the uniform "
+          "shift if it is ~0 in ranks. S/N = RMS ensemble-mean slope / RMS SE (unit-free; the mean slope "
+          "includes its noise).", ""]
+    bed = {}
+    for p in a.bed_files:
+        r = load_bed(p) if os.path.exists(p) else None
+        name = os.path.relpath(p, os.path.join(HERE, "..")) if os.path.abspath(p).startswith(RES) else p
+        if r is None:
+            L.append(f"* `{name}`: " + ("no bed/solid_fraction, skipped" if os.path.exists(p) else "missing"))
+            continue
+        bed[name] = bed_stats(r, a.start)
+        L.append(f"* `{name}`: U_s = {r['U']}, bed.count = {r['N']}, R = {r['R']}, {r['T']:g} time units"
+                 + ("" if os.path.abspath(p).startswith(RES) else " -- **not a study file: a test file (e.g. the "
+                    "tiny bed of tests/scripts/tiny_scene.cfg) for testing the method only, not a result**"))
+    if not a.bed_files:
+        L.append("* none given (the default, `bench/results/slope_study_r4/direct_b.h5` and `direct_c.h5`, "
+                 "not written yet)")
+    L += ["", "| file | W | windows | Var heights | Var ranks | Var ranks [d_p] | removed | uniform heights "
+          "| uniform ranks | S/N heights | S/N ranks | S/N ranks [d_p] |", "|---" * 12 + "|"]
+    for name, B in bed.items():
+        L += [f"| `{os.path.basename(name)}` | {W} | {b['K']} | {b['vh']:.3g} | {b['vr']:.3g} | {b['vrh']:.3g} | "
+              f"{1 - b['vrh'] / b['vh']:.0%} | {b['uh']:.0%} | {b['ur']:.0%} | {b['sh']:.2f} | {b['sr']:.2f} | "
+              f"{b['srh']:.2f} |" for W, b in B.items()]
+    L += ["", "Per node (W = 10), p = 0.05..0.95: share removed 1 - Var_r(rank slope [d_p]) / Var_r(height slope), "
+          "and the mean f_bed [1/d_p]:", ""]
+    for name, B in bed.items():
+        if 10 in B:
+            L += [f"* `{os.path.basename(name)}` removed: " + " ".join(f"{v:+.0%}" for v in B[10]["node"]),
+                  f"* `{os.path.basename(name)}` f_bed: " + " ".join(f"{v:.3f}" for v in B[10]["f"])]
     with open(os.path.join(a.out, "slope_noise.md"), "w") as f:
         f.write("\n".join(L) + "\n")
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.5))
