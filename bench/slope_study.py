@@ -65,7 +65,10 @@ ORDER = ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "pooled_h10w10",
 def specs(realizations, np_):
     base = {"gas_drag.superficial_velocity": 0.19, "run.duration": DURATION, "cpi.warmup": 10,
             "ensemble.realizations_per_rank": realizations // np_}
-    out = {name: ("direct", seed, dict(base)) for name, seed in DIRECT}
+    # The direct runs also record the bed (observe.bed: every realization's solid-fraction
+    # profile, i.e. its whole-bed height distribution), from which the light quantiles' ranks in
+    # the whole bed can be measured as a coordinate (direct_a was made before this was added).
+    out = {name: ("direct", seed, {**base, "observe.bed": "true"}) for name, seed in DIRECT}
     out.update({name: ("cpi", 404, {**base, **extra}) for name, extra in CPI})
     return out
 

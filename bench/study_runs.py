@@ -51,7 +51,7 @@ def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None):
 # What a study keeps of a run, in the run file's own layout: the groups its analysis reads and the
 # root attributes. The working folders (runs/) are not part of a checkout; these files are
 # committed under bench/results/, one per run, so that a study continues in a fresh clone.
-ARCHIVED_GROUPS = ("samples", "cpi", "realization", "p")
+ARCHIVED_GROUPS = ("samples", "cpi", "realization", "p", "bed")
 
 
 def archive(folder, name, dest):
