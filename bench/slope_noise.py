@@ -186,7 +186,12 @@ def load_bed(path):
             return None
         t, q, phi, z = (f[k][:] for k in ("samples/time", "samples/icdf", "bed/solid_fraction", "bed/z"))
         dz = float(f["bed"].attrs.get("profile_dz", np.median(np.diff(z))))
-        par = dict(ln.split("[")[0].split("=", 1) for ln in f["parameters"][()].decode().splitlines() if "=" in ln)
+        if "parameters" in f:  # a run file
+            par = dict(ln.split("[")[0].split("=", 1) for ln in f["parameters"][()].decode().splitlines() if "=" in ln)
+        else:  # a study's archived result: the command's key=value words
+            cmd = f.attrs.get("study_command", b"")
+            cmd = cmd.decode() if isinstance(cmd, bytes) else str(cmd)
+            par = dict(w.split("=", 1) for w in cmd.split() if "=" in w)
     ok = np.isfinite(q).all(axis=(1, 2)) & np.isfinite(phi).all(axis=(1, 2))  # rows with NaN ignored
     t, q, phi = t[ok], q[ok], phi[ok]
     C = np.concatenate([np.zeros(phi.shape[:2] + (1,)), np.cumsum(phi, axis=2)], axis=2)

@@ -58,8 +58,9 @@ CPI = (
     ("auto_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10, "cpi.healing_auto": "true"}),
 )
 # Made in this order: the first direct ensemble, the two burst variants (the most informative
-# pair), the second direct, pooled, evidence-sized healing, the third direct.
-ORDER = ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "pooled_h10w10", "auto_h10w10", "direct_c")
+# pair), the second and third direct ensembles (the floor with an error bar), pooled,
+# evidence-sized healing.
+ORDER = ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "direct_c", "pooled_h10w10", "auto_h10w10")
 
 
 def specs(realizations, np_):
@@ -163,8 +164,9 @@ def plot(args, runs, directs):
         return
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
     mid = 9  # p = 0.5
-    for d, (name, _) in zip(directs, DIRECT):
-        ax[0].plot(d["t"], d["mean"][:, mid], color="grey", lw=1, label=name)
+    for name, _ in DIRECT:
+        if name in runs:
+            ax[0].plot(runs[name]["t"], runs[name]["mean"][:, mid], color="grey", lw=1, label=name)
     for name, _ in CPI:
         if name in runs:
             ax[0].plot(runs[name]["t"], runs[name]["mean"][:, mid], ".", ms=2, label=name)
