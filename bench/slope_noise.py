@@ -298,7 +298,8 @@ def main():
           "in the first k principal components of the 19 x 19 deviation covariance (in-sample); PC1(other): "
           "share along the *other* file's PC1 (out-of-sample). cos = |PC1 . uniform| (1 = pure shift). "
           "Whole-bed ranks (the ICDF of the light species within the whole bed's height distribution) "
-          "cannot be computed: no per-member whole-bed height distribution is stored, only com.", "",
+          "need each member's whole-bed profile, which these files do not store: section 6 measures "
+          "them on runs made with observe.bed = true.", "",
           "end: the slope (last - first sample)/W instead of least squares (the better estimator of a "
           "random walk's drift, by 1.2x in variance; worse for white noise).", "",
           "| file | RMS dev/node | a: -com | b: -node mean | beta·com | PC1 | PC1-2 | PC1-3 | PC1(other) | cos "
