@@ -4,7 +4,7 @@ burst's slope, with pooled slopes (cpi.slope = pooled) and with bursts whose hea
 the evidence asks for, against THREE direct ensembles with their own seeds, so that the noise floor
 has an error bar of its own. Demo bed (1,000 spheres), U_s = 0.19, R = 4 (2 ranks x 2), 600 time
 units, warm-up 10, tolerance 0.16 d_p per jump. Resumable: one result file per run under --results
-(committed), a run whose result is there is not repeated.
+(not committed: study run files stay out of git), a run whose result is there is not repeated.
 
     /usr/bin/python3 bench/slope_study.py --efdem build/mpi_driver/efdem
     /usr/bin/python3 bench/slope_study.py --analyse-only
