@@ -216,12 +216,11 @@ MultistepProjectiveIntegrator::JumpBasis MultistepProjectiveIntegrator::jump_bas
 
 void MultistepProjectiveIntegrator::record_statistical(ControllerRecord& c, const JumpBasis& basis,
                                                        double dt) const {
-    const std::vector<double> w = projection_weights(basis.nodes, t_end_, dt);
-    c.statistical_nodes = basis.committed.size()
-                              ? charged_error(basis.nodes[0].se, basis.committed, w[0])
-                              : statistical_error(basis.nodes, w);
+    // The curvature plays no part in the statistical error.
+    c.statistical_nodes = statistical_error(basis.model(t_end_, ControllerRecord::nan), dt);
     c.statistical = rms(c.statistical_nodes);
-    c.statistical_jump = rms(statistical_error(basis.nodes, w));
+    c.statistical_jump =
+        rms(statistical_error(basis.nodes, projection_weights(basis.nodes, t_end_, dt)));
     c.slope_source = settings_.slope;
     c.pooled_bursts = basis.committed.size() ? static_cast<int>(basis.pooled.bursts()) : 1;
     if (settings_.steps == 1 && pool_.size() > 0) {

@@ -15,18 +15,18 @@
 
 namespace efdem::coarse {
 
-JumpError jump_error(const JumpErrorModel& model, double dt) {
+Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt) {
     EFDEM_EXPECTS(dt >= 0.0 && !model.nodes.empty());
     const std::vector<double> w = projection_weights(model.nodes, model.t0, dt);
+    if (model.committed.size() == 0) return statistical_error(model.nodes, w);
+    EFDEM_EXPECTS(model.nodes.size() == 1 &&
+                  model.committed.size() == model.nodes.front().se.size());
+    return charged_error(model.nodes.front().se, model.committed, w[0]);
+}
+
+JumpError jump_error(const JumpErrorModel& model, double dt) {
     JumpError e;
-    if (model.committed.size() == 0) {
-        e.statistical = model.se_scale * rms(statistical_error(model.nodes, w));
-    } else {
-        EFDEM_EXPECTS(model.nodes.size() == 1 &&
-                      model.committed.size() == model.nodes.front().se.size());
-        e.statistical =
-            model.se_scale * rms(charged_error(model.nodes.front().se, model.committed, w[0]));
-    }
+    e.statistical = model.se_scale * rms(statistical_error(model, dt));
     if (std::isfinite(model.curvature))
         e.truncation = model.curvature * omega_integral(model.nodes, model.t0, dt);
     return e;

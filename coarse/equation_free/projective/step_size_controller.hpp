@@ -52,6 +52,11 @@ struct JumpError {
     double total() const { return statistical + truncation; }
 };
 
+/// Per component, the statistical part of a jump of `dt` under `model` (before se_scale):
+/// sqrt(sum_k W_k^2 se_k^2), or for a pooled slope the charged sqrt(DT^2 se^2 + 2 DT c).
+/// \pre dt >= 0, model.nodes non-empty.
+Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt);
+
 /// The error of a jump of `dt` under `model`. \pre dt >= 0, model.nodes non-empty.
 JumpError jump_error(const JumpErrorModel& model, double dt);
 
