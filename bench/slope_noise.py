@@ -172,7 +172,7 @@ def jump_study(ra, rb, start, W=10, dts=(20, 40, 80), mset=(1, 2, 4)):
 
 
 # ---- 6. ranks in the whole bed (files written with observe.bed = true) ----------------------------
-STUDY_BED = [os.path.join(RES, "slope_study_r4", f"direct_{x}.h5") for x in "bc"]
+STUDY_BED = [os.path.join(RES, "slope_study_r4_u0.19_t600", f"direct_{x}.h5") for x in "bc"]
 
 
 def load_bed(path):
@@ -248,7 +248,7 @@ def main():
     ap.add_argument("--out", default=os.path.join(RES, "slope_noise"))
     ap.add_argument("--start", type=float, default=30.0, help="skip the start-up transient")
     ap.add_argument("--bed-files", nargs="*", default=[p for p in STUDY_BED if os.path.exists(p)],
-                    help="direct files with bed/solid_fraction for section 6 (default: slope_study_r4 "
+                    help="direct files with bed/solid_fraction for section 6 (default: slope_study_r4_u0.19_t600 "
                          "direct_b/c.h5 when they exist)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
@@ -368,7 +368,7 @@ def main():
                  + ("" if os.path.abspath(p).startswith(RES) else " -- **not a study file: a test file (e.g. the "
                     "tiny bed of tests/scripts/tiny_scene.cfg) for testing the method only, not a result**"))
     if not a.bed_files:
-        L.append("* none given (the default, `bench/results/slope_study_r4/direct_b.h5` and `direct_c.h5`, "
+        L.append("* none given (the default, `bench/results/slope_study_r4_u0.19_t600/direct_b.h5` and `direct_c.h5`, "
                  "not written yet)")
     L += ["", "| file | W | windows | Var heights | Var ranks | Var ranks [d_p] | removed | uniform heights "
           "| uniform ranks | S/N heights | S/N ranks | S/N ranks [d_p] |", "|---" * 12 + "|"]

@@ -1,22 +1,34 @@
 #!/usr/bin/python3
 """Where the slope's noise goes over a long slow demixing (issue 33): adaptive CPI with the last
-burst's slope, with pooled slopes (cpi.slope = pooled) and with bursts whose healing is cut to what
-the evidence asks for, against THREE direct ensembles with their own seeds, so that the noise floor
-has an error bar of its own. Demo bed (1,000 spheres), U_s = 0.19, R = 4 (2 ranks x 2), 600 time
-units, warm-up 10, tolerance 0.16 d_p per jump. Resumable: one result file per run under --results
-(not committed: study run files stay out of git), a run whose result is there is not repeated.
+burst's slope, with pooled slopes (cpi.slope = pooled), with bursts whose healing is cut to what
+the evidence asks for, and with either lift (cpi.lift = mean | members), against THREE direct
+ensembles with their own seeds, so that the noise floor has an error bar of its own. Demo bed
+(1,000 spheres), warm-up 10. Resumable: one result file per run under --results (not committed:
+study run files stay out of git), a run whose result is there is not repeated.
 
-    /usr/bin/python3 bench/slope_study.py --efdem build/mpi_driver/efdem
-    /usr/bin/python3 bench/slope_study.py --analyse-only
+    /usr/bin/python3 bench/slope_study.py --efdem build/mpi_driver/efdem                 # U_s 0.19, R 4, 600 units
+    /usr/bin/python3 bench/slope_study.py --us 0.41 --realizations 8 --duration 200
+    /usr/bin/python3 bench/slope_study.py --us 0.19 --realizations 8 --duration 200
+    /usr/bin/python3 bench/slope_study.py ... --analyse-only
+
+Results go to bench/results/slope_study_r<R>_u<U_s>_t<duration>/ unless --results says otherwise.
+The direct runs of bench/adaptive_study.py (same bed, seeds 101 and 202, 200 units) can be copied
+into that folder as direct_a.h5 and direct_b.h5: they are not repeated then.
 
 Runs, in the order they are made (the CPI runs share seed 404: paired, their differences are the
-estimator's, not the seeds'):
+estimator's and the lift's, not the seeds'):
 
   direct_a, direct_b, direct_c   mode=direct, seeds 101, 202, 303
+ U_s = 0.19 (tolerance 0.16 d_p per jump):
   burst_h10w10     cpi.slope = burst, healing 10 + window 10 (the studies so far)
   burst_h2w18      cpi.slope = burst, healing 2 + window 18 (the same burst, the slope from 90 % of it)
   pooled_h10w10    cpi.slope = pooled, cpi.pool = 4, healing 10 + window 10
   auto_h10w10      cpi.healing_auto = true, burst 20 (healing 10 while a post-lift transient shows, else 2)
+  members_h10w10, members_pooled_h10w10   burst_h10w10 and pooled_h10w10 with cpi.lift = members
+  autowindow_h10w10  cpi.healing_auto and cpi.window_auto: healing and window from evidence
+ U_s = 0.41 (tolerance 0.32 d_p per jump, the one that jumps at all in bench/adaptive_study.py;
+ healing 2 + window 20: two wave periods, T ~ 9):
+  burst_h2w20, pooled_h2w20, members_h2w20, members_pooled_h2w20
 
 Error of a CPI run against the direct ensembles: e_j = RMS(X - D_j) over the CPI run's samples and
 the 19 nodes; e^2 = mean_j e_j^2. The floor: RMS(D_i - D_j) for the three pairs (mean, and the
@@ -47,24 +59,52 @@ sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
 
 SCENE = os.path.join(HERE, "scenes", "demo_bed.cfg")
-DURATION = 600.0
-TOLERANCE = 0.16
 DIRECT = (("direct_a", 101), ("direct_b", 202), ("direct_c", 303))
-ADAPTIVE = {"cpi.projection": "adaptive", "cpi.tolerance": TOLERANCE}
-CPI = (
-    ("burst_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10}),
-    ("burst_h2w18", {**ADAPTIVE, "cpi.healing": 2, "cpi.window": 18}),
-    ("pooled_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10, "cpi.slope": "pooled", "cpi.pool": 4}),
-    ("auto_h10w10", {**ADAPTIVE, "cpi.healing": 10, "cpi.window": 10, "cpi.healing_auto": "true"}),
-)
-# Made in this order: the first direct ensemble, the two burst variants (the most informative
-# pair), the second and third direct ensembles (the floor with an error bar), pooled,
-# evidence-sized healing.
-ORDER = ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "direct_c", "pooled_h10w10", "auto_h10w10")
+POOLED = {"cpi.slope": "pooled", "cpi.pool": 4}
+MEMBERS = {"cpi.lift": "members"}
+SLOW = {"cpi.projection": "adaptive", "cpi.tolerance": 0.16, "cpi.healing": 10, "cpi.window": 10}
+WAVES = {"cpi.projection": "adaptive", "cpi.tolerance": 0.32, "cpi.healing": 2, "cpi.window": 20}
+CPI_BY_US = {
+    0.19: (
+        ("burst_h10w10", SLOW),
+        ("burst_h2w18", {**SLOW, "cpi.healing": 2, "cpi.window": 18}),
+        ("pooled_h10w10", {**SLOW, **POOLED}),
+        ("auto_h10w10", {**SLOW, "cpi.healing_auto": "true"}),
+        ("members_h10w10", {**SLOW, **MEMBERS}),
+        ("members_pooled_h10w10", {**SLOW, **POOLED, **MEMBERS}),
+        ("autowindow_h10w10", {**SLOW, "cpi.healing_auto": "true", "cpi.window_auto": "true"}),
+    ),
+    0.41: (
+        ("burst_h2w20", WAVES),
+        ("pooled_h2w20", {**WAVES, **POOLED}),
+        ("members_h2w20", {**WAVES, **MEMBERS}),
+        ("members_pooled_h2w20", {**WAVES, **POOLED, **MEMBERS}),
+    ),
+}
+# Made in this order at U_s = 0.19: the first direct ensemble, the two burst variants (the most
+# informative pair), the second and third direct ensembles (the floor with an error bar), pooled,
+# evidence-sized healing, the members' lift. At 0.41: the directs first, then the CPI runs.
+ORDER_BY_US = {
+    0.19: ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "direct_c", "pooled_h10w10", "auto_h10w10",
+           "members_h10w10", "members_pooled_h10w10", "autowindow_h10w10"),
+    0.41: ("direct_a", "direct_b", "direct_c", "burst_h2w20", "pooled_h2w20", "members_h2w20",
+           "members_pooled_h2w20"),
+}
+# Set from the command line in main(): the study's U_s, horizon, CPI runs and their order.
+DURATION = 600.0
+CPI = CPI_BY_US[0.19]
+ORDER = ORDER_BY_US[0.19]
+QUARTERS = []
 
 
-def specs(realizations, np_):
-    base = {"gas_drag.superficial_velocity": 0.19, "run.duration": DURATION, "cpi.warmup": 10,
+def configure(us, duration):
+    global DURATION, CPI, ORDER, QUARTERS
+    DURATION, CPI, ORDER = duration, CPI_BY_US[us], ORDER_BY_US[us]
+    QUARTERS = [(DURATION * k / 4, DURATION * (k + 1) / 4) for k in range(4)]
+
+
+def specs(realizations, np_, us):
+    base = {"gas_drag.superficial_velocity": us, "run.duration": DURATION, "cpi.warmup": 10,
             "ensemble.realizations_per_rank": realizations // np_}
     # The direct runs also record the bed (observe.bed: every realization's solid-fraction
     # profile, i.e. its whole-bed height distribution), from which the light quantiles' ranks in
@@ -101,14 +141,12 @@ def rms_on(run, ref, window=None):
     return math.sqrt(float(np.mean((x - y) ** 2))) if len(x) else float("nan")
 
 
-QUARTERS = [(DURATION * k / 4, DURATION * (k + 1) / 4) for k in range(4)]
-
-
 def analyse(args, realizations):
     runs = {name: load(result(args, name)) for name in ORDER if sr.archived(result(args, name))}
     directs = [runs[n] for n, _ in DIRECT if n in runs]
-    lines = ["# Slope study (issue 33): demo bed, U_s = 0.19, R = %d, %g time units\n" % (realizations, DURATION),
-             "Made by `/usr/bin/python3 bench/slope_study.py --efdem build/mpi_driver/efdem`; "
+    flags = f"--us {args.us} --realizations {realizations} --duration {DURATION:g}"
+    lines = [f"# Slope study (issue 33): demo bed, U_s = {args.us}, R = {realizations}, {DURATION:g} time units\n",
+             f"Made by `/usr/bin/python3 bench/slope_study.py --efdem build/mpi_driver/efdem {flags}`; "
              "this file by `--analyse-only`.\n"]
     summary = {"floor": {}, "runs": {}}
     if len(directs) >= 2:
@@ -191,15 +229,21 @@ def plot(args, runs, directs):
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--efdem", default=os.path.join(HERE, "..", "build", "mpi_driver", "efdem"))
-    p.add_argument("--out", default=os.path.join(HERE, "..", "runs", "slope_study"))
-    p.add_argument("--results", default=os.path.join(HERE, "results", "slope_study_r4"))
+    p.add_argument("--out", help="working folder of the runs (default runs/slope_study_r<R>_u<U_s>_t<duration>)")
+    p.add_argument("--results", help="one result file per run (default bench/results/slope_study_r<R>_u<U_s>_t<duration>)")
+    p.add_argument("--us", type=float, choices=sorted(CPI_BY_US), default=0.19, help="superficial velocity")
+    p.add_argument("--duration", type=float, default=600.0, help="time units per run")
     p.add_argument("--realizations", type=int, default=4)
     p.add_argument("--np", type=int, default=2)
     p.add_argument("--only", nargs="*", help="make only these runs")
     p.add_argument("--analyse-only", action="store_true")
     args = p.parse_args()
+    configure(args.us, args.duration)
+    study = f"slope_study_r{args.realizations}_u{args.us:g}_t{args.duration:g}"
+    args.out = args.out or os.path.join(HERE, "..", "runs", study)
+    args.results = args.results or os.path.join(HERE, "results", study)
     if not args.analyse_only:
-        todo = specs(args.realizations, args.np)
+        todo = specs(args.realizations, args.np, args.us)
         for name in ORDER:
             if args.only and name not in args.only:
                 continue
