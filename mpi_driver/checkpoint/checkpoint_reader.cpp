@@ -76,7 +76,12 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
     };
     s.history = read_nodes("history");
     if (f.exists(g + "healing")) s.healing = real("healing");  // since cpi.healing_auto
-    if (f.exists(g + "pool/tau")) {                            // written since cpi.slope = pooled
+    if (f.exists(g + "window")) {                              // cpi.window_auto runs
+        s.window = real("window");
+        s.window_fast_time2 = real("window_fast_time2");
+        s.window_measurements = static_cast<int>(integer("window_measurements"));
+    }
+    if (f.exists(g + "pool/tau")) {  // written since cpi.slope = pooled
         std::vector<coarse::SlopeNode> nodes = read_nodes("pool");
         const std::vector<double> commitment = values("pool/commitment", nodes.size());
         for (std::size_t i = 0; i < nodes.size(); ++i)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -80,6 +81,10 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
     real("totals/statistical", t.statistical);
     real("totals/truncation", t.truncation);
     real("healing", s.healing);
+    if (std::isnan(s.window)) return;  // cpi.window_auto only
+    real("window", s.window);
+    real("window_fast_time2", s.window_fast_time2);
+    integer("window_measurements", s.window_measurements);
 }
 }  // namespace
 

@@ -24,17 +24,21 @@ std::map<std::string, std::string> parse_lines(const std::string& text) {
 
 /// Keys added after checkpoints were first written, with the value that does what a run did
 /// before the key existed: a checkpoint that does not list the key was written with that value.
+/// nullptr: any value (a key that only acts with another added key at a value other than its
+/// old one).
 // clang-format off
 constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.slope", "burst"},  // cpi.slope = pooled (issue 33)
     {"cpi.pool", "4"},       // read only with cpi.slope = pooled
     {"cpi.healing_auto", "false"},
+    {"cpi.window_auto", "false"},
+    {"cpi.window_max", nullptr},  // read only with cpi.window_auto
 };
 // clang-format on
 
 bool as_before_the_key(const std::string& key, const std::string& value) {
     for (const auto& [k, v] : kAddedKeys)
-        if (key == k) return value == v;
+        if (key == k) return v == nullptr || value == v;
     return false;
 }
 }  // namespace

@@ -61,7 +61,11 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
         h = hash_vector(b.node.se, h);
         h = hash_value(b.commitment, h);
     }
-    return h;
+    // cpi.window_auto only (files of other runs keep the checksum they had before it).
+    if (std::isnan(s.window)) return h;
+    h = hash_value(s.window, h);
+    h = hash_value(s.window_fast_time2, h);
+    return hash_value(static_cast<long>(s.window_measurements), h);
 }
 }  // namespace
 

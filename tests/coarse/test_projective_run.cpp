@@ -399,6 +399,22 @@ TEST_CASE("CpiSettings reads the adaptive keys and refuses what adaptive would i
                Catch::Contains("cpi.integrator") && Catch::Contains("periods"));
     CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 0.3\n"),
                Catch::Contains("cpi.dt_min"));  // not a whole multiple of the sampling interval
+    // cpi.window_auto: adaptive only; its bounds: 4 samples to cpi.window_max (default 4 bursts).
+    CHECK_THAT(refused("cpi.projection = fixed\ncpi.window_auto = true\n"),
+               Catch::Contains("cpi.window_auto") &&
+                   Catch::Contains("only with cpi.projection = adaptive"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_auto = "
+                       "true\ncpi.window_max = 5\n"),
+               Catch::Contains("cpi.window") && Catch::Contains("cpi.window_max = 5"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_max = 1\n"),
+               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.window_max"));  // < 4 samples
+    ParamTable w = ParamTable::from_text(
+        "cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_auto = true\n", "scene.cfg",
+        "/scenes");
+    const CpiSettings a = CpiSettings::from_params(w.root().scope("cpi"), 0.5);
+    CHECK(a.multistep.window_auto);
+    CHECK(a.multistep.window_min == 2.0);   // 4 samples of 0.5
+    CHECK(a.multistep.window_max == 80.0);  // 4 bursts of 10 + 10
 }
 
 TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drifting",

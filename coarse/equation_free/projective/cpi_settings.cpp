@@ -57,7 +57,8 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         s.periods.max_extension =
             cpi.get_or<double>("max_extension", 30.0, Bounds::closed(0.0, 1e7));
         on_grid("max_extension", s.periods.max_extension);
-        for (const char* key : {"tolerance", "dt_min", "dt_max", "safety", "growth"})
+        for (const char* key :
+             {"tolerance", "dt_min", "dt_max", "safety", "growth", "window_auto", "window_max"})
             if (cpi.contains(key))
                 cpi.fail(
                     key,
@@ -118,6 +119,16 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                      "cpi.dt_min <= cpi.dt_max");
         c.safety = cpi.get_or<double>("safety", 0.8, Bounds::open_closed(0.0, 1.0));
         c.growth = cpi.get_or<double>("growth", 2.0, Bounds::open_closed(1.0, 100.0));
+        // The window from evidence (window_noise.hpp): at least 4 samples (2 per half, what
+        // the measurement needs), at most cpi.window_max.
+        m.window_auto = cpi.get_or<bool>("window_auto", false);
+        m.window_min = 4.0 * sample_interval;
+        m.window_max =
+            cpi.get_or<double>("window_max", 4.0 * burst, Bounds::closed(m.window_min, 1e7));
+        on_grid("window_max", m.window_max);
+        if (m.window_auto && window > m.window_max)
+            cpi.fail("window", fmt::format("is longer than cpi.window_max = {:g}", m.window_max),
+                     "cpi.window <= cpi.window_max with cpi.window_auto");
         if (cpi.contains("dt")) {
             if (s.fixed.dt < c.dt_min || s.fixed.dt > c.dt_max)
                 cpi.fail(

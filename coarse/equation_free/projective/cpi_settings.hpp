@@ -31,6 +31,9 @@
 /// | cpi.pool          | pooled: the last bursts one slope pools (1..64)               | 4       |
 /// | cpi.healing_auto  | heal for cpi.healing only while bursts after a lift show a    | false   |
 /// |                   | transient, else for a tenth of the burst (post_lift_transient) |         |
+/// | cpi.window_auto   | adaptive: the window of the next bursts from how the slope's  | false   |
+/// |                   | noise falls with the window (estimators/window_noise.hpp)     |         |
+/// | cpi.window_max    | adaptive: the longest window cpi.window_auto may choose       | 4 burst |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance

@@ -62,7 +62,8 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
                                 .burst = settings.burst.healing + settings.burst.window,
                                 .window = settings.burst.window}),
       pool_(std::max<std::size_t>(settings.pool, 1)),
-      healing_(settings.burst.healing) {
+      healing_(settings.burst.healing),
+      window_(settings.burst.window) {
     EFDEM_EXPECTS(std::isfinite(settings.burst.healing) && settings.burst.healing >= 0.0);
     EFDEM_EXPECTS(std::isfinite(settings.burst.window) && settings.burst.window > 0.0);
     EFDEM_EXPECTS(settings.steps == 1 || settings.steps == 2);
@@ -70,10 +71,39 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
     EFDEM_EXPECTS(settings.slope == SlopeSource::burst || settings.steps == 1);
     EFDEM_EXPECTS(!settings.healing_auto ||
                   (settings.healing_min >= 0.0 && settings.healing_min <= settings.burst.healing));
+    EFDEM_EXPECTS(!settings.window_auto ||
+                  (settings.adaptive && settings.window_min > 0.0 &&
+                   settings.window_min <= settings.window_max && settings.dt_quantum > 0.0));
 }
 
 double MultistepProjectiveIntegrator::window() const {
+    if (settings_.window_auto) return window_;
     return settings_.burst.healing + settings_.burst.window - healing_;
+}
+
+void MultistepProjectiveIntegrator::judge_window(const Measured& m, ControllerRecord& c) {
+    if (!settings_.window_auto) return;
+    if (m.noise.measured) {
+        c.window_noise_ratio = m.noise.ratio;
+        c.window_noise_correlation = m.noise.correlation;
+        ++noise_measurements_;
+        const int k = std::min(noise_measurements_, MultistepSettings::window_evidence);
+        fast_time2_ = noise_measurements_ == 1
+                          ? m.noise.fast_time2
+                          : fast_time2_ + (m.noise.fast_time2 - fast_time2_) / k;
+    }
+    const double step = settings_.dt_quantum, hi = settings_.window_max;
+    double lo = settings_.window_min;
+    // A wave the realizations share biases a slope over less than two of its periods.
+    if (std::isfinite(m.wave_period))
+        lo = std::min(hi, std::max(lo, std::ceil(2.0 * m.wave_period / step - 1e-9) * step));
+    // No evidence yet: the configured window (within the bounds).
+    window_ = noise_measurements_ == 0
+                  ? std::clamp(window_, lo, hi)
+                  : efficient_window(healing_, fast_time2_,
+                                     MultistepSettings::window_inefficiency_limit, lo, hi, step);
+    c.window_next = window_;
+    controller_.set_burst(burst_length(), window_);
 }
 
 void MultistepProjectiveIntegrator::judge_healing(const BurstSamples& burst, double t_lift,
@@ -96,8 +126,7 @@ std::string_view MultistepProjectiveIntegrator::name() const {
 bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec,
                                                   Measured& out, double length) const {
     const double t_start = stepper.time();
-    const double burst = settings_.burst.healing + settings_.burst.window;
-    if (!(length > 0.0)) length = burst;
+    if (!(length > 0.0)) length = burst_length();
     rec.burst = BurstSamples{};
     rec.burst_length = length;
     stepper.run(length, rec.burst);
@@ -132,6 +161,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
             Eigen::VectorXd::Zero(slope.slope.size());  // fixed DT: estimates without noise
     }
     out.node.tau = slope.t_mean;
+    if (settings_.window_auto) out.noise = window_noise(rec.burst.t, rec.burst.members, t_window);
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
     if (settings_.adaptive && out.decay.ok && out.decay.rate < 0.0) {
         // A decay rate read from noise would halve DT for nothing (the slope's halves differ by
@@ -150,6 +180,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         // the realizations share that the window does not average out.
         const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
         const WaveCoherence w = wave_coherence(rec.burst, t_start);
+        if (w.in_phase) out.wave_period = w.period;
         if (d.drifting) {
             out.hold_kind = DtLimit::fast_transient;
             out.hold = "still in a fast transient (" + d.message + ")";
@@ -166,7 +197,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     return true;
 }
 
-void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
+void MultistepProjectiveIntegrator::accept_burst(const Measured& m, ControllerRecord& c) {
     history_.push_back(m.node);
     pool_.add(m.node);
     while (history_.size() > static_cast<std::size_t>(settings_.steps) + 1) {
@@ -178,6 +209,7 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m) {
     decay_ = m.decay;
     hold_kind_ = m.hold_kind;
     hold_ = m.hold;
+    judge_window(m, c);
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -195,8 +227,7 @@ double MultistepProjectiveIntegrator::prior_curvature() const {
 }
 
 double MultistepProjectiveIntegrator::direct_burst_length(const CoarseStepper& stepper) const {
-    const double burst = settings_.burst.healing + settings_.burst.window,
-                 left = end_time() - stepper.time();
+    const double burst = burst_length(), left = end_time() - stepper.time();
     return left < 2.0 * burst - time_tolerance(end_time()) ? left : burst;
 }
 
@@ -250,7 +281,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     ProjectiveStepRecord rec;
     rec.t_start = stepper.time();
     rec.healing = healing_;
-    rec.burst_length = settings_.burst.healing + settings_.burst.window;
+    rec.burst_length = burst_length();
     ControllerRecord& c = rec.controller;
     c.active = true;
     c.adaptive = settings_.adaptive;
@@ -269,7 +300,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
             history_.push_back(std::move(early));
             curvature_only_front_ = true;
         }
-        accept_burst(m);
+        accept_burst(m, c);
         rec.status = StepStatus::burst_only;
         rec.t_end = t_end_;
         rec.x_end = rec.x_projected = x_end_;
@@ -303,7 +334,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     if (rec.dt == 0.0) {  // one burst of direct simulation from where we are
         if (c.limited_by == DtLimit::below_dt_min) ++totals_.direct;
         if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
-        accept_burst(m);
+        accept_burst(m, c);
         rec.status = StepStatus::burst_only;
         rec.x_projected = rec.x_end;
         controller_.direct_burst_done();
@@ -362,7 +393,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         } else if (settings_.steps == 1 && pool_.size() > 0) {
             pool_.commit(pool_.estimate(1), rec.dt);
         }
-        accept_burst(m);
+        accept_burst(m, c);
         ++totals_.accepted;
         totals_.dt_taken += rec.dt;
         if (settings_.adaptive) {
@@ -397,6 +428,12 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
     if (settings_.slope == SlopeSource::pooled)
         s += fmt::format("; slopes pooled over up to {} bursts", settings_.pool);
     if (settings_.healing_auto) s += fmt::format("; healing from evidence, now {:g}", healing_);
+    if (settings_.window_auto)
+        s += fmt::format("; window from evidence, now {:g} ({} over {} burst(s))", window_,
+                         fast_time2_ > 0.0
+                             ? fmt::format("fast noise about the slow path c = {:.3g}", fast_time2_)
+                             : std::string("no fast noise about the slow path measured"),
+                         noise_measurements_);
     if (t.accepted == 0) return s;
     const double n = static_cast<double>(t.accepted);
     const double err = t.statistical + t.truncation;
@@ -429,6 +466,11 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.totals = totals_;
     s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
     s.healing = healing_;
+    if (settings_.window_auto) {
+        s.window = window_;
+        s.window_fast_time2 = fast_time2_;
+        s.window_measurements = noise_measurements_;
+    }
     return s;
 }
 
@@ -437,6 +479,10 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     curvature_only_front_ = false;
     pool_.restore({});
     healing_ = settings_.burst.healing;
+    window_ = settings_.burst.window;
+    fast_time2_ = std::numeric_limits<double>::quiet_NaN();
+    noise_measurements_ = 0;
+    controller_.set_burst(burst_length(), window());
     if (!state) return;  // nothing saved: as new
     const MultistepState& s = *state;
     EFDEM_EXPECTS(s.history.size() <= static_cast<std::size_t>(settings_.steps) + 1);
@@ -455,6 +501,13 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     pool_.restore({s.pool.begin() + static_cast<std::ptrdiff_t>(skip), s.pool.end()});
     // Checkpoints before cpi.healing_auto have no healing: the configured one.
     healing_ = std::isnan(s.healing) ? settings_.burst.healing : s.healing;
+    // Checkpoints of runs without cpi.window_auto (or before it) have no window: the configured.
+    if (settings_.window_auto && !std::isnan(s.window)) {
+        window_ = s.window;
+        fast_time2_ = s.window_fast_time2;
+        noise_measurements_ = s.window_measurements;
+    }
+    controller_.set_burst(burst_length(), window());
 }
 
 }  // namespace efdem::coarse

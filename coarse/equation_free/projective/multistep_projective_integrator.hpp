@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "coarse/equation_free/estimators/slope_pool.hpp"
+#include "coarse/equation_free/estimators/window_noise.hpp"
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/projective_integrator.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
@@ -80,6 +81,16 @@ struct MultistepSettings {
     /// burst (whose length, burst.healing + burst.window, never changes).
     bool healing_auto = false;
     double healing_min = 0.0;  ///< the shortest healing (0 <= healing_min <= burst.healing)
+    /// cpi.window_auto (adaptive): every accepted burst measures how its slope's noise falls
+    /// with the window (estimators/window_noise.hpp); the bursts after it use the shortest
+    /// window within window_inefficiency_limit of the best efficiency for the healing they
+    /// have, on the dt_quantum grid from window_min to window_max, and at least two periods of
+    /// a wave the realizations share when one is measured. The burst is healing + that window.
+    bool window_auto = false;
+    double window_min = 0.0, window_max = 0.0;  ///< 0 < window_min <= window_max
+    static constexpr double window_inefficiency_limit = 0.25;
+    /// Bursts whose measurements the fast-noise constant averages (a running mean).
+    static constexpr int window_evidence = 4;
 };
 
 class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
@@ -121,6 +132,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         /// Why no jump may start from this burst (empty: it may), and its kind (none: it may).
         std::string hold;
         DtLimit hold_kind = DtLimit::none;
+        WindowNoise noise;  ///< cpi.window_auto: how the slope's noise falls with the window
+        /// The period of a wave the realizations share (wave_coherence), NaN: none measured.
+        double wave_period = std::numeric_limits<double>::quiet_NaN();
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
@@ -128,9 +142,16 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// The length of a burst of direct simulation starting now: one burst, or the rest of the
     /// run when one burst would leave less than one more (the run then ends at its end time).
     double direct_burst_length(const CoarseStepper& stepper) const;
-    void accept_burst(const Measured& m);
-    /// The estimation window of the bursts now: the burst less the current healing.
+    /// Takes the burst's slope and end state; cpi.window_auto: sizes the next bursts' window
+    /// from its evidence (into `c`).
+    void accept_burst(const Measured& m, ControllerRecord& c);
+    /// The estimation window of the bursts now: the burst less the current healing, or
+    /// (cpi.window_auto) the window the evidence asks for.
     double window() const;
+    /// The bursts' length now: healing + window.
+    double burst_length() const { return healing_ + window(); }
+    /// cpi.window_auto: the window of the next bursts from the accepted burst's evidence.
+    void judge_window(const Measured& m, ControllerRecord& c);
     /// cpi.healing_auto: the healing of the next bursts from the burst after a lift at t_lift;
     /// the evidence goes into `c`.
     void judge_healing(const BurstSamples& burst, double t_lift, ControllerRecord& c);
@@ -169,6 +190,11 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// record what pooling would have given).
     SlopePool pool_;
     double healing_;  ///< the healing of the next burst (cpi.healing_auto: from the evidence)
+    double window_;   ///< cpi.window_auto: the window of the next burst
+    /// cpi.window_auto: running mean of the bursts' fast-noise constant c (window_noise.hpp)
+    /// over the last window_evidence measurements, and how many there were.
+    double fast_time2_ = std::numeric_limits<double>::quiet_NaN();
+    int noise_measurements_ = 0;
     Totals totals_;
 };
 

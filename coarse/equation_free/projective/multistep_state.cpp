@@ -14,6 +14,11 @@ bool same(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 bool same(const SlopeNode& a, const SlopeNode& b) {
     return a.tau == b.tau && same(a.slope, b.slope) && same(a.se, b.se);
 }
+
+/// Equal, or both NaN (the "not written" of optional values).
+bool same_or_nan(double a, double b) {
+    return a == b || (std::isnan(a) && std::isnan(b));
+}
 }  // namespace
 
 bool MultistepState::operator==(const MultistepState& o) const {
@@ -35,7 +40,9 @@ bool MultistepState::operator==(const MultistepState& o) const {
            t.direct == u.direct && t.dt_taken == u.dt_taken && t.dt_tolerance == u.dt_tolerance &&
            t.dt_tolerance_2r == u.dt_tolerance_2r && t.dt_tolerance_4r == u.dt_tolerance_4r &&
            t.statistical == u.statistical && t.truncation == u.truncation &&
-           (healing == o.healing || (std::isnan(healing) && std::isnan(o.healing)));
+           same_or_nan(healing, o.healing) && same_or_nan(window, o.window) &&
+           same_or_nan(window_fast_time2, o.window_fast_time2) &&
+           window_measurements == o.window_measurements;
 }
 
 MultistepState MultistepState::from_layout(const std::vector<double>& r, const std::string& text) {

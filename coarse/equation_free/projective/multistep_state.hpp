@@ -49,6 +49,12 @@ struct MultistepState {
     /// The healing of the next burst (cpi.healing_auto changes it); NaN in checkpoints written
     /// before it: the configured cpi.healing.
     double healing = std::numeric_limits<double>::quiet_NaN();
+    /// cpi.window_auto: the window of the next burst, the running fast-noise constant and the
+    /// bursts it was measured on (window_noise.hpp); NaN / 0 in checkpoints of runs without it
+    /// (or written before it).
+    double window = std::numeric_limits<double>::quiet_NaN();
+    double window_fast_time2 = std::numeric_limits<double>::quiet_NaN();
+    int window_measurements = 0;
 
     /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
     bool operator==(const MultistepState& other) const;

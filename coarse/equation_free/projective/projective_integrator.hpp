@@ -78,6 +78,10 @@ struct ControllerRecord {
     /// cpi.healing_auto: the post-lift transient statistic of the burst after the jump and its
     /// threshold (estimators/post_lift_transient.hpp); NaN when not tested.
     double transient = nan, transient_threshold = nan;
+    /// cpi.window_auto: the accepted burst's V(W/2)/V(W) and its members' half-window slope
+    /// correlation (estimators/window_noise.hpp; NaN when not measured), and the window of the
+    /// bursts from now on.
+    double window_noise_ratio = nan, window_noise_correlation = nan, window_next = nan;
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
     Eigen::VectorXd statistical_nodes;  ///< per component

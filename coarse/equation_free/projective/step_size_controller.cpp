@@ -87,6 +87,12 @@ StepSizeController::StepSizeController(const StepSizeSetup& setup) : setup_(setu
     }
 }
 
+void StepSizeController::set_burst(double burst, double window) {
+    EFDEM_EXPECTS(window > 0.0 && window <= burst);
+    setup_.burst = burst;
+    setup_.window = window;
+}
+
 DtPlan StepSizeController::plan(const PlanInput& in) const {
     DtPlan p;
     const double burst = setup_.burst;

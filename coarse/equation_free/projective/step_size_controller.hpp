@@ -197,6 +197,9 @@ class StepSizeController {
     const StepSizeSetup& setup() const { return setup_; }
     const StepSizeState& state() const { return state_; }
     void restore(const StepSizeState& state) { state_ = state; }
+    /// cpi.window_auto: the bursts from now on are `burst` long with a `window` (their end-of-run
+    /// room and stability cycle). \pre 0 < window <= burst.
+    void set_burst(double burst, double window);
 
   private:
     StepSizeSetup setup_;
