@@ -33,6 +33,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.healing_auto", "false"},
     {"cpi.window_auto", "false"},
     {"cpi.window_max", nullptr},  // read only with cpi.window_auto
+    {"cpi.noisy_curvature", "counted"},
 };
 // clang-format on
 
@@ -40,6 +41,14 @@ bool as_before_the_key(const std::string& key, const std::string& value) {
     for (const auto& [k, v] : kAddedKeys)
         if (key == k) return v == nullptr || value == v;
     return false;
+}
+
+/// What a checkpoint that does not list `key` was written with ("" when the key is not one of
+/// kAddedKeys or any value does).
+std::string value_before_the_key(const std::string& key) {
+    for (const auto& [k, v] : kAddedKeys)
+        if (key == k && v != nullptr) return v;
+    return {};
 }
 }  // namespace
 
@@ -70,8 +79,13 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
         if (may_change_on_restart(key)) continue;
         const auto it = then.find(key);
         if (it == then.end()) {
-            if (!as_before_the_key(key, value))
-                changes.push_back(fmt::format("{} = {} (not in the checkpoint)", key, value));
+            if (as_before_the_key(key, value)) continue;
+            const std::string before = value_before_the_key(key);
+            changes.push_back(
+                before.empty()
+                    ? fmt::format("{} = {} (not in the checkpoint)", key, value)
+                    : fmt::format("{} = {} (not in the checkpoint, whose run did {} = {})", key,
+                                  value, key, before));
         } else if (it->second != value) {
             changes.push_back(fmt::format("{} = {} (checkpoint: {})", key, value, it->second));
         }

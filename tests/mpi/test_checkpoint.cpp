@@ -114,6 +114,19 @@ TEST_CASE("a restart may change run length, output and layout keys, not physics"
                Catch::Contains("pair_contact.kn = 3e5 (checkpoint: 2e5)"));
     CHECK_THROWS_WITH(check_restart("c.h5", h, h.parameters, 2, false),
                       Catch::Contains("holds 4 realizations but this run has 2"));
+    // Keys added since: absent from the checkpoint, accepted at what the runs before them did
+    // (cpi.window_max: any value, it acts only with cpi.window_auto), refused otherwise with
+    // that value named.
+    CHECK(check_restart("c.h5", h,
+                        h.parameters +
+                            "cpi.slope = burst\ncpi.window_auto = false\ncpi.window_max = 80\n"
+                            "cpi.noisy_curvature = counted\n",
+                        4, false)
+              .empty());
+    CHECK_THROWS_WITH(
+        check_restart("c.h5", h, h.parameters + "cpi.noisy_curvature = ignored\n", 4, false),
+        Catch::Contains("cpi.noisy_curvature = ignored (not in the checkpoint, whose run did "
+                        "cpi.noisy_curvature = counted)"));
 }
 
 TEST_CASE("checkpoint file names sort in writing order and exclude .tmp files",

@@ -57,8 +57,10 @@ EOF
   done
 }
 
+# cpi.noisy_curvature = counted: what the stored checkpoints' runs did (the rejection in them came
+# from a curvature within its noise).
 adaptive=(mode=cpi cpi.projection=adaptive cpi.integrator=adams_bashforth2 cpi.tolerance=0.06
-          cpi.dt_min=0.5 run.duration=24)
+          cpi.dt_min=0.5 run.duration=24 cpi.noisy_curvature=counted)
 fixed=(mode=cpi)
 run 2 "$work/adaptive-ref.log" "$@" "$efdem" "$scene" "${adaptive[@]}" ensemble.realizations_per_rank=2 \
   output.directory="$work" output.prefix=adaptive-ref checkpoint.interval=2 checkpoint.keep=10

@@ -34,4 +34,11 @@ struct MeanSignificance {
 /// (every se = 0): resolved exactly when some mean is not zero.
 MeanSignificance mean_significance(const Eigen::MatrixXd& values);
 
+/// The same test on an estimate `mean` (n components) whose noise variance per component
+/// `se2` was measured from the scatter of `realizations` realizations (a linear combination of
+/// their means, e.g. a divided difference of slopes). Not measured with fewer than 2
+/// realizations or no component. \pre mean.size() == se2.size(), se2 >= 0.
+MeanSignificance significance(const Eigen::VectorXd& mean, const Eigen::VectorXd& se2,
+                              int realizations);
+
 }  // namespace efdem::coarse

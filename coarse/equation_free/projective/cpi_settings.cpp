@@ -57,8 +57,8 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         s.periods.max_extension =
             cpi.get_or<double>("max_extension", 30.0, Bounds::closed(0.0, 1e7));
         on_grid("max_extension", s.periods.max_extension);
-        for (const char* key :
-             {"tolerance", "dt_min", "dt_max", "safety", "growth", "window_auto", "window_max"})
+        for (const char* key : {"tolerance", "dt_min", "dt_max", "safety", "growth", "window_auto",
+                                "window_max", "noisy_curvature"})
             if (cpi.contains(key))
                 cpi.fail(
                     key,
@@ -121,6 +121,8 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         c.growth = cpi.get_or<double>("growth", 2.0, Bounds::open_closed(1.0, 100.0));
         // The window from evidence (window_noise.hpp): at least 4 samples (2 per half, what
         // the measurement needs), at most cpi.window_max.
+        m.count_noisy_curvature =
+            cpi.get_or_choice("noisy_curvature", "ignored", {"ignored", "counted"}) == "counted";
         m.window_auto = cpi.get_or<bool>("window_auto", false);
         m.window_min = 4.0 * sample_interval;
         m.window_max =

@@ -34,6 +34,8 @@
 /// | cpi.window_auto   | adaptive: the window of the next bursts from how the slope's  | false   |
 /// |                   | noise falls with the window (estimators/window_noise.hpp)     |         |
 /// | cpi.window_max    | adaptive: the longest window cpi.window_auto may choose       | 4 burst |
+/// | cpi.noisy_curvature | adaptive: a posteriori curvature within its noise `ignored` | ignored |
+/// |                   | or `counted` as truncation error (runs before it: counted)    |         |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance

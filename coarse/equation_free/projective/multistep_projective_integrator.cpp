@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/equation_free/estimators/mean_significance.hpp"
 #include "coarse/equation_free/estimators/phase_drift.hpp"
 #include "coarse/equation_free/estimators/post_lift_transient.hpp"
 #include "coarse/equation_free/estimators/slope_estimators.hpp"
@@ -377,10 +378,26 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     judged.push_back(m.node);
     const DividedDifference d = slope_divided_difference(judged);
     const double omega = omega_integral(nodes, t_end_, rec.dt);
-    c.truncation = d.norm * omega;
+    // A curvature within its own noise is no evidence of truncation error: its debiased norm is
+    // still positive half the time by chance, and it would reject jumps the tolerance was spent
+    // on with the statistical part (the prior curvature of such a plan is already 0).
+    double curvature = d.norm;
+    if (settings_.adaptive && !settings_.count_noisy_curvature && curvature > 0.0) {
+        const int realizations =
+            rec.burst.members.empty() ? 0 : static_cast<int>(rec.burst.members.front().rows());
+        const MeanSignificance sig = significance(d.value, d.noise_variance, realizations);
+        if (sig.measured && !sig.resolved) {
+            append_message(
+                rec, fmt::format("the curvature after the jump is within its noise (S = {:.3g} "
+                                 "<= {:.3g}): truncation error judged 0, not {:.3g}",
+                                 sig.statistic, sig.threshold, curvature * omega));
+            curvature = 0.0;
+        }
+    }
+    c.truncation = curvature * omega;
     c.truncation_nodes = d.value.cwiseAbs() * omega;
 
-    const JumpErrorModel posterior = basis.model(t_end_, d.norm);
+    const JumpErrorModel posterior = basis.model(t_end_, curvature);
     const JumpVerdict verdict =
         controller_.judge(rec.dt, {c.statistical, c.truncation}, posterior, forced_reject);
     if (verdict.accepted) {

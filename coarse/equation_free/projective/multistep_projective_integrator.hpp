@@ -87,6 +87,10 @@ struct MultistepSettings {
     /// have, on the dt_quantum grid from window_min to window_max, and at least two periods of
     /// a wave the realizations share when one is measured. The burst is healing + that window.
     bool window_auto = false;
+    /// cpi.noisy_curvature (adaptive): false ("ignored"), a jump's a posteriori curvature counts
+    /// as truncation error only when it is resolved above its own noise (mean_significance.hpp);
+    /// true ("counted", what runs before it did): its debiased norm always counts.
+    bool count_noisy_curvature = false;
     double window_min = 0.0, window_max = 0.0;  ///< 0 < window_min <= window_max
     static constexpr double window_inefficiency_limit = 0.25;
     /// Bursts whose measurements the fast-noise constant averages (a running mean).
