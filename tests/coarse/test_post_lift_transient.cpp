@@ -20,29 +20,24 @@ namespace {
 /// units). A lift sets every member to the target plus `kick` on the fast components: kick 0
 /// leaves them where the slow dynamics has them (near 0), kick 1 starts a fast relaxation that
 /// a burst's first half shows and its second half does not.
-class KickedOu final : public CoarseStepper {
+class KickedOu final : public test::OuEnsembleView {
   public:
     KickedOu(double kick, std::uint64_t seed)
-        : toy_(rates(), 0.05, 4, 0.1, Eigen::VectorXd::Zero(19), seed), kick_(kick) {}
+        : OuEnsembleView(
+              test::OuEnsembleStepper(rates(), 0.05, 4, 0.1, Eigen::VectorXd::Zero(19), seed)),
+          kick_(kick) {}
     static Eigen::VectorXd rates() {
         Eigen::VectorXd k = Eigen::VectorXd::Constant(19, 1e-4);
         k.tail(9).setConstant(1.0);
         return k;
     }
-    double time() const override { return toy_.time(); }
-    void run(double duration, BurstSamples& out) override { toy_.run(duration, out); }
     void lift(const Eigen::VectorXd& target, double new_time) override {
         Eigen::VectorXd x = target;
         x.tail(9).array() += kick_;
         toy_.lift(x, new_time);
     }
-    bool can_keep_state() const override { return true; }
-    void keep_state() override { toy_.keep_state(); }
-    void return_to_kept_state() override { toy_.return_to_kept_state(); }
-    void confirm_kept_state() override { toy_.confirm_kept_state(); }
 
   private:
-    test::OuEnsembleStepper toy_;
     double kick_;
 };
 

@@ -121,13 +121,13 @@ namespace {
 /// components, sigma 0.05: q = 0.0025 per unit time) seen through white noise of standard
 /// deviation `white` on every sample (fast fluctuations about the slow path, uncorrelated from
 /// one sample to the next). The noise is not part of the state: a lift moves the walk.
-class WalkSeenThroughNoise final : public CoarseStepper {
+class WalkSeenThroughNoise final : public efdem::test::OuEnsembleView {
   public:
     WalkSeenThroughNoise(double white, std::uint64_t seed)
-        : toy_(Eigen::VectorXd::Constant(10, 1e-4), 0.05, 8, 0.1, Eigen::VectorXd::Zero(10), seed),
+        : OuEnsembleView(efdem::test::OuEnsembleStepper(Eigen::VectorXd::Constant(10, 1e-4), 0.05,
+                                                        8, 0.1, Eigen::VectorXd::Zero(10), seed)),
           white_(white),
           rng_(seed + 99) {}
-    double time() const override { return toy_.time(); }
     void run(double duration, BurstSamples& out) override {
         const std::size_t first = out.t.size();
         toy_.run(duration, out);
@@ -139,16 +139,8 @@ class WalkSeenThroughNoise final : public CoarseStepper {
             out.x[k] = out.members[k].colwise().mean().transpose();
         }
     }
-    void lift(const Eigen::VectorXd& target, double new_time) override {
-        toy_.lift(target, new_time);
-    }
-    bool can_keep_state() const override { return true; }
-    void keep_state() override { toy_.keep_state(); }
-    void return_to_kept_state() override { toy_.return_to_kept_state(); }
-    void confirm_kept_state() override { toy_.confirm_kept_state(); }
 
   private:
-    efdem::test::OuEnsembleStepper toy_;
     double white_;
     std::mt19937_64 rng_;
 };

@@ -211,4 +211,23 @@ class OuEnsembleStepper final : public coarse::CoarseStepper {
     std::optional<Kept> kept_;
 };
 
+/// An OuEnsembleStepper seen through a change a test makes: derive and override run() (what
+/// the samples show) or lift() (what a lift does); everything else is the toy's.
+class OuEnsembleView : public coarse::CoarseStepper {
+  public:
+    explicit OuEnsembleView(OuEnsembleStepper toy) : toy_(std::move(toy)) {}
+    double time() const override { return toy_.time(); }
+    void run(double duration, coarse::BurstSamples& out) override { toy_.run(duration, out); }
+    void lift(const Eigen::VectorXd& target, double new_time) override {
+        toy_.lift(target, new_time);
+    }
+    bool can_keep_state() const override { return true; }
+    void keep_state() override { toy_.keep_state(); }
+    void return_to_kept_state() override { toy_.return_to_kept_state(); }
+    void confirm_kept_state() override { toy_.confirm_kept_state(); }
+
+  protected:
+    OuEnsembleStepper toy_;
+};
+
 }  // namespace efdem::test
