@@ -200,3 +200,57 @@ TEST_CASE("cpi.window_auto: four healings for a random walk, longer with fast no
         for (std::size_t i = 4; i < fast.size(); ++i) CHECK(fast[i] > 6.5);
     }
 }
+
+namespace {
+
+/// The walk of WalkSeenThroughNoise (no white noise) with a wave every member shares:
+/// amplitude 0.5 and period 2.5 on every component and on the phase signal.
+class WalkWithWave final : public efdem::test::OuEnsembleView {
+  public:
+    explicit WalkWithWave(std::uint64_t seed)
+        : OuEnsembleView(efdem::test::OuEnsembleStepper(Eigen::VectorXd::Constant(10, 1e-4), 0.05,
+                                                        8, 0.1, Eigen::VectorXd::Zero(10), seed)) {}
+    void run(double duration, BurstSamples& out) override {
+        const std::size_t first = out.t.size();
+        toy_.run(duration, out);
+        for (std::size_t k = first; k < out.t.size(); ++k) {
+            const double wave = 0.5 * std::sin(2.0 * M_PI * out.t[k] / 2.5);
+            out.members[k].array() += wave;
+            out.x[k].array() += wave;
+            out.phase_signal[k] += wave;
+            out.member_phase[k].array() += wave;
+        }
+    }
+};
+
+}  // namespace
+
+TEST_CASE("cpi.window_auto keeps whole wave periods", "[unit][coarse][window_noise]") {
+    // A walk alone asks for W = 4 h = 4 (above); a wave of period 2.5 in the ensemble mean
+    // makes it whole periods, at least two: 5.
+    WalkWithWave toy(3);
+    MultistepSettings s;
+    s.burst.healing = 1.0;
+    s.burst.window = 8.0;
+    s.control = {.tolerance = 0.05, .dt_min = 1.0, .dt_max = 40.0};
+    s.dt_quantum = 0.1;
+    s.drift_rate = 1e6;  // the wave guard on; no burst is a fast transient
+    s.window_auto = true;
+    s.window_min = 0.4;
+    s.window_max = 40.0;
+    MultistepProjectiveIntegrator integrator(s);
+    integrator.set_end_time(200.0);
+    int windows = 0;
+    while (200.0 - toy.time() >= 2.0 * 40.0) {
+        const ProjectiveStepRecord r = integrator.step(toy);
+        REQUIRE(r.advanced());
+        if (!std::isfinite(r.controller.window_next)) continue;
+        ++windows;
+        INFO("window " << r.controller.window_next);
+        CHECK(r.controller.window_next >= 5.0 - 1e-9);
+        // A whole number of periods, to the sampling grid.
+        const double periods = r.controller.window_next / 2.5;
+        CHECK(std::abs(periods - std::round(periods)) < 0.1 / 2.5 + 1e-9);
+    }
+    CHECK(windows >= 5);
+}

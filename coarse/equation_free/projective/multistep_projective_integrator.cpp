@@ -93,16 +93,18 @@ void MultistepProjectiveIntegrator::judge_window(const Measured& m, ControllerRe
                           ? m.noise.fast_time2
                           : fast_time2_ + (m.noise.fast_time2 - fast_time2_) / k;
     }
-    const double step = settings_.dt_quantum, hi = settings_.window_max;
-    double lo = settings_.window_min;
-    // A wave the realizations share biases a slope over less than two of its periods.
-    if (std::isfinite(m.wave_period))
-        lo = std::min(hi, std::max(lo, std::ceil(2.0 * m.wave_period / step - 1e-9) * step));
+    const double step = settings_.dt_quantum, hi = settings_.window_max, lo = settings_.window_min;
     // No evidence yet: the configured window (within the bounds).
     window_ = noise_measurements_ == 0
                   ? std::clamp(window_, lo, hi)
                   : efficient_window(healing_, fast_time2_,
                                      MultistepSettings::window_inefficiency_limit, lo, hi, step);
+    // A wave of the ensemble mean biases a slope over a part of its period: whole periods, at
+    // least two (on the sampling grid, rounded up), as far as cpi.window_max allows.
+    if (std::isfinite(m.wave_period)) {
+        const double periods = std::max(2.0, std::ceil(window_ / m.wave_period - 1e-9));
+        window_ = std::min(hi, std::ceil(periods * m.wave_period / step - 1e-9) * step);
+    }
     c.window_next = window_;
     controller_.set_burst(burst_length(), window_);
 }
@@ -181,7 +183,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         // the realizations share that the window does not average out.
         const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
         const WaveCoherence w = wave_coherence(rec.burst, t_start);
-        if (w.in_phase) out.wave_period = w.period;
+        out.wave_period = w.period;  // NaN unless the ensemble mean oscillates twice
         if (d.drifting) {
             out.hold_kind = DtLimit::fast_transient;
             out.hold = "still in a fast transient (" + d.message + ")";

@@ -84,8 +84,9 @@ struct MultistepSettings {
     /// cpi.window_auto (adaptive): every accepted burst measures how its slope's noise falls
     /// with the window (estimators/window_noise.hpp); the bursts after it use the shortest
     /// window within window_inefficiency_limit of the best efficiency for the healing they
-    /// have, on the dt_quantum grid from window_min to window_max, and at least two periods of
-    /// a wave the realizations share when one is measured. The burst is healing + that window.
+    /// have, on the dt_quantum grid from window_min to window_max; when the ensemble mean's
+    /// phase signal shows a wave (two periods in the burst), whole periods of it, at least two.
+    /// The burst is healing + that window.
     bool window_auto = false;
     /// cpi.noisy_curvature (adaptive): false ("ignored"), a jump's a posteriori curvature counts
     /// as truncation error only when it is resolved above its own noise (mean_significance.hpp);
