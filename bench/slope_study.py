@@ -28,9 +28,12 @@ estimator's and the lift's, not the seeds'):
   autowindow_h10w10  cpi.healing_auto and cpi.window_auto: healing and window from evidence
   quiet_h10w10     burst_h10w10 with cpi.noisy_curvature = ignored (every other run: counted, what
                    the runs made before the key did)
+  own_h10w10       burst_h10w10 with cpi.lift = own (each realization jumps with its own slope)
  U_s = 0.41 (tolerance 0.32 d_p per jump, the one that jumps at all in bench/adaptive_study.py;
  healing 2 + window 20: two wave periods, T ~ 9):
   burst_h2w20, pooled_h2w20, members_h2w20, members_pooled_h2w20
+  autowindow_h2w20, quiet_h2w20   burst_h2w20 with cpi.window_auto (whole periods kept) and with
+                   cpi.noisy_curvature = ignored
 
 Error of a CPI run against the direct ensembles: e_j = RMS(X - D_j) over the CPI run's samples and
 the 19 nodes; e^2 = mean_j e_j^2. The floor: RMS(D_i - D_j) for the three pairs (mean, and the
@@ -80,12 +83,15 @@ CPI_BY_US = {
         ("members_pooled_h10w10", {**SLOW, **POOLED, **MEMBERS}),
         ("autowindow_h10w10", {**SLOW, "cpi.healing_auto": "true", "cpi.window_auto": "true"}),
         ("quiet_h10w10", {**SLOW, "cpi.noisy_curvature": "ignored"}),
+        ("own_h10w10", {**SLOW, "cpi.lift": "own"}),
     ),
     0.41: (
         ("burst_h2w20", WAVES),
         ("pooled_h2w20", {**WAVES, **POOLED}),
         ("members_h2w20", {**WAVES, **MEMBERS}),
         ("members_pooled_h2w20", {**WAVES, **POOLED, **MEMBERS}),
+        ("autowindow_h2w20", {**WAVES, "cpi.window_auto": "true"}),
+        ("quiet_h2w20", {**WAVES, "cpi.noisy_curvature": "ignored"}),
     ),
 }
 # Made in this order at U_s = 0.19: the first direct ensemble, the two burst variants (the most
@@ -93,9 +99,9 @@ CPI_BY_US = {
 # evidence-sized healing, the members' lift. At 0.41: the directs first, then the CPI runs.
 ORDER_BY_US = {
     0.19: ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "direct_c", "pooled_h10w10", "auto_h10w10",
-           "members_h10w10", "members_pooled_h10w10", "autowindow_h10w10", "quiet_h10w10"),
+           "members_h10w10", "members_pooled_h10w10", "autowindow_h10w10", "quiet_h10w10", "own_h10w10"),
     0.41: ("direct_a", "direct_b", "direct_c", "burst_h2w20", "pooled_h2w20", "members_h2w20",
-           "members_pooled_h2w20"),
+           "members_pooled_h2w20", "autowindow_h2w20", "quiet_h2w20"),
 }
 # Set from the command line in main(): the study's U_s, horizon, CPI runs and their order.
 DURATION = 600.0

@@ -71,6 +71,21 @@ class CoarseStepper {
      */
     virtual void lift(const Eigen::VectorXd& target, double new_time) = 0;
 
+    /**
+     * \brief Lifts the members apart (cpi.lift = own): member k (row k of the samples'
+     *        BurstSamples::members) to its own coarse vector now plus the jump's increment
+     *        (target minus the members' mean now) plus `member_steps.row(k)` minus the rows'
+     *        mean, so that the members' mean still lands on `target`; sets the micro clock to
+     *        `new_time`.
+     *
+     * A member whose row is not finite moves by the common increment alone; so do all when the
+     * rows do not match the members (the ensemble changed since the samples). Only steppers
+     * that restrict their members can (lifts_apart()); the default is a contract violation.
+     */
+    virtual bool lifts_apart() const { return false; }
+    virtual void lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
+                            double new_time);
+
     /// \name Going back: reject-and-redo of adaptive projective integration.
     /// keep_state() keeps the whole micro state (every realization, the random streams, the
     /// clock) in memory; the samples taken from then on are provisional. return_to_kept_state()

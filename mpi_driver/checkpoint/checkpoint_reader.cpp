@@ -76,7 +76,15 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
     };
     s.history = read_nodes("history");
     if (f.exists(g + "healing")) s.healing = real("healing");  // since cpi.healing_auto
-    if (f.exists(g + "window")) {                              // cpi.window_auto runs
+    if (f.exists(g + "member_deviation")) {  // cpi.lift = own runs: R x m, row-major
+        const std::vector<double> d = f.read_doubles(g + "member_deviation");
+        if (x.empty() || d.size() % x.size() != 0)
+            refuse(path, "has a malformed " + g + "member_deviation dataset");
+        s.member_deviation = Eigen::Map<
+            const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            d.data(), static_cast<Eigen::Index>(d.size() / x.size()), m);
+    }
+    if (f.exists(g + "window")) {  // cpi.window_auto runs
         s.window = real("window");
         s.window_fast_time2 = real("window_fast_time2");
         s.window_measurements = static_cast<int>(integer("window_measurements"));

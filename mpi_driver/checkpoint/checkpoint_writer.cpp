@@ -81,6 +81,14 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
     real("totals/statistical", t.statistical);
     real("totals/truncation", t.truncation);
     real("healing", s.healing);
+    if (s.member_deviation.size() > 0) {  // cpi.lift = own only; row-major R x m
+        const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> d =
+            s.member_deviation;
+        const auto rows = static_cast<std::size_t>(d.rows()),
+                   cols = static_cast<std::size_t>(d.cols());
+        f.write(g + "member_deviation", std::span<const double>(d.data(), rows * cols),
+                {rows, cols});
+    }
     if (std::isnan(s.window)) return;  // cpi.window_auto only
     real("window", s.window);
     real("window_fast_time2", s.window_fast_time2);

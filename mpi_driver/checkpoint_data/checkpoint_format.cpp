@@ -53,6 +53,12 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
         h = hash_value(d, h);
     // Written before cpi.healing_auto / the pool: the checksum such a file was written with.
     if (!std::isnan(s.healing)) h = hash_value(s.healing, h);
+    // cpi.lift = own only (files of other runs keep the checksum they had before it).
+    if (s.member_deviation.size() > 0) {
+        h = hash_value(static_cast<long>(s.member_deviation.rows()), h);
+        h = fnv1a(s.member_deviation.data(),
+                  static_cast<std::size_t>(s.member_deviation.size()) * sizeof(double), h);
+    }
     if (s.pool.empty()) return h;
     h = hash_value(static_cast<std::uint64_t>(s.pool.size()), h);
     for (const coarse::PooledBurst& b : s.pool) {

@@ -22,7 +22,9 @@
 ///                           dt_tolerance, dt_tolerance_2r, dt_tolerance_4r, statistical,
 ///                           truncation}; pool/{tau, slope, se, commitment} (n, n x m,
 ///                           n x m, n: the slope pool; absent in files written before it);
-///                           healing (the next burst's, cpi.healing_auto; absent before it)
+///                           healing (the next burst's, cpi.healing_auto; absent before it);
+///                           window, window_fast_time2, window_measurements (cpi.window_auto
+///                           runs only); member_deviation (R x m, cpi.lift = own runs only)
 ///                           (coarse::MultistepState)
 ///   /driver/integrator, /driver/integrator_text   formats 2 and 3: the same state as a
 ///                           positional vector and three lines of text

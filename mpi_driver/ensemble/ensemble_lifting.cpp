@@ -35,6 +35,31 @@ void EnsembleLifting::restore(const StepperState& s) {
     for (std::size_t r = 0; r < streams_.size(); ++r) streams_[r].set_state(s.lifting[r]);
 }
 
+namespace {
+/// The member steps of a lift apart, their mean over the finite rows taken out (a non-finite row
+/// becomes zero: the common increment alone); empty when there are none or their rows do not
+/// match the n lifted realizations (the ensemble changed since the burst).
+Eigen::MatrixXd centred_steps(const Eigen::MatrixXd* steps, long n, Eigen::Index m) {
+    if (!steps || steps->rows() != n || steps->cols() != m) return {};
+    Eigen::MatrixXd out = *steps;
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(m);
+    long finite = 0;
+    for (Eigen::Index k = 0; k < out.rows(); ++k) {
+        if (!out.row(k).allFinite()) {
+            out.row(k).setZero();
+            continue;
+        }
+        sum += out.row(k).transpose();
+        ++finite;
+    }
+    if (finite == 0) return {};
+    const Eigen::VectorXd mean = sum / static_cast<double>(finite);
+    for (Eigen::Index k = 0; k < out.rows(); ++k)
+        if (steps->row(k).allFinite()) out.row(k) -= mean.transpose();
+    return out;
+}
+}  // namespace
+
 void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
                            coarse::EnsembleObservable& observable, const Request& request) {
     const double start = MPI_Wtime();
@@ -89,7 +114,7 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
         last_ = LiftRecord{};
         // Each lifted realization's own X and their mean, in realization order (the same sum on
         // any layout); the increment target - mean moves every one of them alike.
-        Eigen::MatrixXd own;
+        Eigen::MatrixXd own, steps;
         Eigen::VectorXd increment;
         if (members) {
             own = observable.restrict_members(all_own, all_top);
@@ -103,7 +128,9 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
                 }
             EFDEM_ASSERT(n > 0);
             increment = *target - sum / static_cast<double>(n);
+            steps = centred_steps(request.member_steps, n, target->size());
         }
+        long k = 0;  // the lifted realizations so far: row k of the steps
         for (int r = 0; r < layout_.size(); ++r) {
             if (!lifted_here(r)) {
                 last_.changed.push_back(0);
@@ -117,6 +144,8 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             std::string repaired;
             if (members) {
                 x = own.row(r).transpose() + increment;
+                if (steps.rows() > 0) x += steps.row(k).transpose();
+                ++k;
                 if (member_repair_) {
                     const coarse::RepairReport report = member_repair_(x);
                     if (report.changed())

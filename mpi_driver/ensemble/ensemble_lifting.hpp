@@ -14,6 +14,8 @@
 ///   mean     every realization to the observable's lifting target of X;
 ///   members  (cpi.lift = members) realization r to X_r + (X - mean_r X_r): each keeps its
 ///            offset from the ensemble mean (one more gather: every realization's ICDF).
+///            With member steps (cpi.lift = own), the k-th lifted realization moves by row k of
+///            them on top (less the rows' mean: the mean still lands on X).
 ///
 /// A lift can be limited to some realizations (`only`: a realization rebuilt after a failure).
 
@@ -45,6 +47,10 @@ class EnsembleLifting {
         bool top_half = false;  ///< the observable's lifting target needs the top-half ICDF
         bool members = false;   ///< cpi.lift = members (not with `only`)
         const Eigen::VectorXd* target = nullptr;  ///< root: the coarse X; elsewhere null
+        /// Root, with members: one row per lifted realization in realization order (the
+        /// burst's members), added to its move; null, a row count that differs from the lifted
+        /// realizations', or a non-finite row: the common increment alone.
+        const Eigen::MatrixXd* member_steps = nullptr;
         /// Every rank, per global realization: lift only those marked 1 (null: all active), and
         /// leave the others' clocks alone (else a dropped realization's clock follows the jump).
         const std::vector<char>* only = nullptr;

@@ -102,6 +102,18 @@ void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
     do_lift(new_time, top, &target, members);
 }
 
+bool EnsembleStepper::lifts_apart() const {
+    return settings_.lift_members && observable().restricts_members();
+}
+
+void EnsembleStepper::lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
+                                 double new_time) {
+    EFDEM_EXPECTS(lifts_apart());
+    const bool top = observable().needs_top_half();
+    broadcast({Command::lift_members, new_time, top});
+    do_lift(new_time, top, &target, true, &member_steps);
+}
+
 void EnsembleStepper::finish(int exit_code) {
     if (exit_code != kExitInterrupted) snapshots_.release();
     finish_code_ = exit_code;
@@ -265,12 +277,13 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
 }
 
 void EnsembleStepper::do_lift(double new_time, bool top_half, const Eigen::VectorXd* target,
-                              bool members) {
+                              bool members, const Eigen::MatrixXd* member_steps) {
     EnsembleLifting::Request request;
     request.new_time = new_time;
     request.top_half = top_half;
     request.members = members;
     request.target = target;
+    request.member_steps = member_steps;
     lifting_.lift(local_, failures_.active(), observable(), request);
 }
 

@@ -100,6 +100,11 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     int realizations() const { return layout_.size(); }
     void run(double duration, coarse::BurstSamples& out) override;
     void lift(const Eigen::VectorXd& target, double new_time) override;
+    /// cpi.lift = own: lift_members's lift, each realization moved by its row of member_steps
+    /// on top (EnsembleLifting). Root only, like lift().
+    bool lifts_apart() const override;
+    void lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
+                    double new_time) override;
     /// Every rank keeps its realizations' states in memory (an EnsembleSnapshot: RealizationState,
     /// as a checkpoint does), the root its lifting streams and warm starts; samples are held back
     /// from the sink until confirm_kept_state() and dropped by return_to_kept_state(). The cost
@@ -232,7 +237,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     // serve()).
     /// Returns the samples taken (fewer than `samples` when a stop was agreed).
     long do_run(long samples, bool top_half, coarse::BurstSamples* out);
-    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members);
+    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members,
+                 const Eigen::MatrixXd* member_steps = nullptr);
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header,
                                         bool at_resume_point);
     void do_keep();

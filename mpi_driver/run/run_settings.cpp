@@ -70,13 +70,21 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     const auto observables = coarse::observable_table().names();
     s.observable = cpi.get_or_choice("observable", observables.front(), observables);
     s.cpi = coarse::CpiSettings::from_params(cpi, s.observe.interval, s.is_cpi());
-    s.lift_members = cpi.get_or_choice("lift", "mean", {"mean", "members"}) == "members";
+    const std::string lift = cpi.get_or_choice("lift", "mean", {"mean", "members", "own"});
+    s.lift_members = lift != "mean";
     if (s.lift_members && s.is_cpi() && !restricts_members(s.observable, s.observe.quantiles))
-        cpi.fail(
-            "lift",
-            "= members moves each realization from its own coarse state, and cpi.observable = " +
-                s.observable + " cannot restrict a realization on its own",
-            "mean, or members with cpi.observable = icdf");
+        cpi.fail("lift",
+                 "= " + lift +
+                     " moves each realization from its own coarse state, and cpi.observable = " +
+                     s.observable + " cannot restrict a realization on its own",
+                 "mean, or " + lift + " with cpi.observable = icdf");
+    // own: each realization jumps with its own slope (the multistep integrator measures them).
+    s.cpi.multistep.lift_apart = lift == "own";
+    if (lift == "own" && s.cpi.projection == coarse::CpiSettings::Projection::periods)
+        cpi.fail("lift",
+                 "= own moves each realization by its own slope's jump, which cpi.projection = "
+                 "periods does not measure",
+                 "mean or members with cpi.projection = periods; own with fixed or adaptive");
     if (s.is_steady()) {
         const auto* row = coarse::observable_table().find(s.observable);
         const long dimension =

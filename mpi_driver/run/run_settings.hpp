@@ -92,8 +92,10 @@ struct RunSettings {
     ObserveSettings observe;
     /// cpi.observable: a row of coarse::observable_table().
     std::string observable = "icdf";
-    /// cpi.lift = members: every realization is moved by the jump's increment, keeping its own
-    /// offset from the mean (the ensemble stepper's lift); `mean` (default): all lifted to X.
+    /// cpi.lift = members or own: every realization is moved from its own coarse state by the
+    /// jump's increment, keeping its offset from the mean (the ensemble stepper's lift); with
+    /// own (cpi.multistep.lift_apart) also by DT times its own slope's deviation from the
+    /// ensemble slope; `mean` (default): all lifted to X.
     bool lift_members = false;
     /// The other cpi.* keys, read by the coarse layer.
     coarse::CpiSettings cpi;

@@ -4,6 +4,7 @@
 // projective integrator bit for bit, members (each realization's coarse vector) included.
 #include <catch2/catch.hpp>
 
+#include <limits>
 #include <memory>
 
 #include "coarse/demixing/ensemble_observable.hpp"
@@ -255,4 +256,56 @@ TEST_CASE("cpi.lift = members moves every realization by the same increment, kee
           Approx(gap * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) * (1.0 - 0.1 * kH) *
                  (1.0 - 0.1 * kH))
               .epsilon(1e-12));
+}
+
+TEST_CASE("cpi.lift = own moves each realization by its own step on top of the common increment",
+          "[mpi][ensemble][cpi]") {
+    // As for members, plus row k of the member steps less their mean over the finite rows: the
+    // members' mean still lands on the target. A non-finite row moves by the common increment
+    // alone; steps whose rows do not match the realizations are not used at all.
+    const MpiComm world(MPI_COMM_WORLD);
+    ToyEnsemble toy(world, true);
+    EnsembleStepper& stepper = toy.stepper;
+    if (!world.is_root()) {
+        stepper.serve();
+        return;
+    }
+    REQUIRE(stepper.lifts_apart());
+    coarse::BurstSamples before, after, mismatched;
+    stepper.run(0.5, before);
+    const Eigen::MatrixXd own = before.members.back();  // R x 3, the states now
+    const Eigen::Vector3d target(2.0, 0.3, 0.7);
+    Eigen::MatrixXd steps(kRealizations, 3);
+    steps << 0.5, 0.0, 0.1,  //
+        -0.1, 0.2, 0.0,      //
+        0.0, 0.0, 0.0,       //
+        0.2, -0.2, 0.5;
+    steps.row(2).setConstant(std::numeric_limits<double>::quiet_NaN());
+    stepper.lift_apart(target, steps, stepper.time() + 1.0);
+    stepper.run(5 * kH, after);
+    // The same lift with a step matrix of the wrong size: every realization alike (members).
+    const Eigen::MatrixXd own2 = after.members.back();
+    stepper.lift_apart(target, Eigen::MatrixXd::Ones(kRealizations - 1, 3), stepper.time() + 1.0);
+    stepper.run(5 * kH, mismatched);
+    stepper.finish();
+    const Eigen::VectorXd increment = target - coarse::ensemble_mean(own);
+    // Mean over the finite rows 0, 1, 3: (0.2, 0, 0.2).
+    const Eigen::Vector3d mean_step(0.6 / 3, 0.0, 0.6 / 3);
+    const Eigen::MatrixXd a = toy_matrix();
+    REQUIRE(after.members.size() == 1);
+    Eigen::VectorXd lifted_mean = Eigen::VectorXd::Zero(3);
+    for (int r = 0; r < kRealizations; ++r) {
+        Eigen::VectorXd y = own.row(r).transpose() + increment;
+        if (r != 2) y += steps.row(r).transpose() - mean_step;
+        lifted_mean += y / kRealizations;
+        for (int k = 0; k < 5; ++k) y += kH * (a * y);
+        CHECK((after.members[0].row(r).transpose() - y).cwiseAbs().maxCoeff() < 1e-14);
+    }
+    CHECK((lifted_mean - target).cwiseAbs().maxCoeff() < 1e-14);
+    const Eigen::VectorXd increment2 = target - coarse::ensemble_mean(own2);
+    for (int r = 0; r < kRealizations; ++r) {
+        Eigen::VectorXd y = own2.row(r).transpose() + increment2;
+        for (int k = 0; k < 5; ++k) y += kH * (a * y);
+        CHECK((mismatched.members[0].row(r).transpose() - y).cwiseAbs().maxCoeff() < 1e-14);
+    }
 }

@@ -40,3 +40,12 @@ set -e
 [ $rc -eq 2 ] && grep -q "cpi.lift" "$work/refused.log" && [ ! -e "$work/refused/efdem.h5" ] \
   || { cat "$work/refused.log"; echo "FAIL: cpi.lift = members with the compact observable: exit $rc, expected 2"; exit 1; }
 echo "PASS: cpi.lift = members with the compact observable is refused (exit 2, the key named)"
+set +e
+timeout 120 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi cpi.lift=own \
+  cpi.projection=periods output.directory="$work/refused_own" > "$work/refused_own.log" 2>&1
+rc=$?
+set -e
+[ $rc -eq 2 ] && grep -q "cpi.lift" "$work/refused_own.log" && grep -q "periods" "$work/refused_own.log" \
+  && [ ! -e "$work/refused_own/efdem.h5" ] \
+  || { cat "$work/refused_own.log"; echo "FAIL: cpi.lift = own with cpi.projection = periods: exit $rc, expected 2"; exit 1; }
+echo "PASS: cpi.lift = own with cpi.projection = periods is refused (exit 2, the key named)"

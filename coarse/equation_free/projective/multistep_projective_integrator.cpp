@@ -165,6 +165,12 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     }
     out.node.tau = slope.t_mean;
     if (settings_.window_auto) out.noise = window_noise(rec.burst.t, rec.burst.members, t_window);
+    if (settings_.lift_apart) {
+        // Each member's own slope over the same window, less their mean (the ensemble's).
+        Eigen::MatrixXd own = member_least_squares_slopes(rec.burst.t, rec.burst.members, t_window);
+        if (own.rows() > 0) own.rowwise() -= own.colwise().mean();
+        out.member_deviation = std::move(own);
+    }
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
     if (settings_.adaptive && out.decay.ok && out.decay.rate < 0.0) {
         // A decay rate read from noise would halve DT for nothing (the slope's halves differ by
@@ -212,6 +218,7 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m, ControllerRe
     decay_ = m.decay;
     hold_kind_ = m.hold_kind;
     hold_ = m.hold;
+    member_deviation_ = m.member_deviation;
     judge_window(m, c);
 }
 
@@ -354,7 +361,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         return rec;
     }
     if (settings_.adaptive) stepper.keep_state();
-    stepper.lift(x, t_end_ + rec.dt);
+    if (settings_.lift_apart && stepper.lifts_apart() && member_deviation_.rows() > 0)
+        stepper.lift_apart(x, rec.dt * member_deviation_, t_end_ + rec.dt);
+    else
+        stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
 
     ProjectiveStepRecord after;  // the burst that judges the jump
@@ -485,6 +495,7 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.totals = totals_;
     s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
     s.healing = healing_;
+    s.member_deviation = member_deviation_;
     if (settings_.window_auto) {
         s.window = window_;
         s.window_fast_time2 = fast_time2_;
@@ -501,6 +512,7 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     window_ = settings_.burst.window;
     fast_time2_ = std::numeric_limits<double>::quiet_NaN();
     noise_measurements_ = 0;
+    member_deviation_ = Eigen::MatrixXd();
     controller_.set_burst(burst_length(), window());
     if (!state) return;  // nothing saved: as new
     const MultistepState& s = *state;
@@ -514,6 +526,9 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     hold_ = s.hold;
     controller_.restore(s.controller);
     totals_ = s.totals;
+    // Checkpoints of runs without cpi.lift = own (or before it): the members move alike until
+    // the next accepted burst measures them.
+    if (settings_.lift_apart) member_deviation_ = s.member_deviation;
     // A restart with a smaller cpi.pool keeps the newest bursts.
     const std::size_t skip =
         s.pool.size() > pool_.capacity() ? s.pool.size() - pool_.capacity() : 0;

@@ -92,6 +92,11 @@ struct MultistepSettings {
     /// as truncation error only when it is resolved above its own noise (mean_significance.hpp);
     /// true ("counted", what runs before it did): its debiased norm always counts.
     bool count_noisy_curvature = false;
+    /// cpi.lift = own: every jump lifts the members apart (CoarseStepper::lift_apart), member r
+    /// moved by DT times its own slope's deviation from the ensemble slope (from the last
+    /// accepted burst's window) on top of the common increment: a member that has stopped
+    /// stays where it stopped, and the members' mean lands where the projection put it.
+    bool lift_apart = false;
     double window_min = 0.0, window_max = 0.0;  ///< 0 < window_min <= window_max
     static constexpr double window_inefficiency_limit = 0.25;
     /// Bursts whose measurements the fast-noise constant averages (a running mean).
@@ -140,6 +145,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         WindowNoise noise;  ///< cpi.window_auto: how the slope's noise falls with the window
         /// The period of a wave the realizations share (wave_coherence), NaN: none measured.
         double wave_period = std::numeric_limits<double>::quiet_NaN();
+        /// cpi.lift = own: each member's slope minus the ensemble slope over the window.
+        Eigen::MatrixXd member_deviation;
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
@@ -200,6 +207,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// over the last window_evidence measurements, and how many there were.
     double fast_time2_ = std::numeric_limits<double>::quiet_NaN();
     int noise_measurements_ = 0;
+    /// cpi.lift = own: each member's slope minus the ensemble slope over the last accepted
+    /// burst's window (R x dim; empty: none measured, the members move alike).
+    Eigen::MatrixXd member_deviation_;
     Totals totals_;
 };
 

@@ -11,6 +11,10 @@ bool same(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     return a.size() == b.size() && (a.array() == b.array()).all();
 }
 
+bool same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols() && (a.array() == b.array()).all();
+}
+
 bool same(const SlopeNode& a, const SlopeNode& b) {
     return a.tau == b.tau && same(a.slope, b.slope) && same(a.se, b.se);
 }
@@ -42,7 +46,8 @@ bool MultistepState::operator==(const MultistepState& o) const {
            t.statistical == u.statistical && t.truncation == u.truncation &&
            same_or_nan(healing, o.healing) && same_or_nan(window, o.window) &&
            same_or_nan(window_fast_time2, o.window_fast_time2) &&
-           window_measurements == o.window_measurements;
+           window_measurements == o.window_measurements &&
+           same(member_deviation, o.member_deviation);
 }
 
 MultistepState MultistepState::from_layout(const std::vector<double>& r, const std::string& text) {

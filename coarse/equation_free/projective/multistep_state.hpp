@@ -55,6 +55,9 @@ struct MultistepState {
     double window = std::numeric_limits<double>::quiet_NaN();
     double window_fast_time2 = std::numeric_limits<double>::quiet_NaN();
     int window_measurements = 0;
+    /// cpi.lift = own: each member's slope minus the ensemble slope over the last accepted
+    /// burst's window (R x dim); empty in checkpoints of runs without it (or written before it).
+    Eigen::MatrixXd member_deviation;
 
     /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
     bool operator==(const MultistepState& other) const;

@@ -38,6 +38,11 @@ double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, doub
     return std::numeric_limits<double>::infinity();
 }
 
+void CoarseStepper::lift_apart([[maybe_unused]] const Eigen::VectorXd& target,
+                               [[maybe_unused]] const Eigen::MatrixXd& member_steps,
+                               [[maybe_unused]] double new_time) {
+    EFDEM_EXPECTS(lifts_apart());
+}
 void CoarseStepper::keep_state() {
     EFDEM_EXPECTS(can_keep_state());
 }
