@@ -277,6 +277,7 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
             {"window_noise_ratio", c.window_noise_ratio},
             {"window_noise_correlation", c.window_noise_correlation},
             {"window_next", c.window_next},
+            {"member_step", c.member_step},
             {"predicted_truncation", c.predicted_truncation},
             {"dt_tolerance", c.dt_tolerance},
             {"dt_tolerance_2r", c.dt_tolerance_2r},

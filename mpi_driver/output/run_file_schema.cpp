@@ -156,6 +156,10 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "cpi.window_auto: correlation of the members' slopes over the window's two halves", step},
         {"/cpi/controller/window_next", "sqrt(d_p/g)",
          "cpi.window_auto: the window of the bursts from this step on", step},
+        {"/cpi/controller/member_step", "d_p",
+         "cpi.lift = own: RMS over the realizations and nodes of DT (s_r - mean s), how far the "
+         "jump moved the realizations apart (NaN: they moved alike)",
+         step},
         {"/cpi/controller/pooled_bursts", "1",
          "bursts the step's slope used (1: the last burst's own)", step},
         {"/cpi/controller/error_truncation", "d_p", "estimated truncation error of the step (RMS)",

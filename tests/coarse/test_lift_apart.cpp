@@ -70,7 +70,8 @@ class RelaxingMembers final : public CoarseStepper {
 
 /// Fixed DT = 10 with bursts of 1 + 4 (8 samples of 0.5 in the window): k DT <= 1, so forward
 /// Euler is stable and accurate for every member.
-double end_mean(bool apart, bool members_alike, RelaxingMembers& toy, double t_end) {
+/// `recorded`: the jumps whose record says how far they moved the members apart.
+double end_mean(bool apart, bool members_alike, RelaxingMembers& toy, double t_end, int& recorded) {
     MultistepSettings s;
     s.burst.healing = 1.0;
     s.burst.window = 4.0;
@@ -93,6 +94,10 @@ double end_mean(bool apart, bool members_alike, RelaxingMembers& toy, double t_e
     while (toy.time() < t_end - 1e-9 && t_end - toy.time() >= 5.0 - 1e-9) {
         const ProjectiveStepRecord rec = integrator.step(stepper);
         REQUIRE(rec.advanced());
+        if (std::isfinite(rec.controller.member_step)) {
+            CHECK(rec.controller.member_step > 0.0);
+            ++recorded;
+        }
     }
     REQUIRE(toy.time() == Approx(t_end).margin(1e-9));
     return toy.mean();
@@ -111,12 +116,15 @@ TEST_CASE("cpi.lift = own keeps members that have stopped where they stopped",
     const double t_end = 300.0;
     RelaxingMembers own = four_members(), mean = four_members(), alike = four_members();
     const double exact = own.exact_mean(t_end);  // 4.952
-    const double e_own = end_mean(true, false, own, t_end) - exact;
-    const double e_mean = end_mean(false, false, mean, t_end) - exact;
-    const double e_alike = end_mean(false, true, alike, t_end) - exact;
+    int recorded_own = 0, recorded_mean = 0, recorded_alike = 0;
+    const double e_own = end_mean(true, false, own, t_end, recorded_own) - exact;
+    const double e_mean = end_mean(false, false, mean, t_end, recorded_mean) - exact;
+    const double e_alike = end_mean(false, true, alike, t_end, recorded_alike) - exact;
     INFO("end-mean errors: own " << e_own << ", mean " << e_mean << ", members " << e_alike);
     CHECK(own.apart > 10);  // every jump lifted apart (20 cycles of 15)
     CHECK(mean.apart == 0);
+    CHECK(recorded_own == own.apart);  // /cpi/controller/member_step of every jump apart
+    CHECK(recorded_mean + recorded_alike == 0);
     // Forward Euler per member (k DT <= 1, cycles of 15): 0.010 computed by a separate script of
     // the same scheme; 0.05 leaves room for the window's placement.
     CHECK(std::abs(e_own) < 0.05);

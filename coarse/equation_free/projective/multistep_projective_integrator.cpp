@@ -361,9 +361,11 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         return rec;
     }
     if (settings_.adaptive) stepper.keep_state();
-    if (settings_.lift_apart && stepper.lifts_apart() && member_deviation_.rows() > 0)
+    if (settings_.lift_apart && stepper.lifts_apart() && member_deviation_.rows() > 0) {
         stepper.lift_apart(x, rec.dt * member_deviation_, t_end_ + rec.dt);
-    else
+        c.member_step = rec.dt * std::sqrt(member_deviation_.squaredNorm() /
+                                           static_cast<double>(member_deviation_.size()));
+    } else
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
 

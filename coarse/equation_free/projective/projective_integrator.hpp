@@ -82,6 +82,9 @@ struct ControllerRecord {
     /// correlation (estimators/window_noise.hpp; NaN when not measured), and the window of the
     /// bursts from now on.
     double window_noise_ratio = nan, window_noise_correlation = nan, window_next = nan;
+    /// cpi.lift = own: RMS over the realizations and components of DT (s_r - mean s), how far
+    /// the jump moved the realizations apart (NaN: they moved alike).
+    double member_step = nan;
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
     Eigen::VectorXd statistical_nodes;  ///< per component
