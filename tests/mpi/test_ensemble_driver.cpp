@@ -162,6 +162,12 @@ struct ToyEnsemble {
         ss.lift_members = lift_members;
         return ss;
     }
+    /// The other ranks serve the root's commands until it finishes them; true on the root.
+    bool root_or_serve() {
+        if (layout.is_root()) return true;
+        stepper.serve();
+        return false;
+    }
     EnsembleLayout layout;
     coarse::IcdfObservable observable{3};
     test::ToyLifter lifter;
@@ -228,11 +234,8 @@ TEST_CASE("cpi.lift = members moves every realization by the same increment, kee
     // the next sample (5 Euler substeps of the toy from there) is reproduced here exactly.
     const MpiComm world(MPI_COMM_WORLD);
     ToyEnsemble toy(world, true);
+    if (!toy.root_or_serve()) return;
     EnsembleStepper& stepper = toy.stepper;
-    if (!world.is_root()) {
-        stepper.serve();
-        return;
-    }
     coarse::BurstSamples before, after;
     stepper.run(0.5, before);
     const Eigen::MatrixXd own = before.members.back();  // R x 3, the states now
@@ -265,11 +268,8 @@ TEST_CASE("cpi.lift = own moves each realization by its own step on top of the c
     // alone; steps whose rows do not match the realizations are not used at all.
     const MpiComm world(MPI_COMM_WORLD);
     ToyEnsemble toy(world, true);
+    if (!toy.root_or_serve()) return;
     EnsembleStepper& stepper = toy.stepper;
-    if (!world.is_root()) {
-        stepper.serve();
-        return;
-    }
     REQUIRE(stepper.lifts_apart());
     coarse::BurstSamples before, after, mismatched;
     stepper.run(0.5, before);

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # cpi.lift on a real DEM ensemble (4 realizations of the tiny bed on 2 ranks, fixed DT):
 # `mean` lifts every realization to the projected ICDF, so the spread between them collapses;
-# `members` moves each by the jump's increment, so the spread a direct ensemble has is kept.
+# `members` moves each by the jump's increment, so the spread a direct ensemble has is kept;
+# `own` (each by its own slope's jump too) keeps it as well and records every jump's member step.
 # Measured (2026-12-02): RMS s.d. over the nodes 0.466 d_p at the last sample before the first
 # lift, then 0.08 (mean) and 0.45 (members) at the first sample after it. Asserted with margins
 # an ensemble of 4 cannot cross by chance: members >= 0.7 x before, mean <= 0.4 x before. Also
 # refused: cpi.lift = members with the compact observable (no per-realization coarse state).
 #   lift_members.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 source "$(dirname "$0")/lib.sh" "$@"
-for lift in mean members; do
+for lift in mean members own; do
   timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi run.duration=12 \
     ensemble.realizations_per_rank=2 cpi.lift=$lift output.directory="$work" output.prefix=$lift \
     > "$work/$lift.log" 2>&1 || { cat "$work/$lift.log"; echo "FAIL: the cpi.lift = $lift run failed"; exit 1; }
@@ -19,18 +20,23 @@ import sys
 import h5py
 import numpy as np
 ratio = {}
-for lift in ("mean", "members"):
+for lift in ("mean", "members", "own"):
     with h5py.File(f"{sys.argv[1]}/{lift}.h5", "r") as f:
         t, var = f["samples/time"][:], f["samples/variance"][:]
         t_end, dt = f["cpi/t_end"][0], f["cpi/dt"][0]  # the first jump: from t_end to t_end + dt
+        # own (fixed DT here): every jump moved the realizations apart, and says by how much.
+        if lift == "own":
+            step = f["cpi/controller/member_step"][:] if "cpi/controller/member_step" in f else np.zeros(0)
+            if not (len(step) > 0 and np.all(step[np.asarray(f["cpi/dt"][:]) > 0] > 0)):
+                sys.exit(f"FAIL: cpi.lift = own with a fixed DT did not lift apart: member_step {step}")
     before = np.sqrt(var[np.searchsorted(t, t_end - 1e-9)].mean())
     after = np.sqrt(var[np.searchsorted(t, t_end + dt + 1e-9)].mean())
     ratio[lift] = after / before
     print(f"cpi.lift = {lift}: RMS s.d. {before:.3f} d_p before the first lift, {after:.3f} after")
-if not (ratio["members"] >= 0.7 and ratio["mean"] <= 0.4):
-    sys.exit(f"FAIL: spread after / before the first lift: members {ratio['members']:.2f} (want >= 0.7), "
-             f"mean {ratio['mean']:.2f} (want <= 0.4)")
-print("PASS: cpi.lift = members keeps the realizations' spread through a lift; mean collapses it")
+if not (ratio["members"] >= 0.7 and ratio["own"] >= 0.7 and ratio["mean"] <= 0.4):
+    sys.exit(f"FAIL: spread after / before the first lift: members {ratio['members']:.2f}, own "
+             f"{ratio['own']:.2f} (want >= 0.7), mean {ratio['mean']:.2f} (want <= 0.4)")
+print("PASS: cpi.lift = members and own keep the realizations' spread through a lift; mean collapses it")
 PY
 set +e
 timeout 120 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi cpi.lift=members \
