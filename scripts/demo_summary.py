@@ -11,12 +11,17 @@ same times, and what the CPI run cost, each number labelled with what it is.
   (both ensembles' noise; about 95 % if CPI were exact). With independent seeds and equal
   spreads, an exact CPI would lie inside the direct band for only about 83 % of the points (the
   difference of two such means has sqrt(2) times the standard error of one).
+  Beside them the noise floor of this comparison: the RMS difference two exact, independent
+  ensembles of these sizes would show, sqrt(mean(se_direct^2 + se_cpi^2)) from the two
+  ensembles' own spreads, and CPI's RMS difference as a multiple of it.
 * Cost: the DEM-time speed-up of CPI (simulated time / DEM time per realization, the gain of the
-  jumps) and the wall-time ratio direct / CPI of the run loops (and of the whole runs, settling
-  of the beds included), which also carries the coarse layer's overhead and the machine's load.
+  jumps kept; rejected ones are paid for) and the wall-time ratio direct / CPI of the run loops
+  (and of the whole runs, settling of the beds included), which also carries the coarse layer's
+  overhead and the machine's load. Only runs of equal spans are compared: a ratio of wall times
+  over different spans says nothing about CPI.
 
 Exit 2 with a message for missing or unsuitable files (not efdem run files, modes other than
-direct then cpi, other p-grids, no common sample time).
+direct then cpi, other p-grids, no common sample time, different simulated spans).
 """
 import sys
 
@@ -51,6 +56,7 @@ def load(path, mode):
         dt = f["cpi/dt"][:] if "cpi/dt" in f else np.zeros(0)
         status = [run_files.text(s) for s in f["cpi/status"][:]] if "cpi/status" in f else [""] * len(dt)
         run["jumps"] = int(sum(1 for d, s in zip(dt, status) if d > 0 and s != "rejected"))
+        run["rejected"] = int(sum(1 for s in status if s == "rejected"))
     return run
 
 
@@ -69,12 +75,14 @@ def agreement(d, c):
     ok = np.isfinite(diff)  # a mean is NaN only where no realization was left
     if not ok.any():
         raise run_files.UsageError("no finite ensemble mean at the common sample times")
+    floor = np.sqrt(se_d ** 2 + se_c ** 2)  # RMS difference of two exact independent ensembles
     inside_direct = np.abs(diff) <= Z95 * se_d
     inside_difference = np.abs(diff) <= Z95 * np.sqrt(se_d ** 2 + se_c ** 2)
     return {
         "times": len(common), "t_first": float(common[0]), "t_last": float(common[-1]),
         "points": int(ok.sum()),
         "rms": float(np.sqrt(np.mean(diff[ok] ** 2))),
+        "floor": float(np.sqrt(np.mean(floor[ok] ** 2))),
         "inside_direct_band": float(np.mean(inside_direct[ok])),
         "inside_difference_band": float(np.mean(inside_difference[ok])),
     }
@@ -84,14 +92,25 @@ def ratio(a, b):
     return a / b if b > 0 and np.isfinite(a) and np.isfinite(b) else np.nan
 
 
+def equal_spans(d, c):
+    """UsageError unless both runs simulated the same span (up to round-off)."""
+    a, b = d["simulated_time"], c["simulated_time"]
+    if abs(a - b) > 1e-6 * max(1.0, abs(a), abs(b)):
+        raise run_files.UsageError(
+            f"the direct run simulated {a:.6g} time units and the CPI run {b:.6g}: their wall times and "
+            "costs compare only over equal spans (run both with the same run.duration)")
+
+
 def summary(d, c):
     """The summary's lines (a list of str)."""
+    equal_spans(d, c)
     a = agreement(d, c)
     lines = []
     for name, r in (("direct", d), ("cpi", c)):
         settle = ("" if np.isnan(r["settling_wall_seconds"]) else
                   f" + {r['settling_wall_seconds']:.0f} s settling the beds = {r['total_wall_seconds']:.0f} s")
-        jumps = f", {r['jumps']} projective jump(s)" if name == "cpi" else ""
+        jumps = (f", {r['jumps']} projective jump(s) kept, {r['rejected']} rejected (a rejected jump's burst is "
+                 "paid for)" if name == "cpi" else "")
         lines.append(f"{name:>6}: R = {r['realizations']:.0f}, seed {r['seed']}, {r['end_status']}; simulated "
                      f"{r['simulated_time']:.4g} time units with {r['dem_time']:.4g} of DEM per realization{jumps}; "
                      f"wall {r['wall_seconds']:.0f} s run{settle}")
@@ -102,6 +121,9 @@ def summary(d, c):
         lines.append(f"  (both runs have seed {d['seed']}: they share their noise until CPI's first jump, which "
                      "flatters the agreement; the demo gives CPI its own seed)")
     lines.append(f"  RMS difference of the ensemble means (CPI - direct): {a['rms']:.3f} d_p")
+    lines.append(f"  noise floor of this comparison (RMS difference of two exact independent ensembles of these "
+                 f"sizes, from their own spread): {a['floor']:.3f} d_p; CPI's difference is "
+                 f"{ratio(a['rms'], a['floor']):.2f}x the floor")
     lines.append(f"  CPI inside the direct ensemble's 95 % band of its mean: {100 * a['inside_direct_band']:.0f} % "
                  "of points (an exact CPI with independent seeds and equal spread: about 83 %)")
     lines.append(f"  CPI within 1.96 standard errors of the difference of the two means: "

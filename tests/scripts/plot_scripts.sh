@@ -69,7 +69,7 @@ expect 2 "cannot be written" "plot_icdf, output folder missing" \
 out=$($py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/cpi.h5" 2>&1); code=$?
 for line in "RMS difference of the ensemble means" "inside the direct ensemble's 95 % band" \
             "within 1.96 standard errors of the difference" "DEM-time speed-up of CPI (simulated / DEM time)" \
-            "wall-time ratio direct / CPI"; do
+            "wall-time ratio direct / CPI" "noise floor of this comparison" "1 projective jump(s) kept, 0 rejected"; do
   [ $code -eq 0 ] && grep -qF "$line" <<< "$out" && pass "demo_summary: '$line'" || fail "demo_summary lacks '$line': $out"
 done
 # The speed-up is simulated / DEM time of the cpi file, printed to 2 decimals.
@@ -83,6 +83,15 @@ for name, shift in (("same", 0.0), ("shifted", 1.0)):
     with h5py.File(f"{w}/{name}.h5", "a") as f:
         f.attrs["mode"] = "cpi"
         f["samples/mean"][...] = f["samples/mean"][...] + shift
+# A CPI file of a longer span than the direct run's (the old quick start's 40 against 100).
+shutil.copy(f"{w}/cpi.h5", f"{w}/longer.h5")
+with h5py.File(f"{w}/longer.h5", "a") as f:
+    f.attrs["simulated_time"] = f.attrs["simulated_time"] + 2.5
+# The floor of two copies of one ensemble: sqrt(2) se, its RMS over the points.
+import numpy as np
+with h5py.File(f"{w}/direct.h5", "r") as f:
+    se2 = f["samples/variance"][:] / f.attrs["realizations"]
+print(f"{np.sqrt(np.mean(2 * se2)):.3f}", file=open(f"{w}/floor.txt", "w"))
 PY
 # Equal means: every difference is 0 (<= any band); shifted by 1 d_p everywhere: RMS exactly 1.
 expect 0 "RMS difference of the ensemble means (CPI - direct): 0.000 d_p" "demo_summary, equal means" \
@@ -91,6 +100,12 @@ expect 0 "95 % band of its mean: 100 % of points" "demo_summary, equal means ins
   $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
 expect 0 "RMS difference of the ensemble means (CPI - direct): 1.000 d_p" "demo_summary, shifted by 1" \
   $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/shifted.h5"
+# The floor: the same ensemble twice has sqrt(2) times one's standard error at every point.
+expect 0 "two exact independent ensembles of these sizes, from their own spread): $(cat "$work/floor.txt") d_p" \
+  "demo_summary, the floor of an ensemble compared with itself" $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
+# Different spans: refused, both spans named.
+expect 2 "their wall times and costs compare only over equal spans" "demo_summary, unequal spans" \
+  $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/longer.h5"
 expect 2 "expected 2 arguments" "demo_summary without arguments" $py "$src/scripts/demo_summary.py"
 expect 2 "cpi.h5: a cpi run; expected the direct run here" "demo_summary, runs swapped" \
   $py "$src/scripts/demo_summary.py" "$work/cpi.h5" "$work/direct.h5"
