@@ -1,6 +1,9 @@
 """What the resumable studies in bench/ share: one efdem run per folder, skipped when its run file
-says "completed", restarted from scratch when it is incomplete."""
+says "completed"; an incomplete one continues from its newest checkpoint (every run writes them:
+a direct run every 100 samples, a CPI run after every coarse step; a restart is bit for bit the
+uninterrupted run, mpi:restart_equality), or starts again when it has none or efdem refuses it."""
 import datetime as dt_
+import glob
 import os
 import shutil
 import subprocess
@@ -25,24 +28,45 @@ def completed(folder, name):
         return False
 
 
+def newest_checkpoint(folder, name):
+    """The newest checkpoint an earlier, incomplete attempt of FOLDER/NAME left, or None."""
+    found = sorted(glob.glob(os.path.join(folder, name, f"{name}_ckpt_*.h5")))
+    return found[-1] if found else None
+
+
 def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None):
     """mpirun -np NP efdem SCENE mode=MODE output.* KEY=VALUE... into FOLDER/NAME/ (command.txt,
-    NAME.log, NAME.h5). Returns whether it completed."""
+    NAME.log, NAME.h5), continued from the newest checkpoint of an earlier attempt when there is
+    one. Returns whether it completed."""
     label = label or name
     d = os.path.join(folder, name)
-    if os.path.isdir(d):
-        shutil.rmtree(d)  # an incomplete run: start it again
-    os.makedirs(d)
+    overrides = dict(overrides)
+    overrides.setdefault("checkpoint.interval", 100 if mode == "direct" else 1)
     cmd = ["mpirun", "-np", str(np_), "--oversubscribe", efdem, scene, f"mode={mode}",
            f"output.directory={os.path.abspath(d)}", f"output.prefix={name}"] + \
         [f"{k}={v}" for k, v in overrides.items()]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    with open(os.path.join(d, "command.txt"), "w") as f:
-        f.write(" ".join(cmd) + "\n")
     t0 = time.time()
-    print(f"  {label}: started {dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
-    with open(os.path.join(d, name + ".log"), "w") as log:
-        code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+    checkpoint = newest_checkpoint(folder, name) if os.path.isdir(d) else None
+    code = None
+    if checkpoint:
+        print(f"  {label}: continued from {os.path.basename(checkpoint)} "
+              f"{dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
+        with open(os.path.join(d, name + ".log"), "a") as log:
+            code = subprocess.call(cmd + [f"restart={checkpoint}"], stdout=log, stderr=subprocess.STDOUT,
+                                   env=env)
+        if code == 2:  # efdem refused the checkpoint (another version, other keys): start again
+            print(f"  {label}: the checkpoint was refused (see {name}.log): started again", flush=True)
+            code = None
+    if code is None:
+        if os.path.isdir(d):
+            shutil.rmtree(d)  # an incomplete run without a usable checkpoint: start it again
+        os.makedirs(d)
+        with open(os.path.join(d, "command.txt"), "w") as f:
+            f.write(" ".join(cmd) + "\n")
+        print(f"  {label}: started {dt_.datetime.now(dt_.timezone.utc):%H:%M:%S} UTC", flush=True)
+        with open(os.path.join(d, name + ".log"), "w") as log:
+            code = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
     ok = code == 0 and completed(folder, name)
     print(f"  {label}: {'ok' if ok else f'FAILED ({code})'} in {time.time() - t0:.0f} s", flush=True)
     return ok

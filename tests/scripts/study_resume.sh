@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# The resumable studies of bench/ (bench/study_runs.py run_case): a run that an earlier attempt
+# left incomplete continues from its newest checkpoint, and the result is bit for bit the
+# uninterrupted run's (compare_runs.py); a checkpoint efdem refuses (here: not HDF5) makes the
+# run start again and complete. The incomplete attempt is made by marking a completed run's file
+# 'running' and deleting the checkpoints after the first: what a kill leaves, since a restart
+# takes the output files from the checkpoint.
+#   study_resume.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+source "$(dirname "$0")/lib.sh" "$@"
+src=$(cd "$here/../.." && pwd)
+cd "$work" || exit 1
+/usr/bin/python3 - "$src" "$efdem" "$here/tiny_scene.cfg" "$work" "$here/compare_runs.py" <<'PY' || exit 1
+import glob, os, shutil, subprocess, sys
+import h5py
+src, efdem, scene, work, compare = sys.argv[1:]
+sys.path.insert(0, os.path.join(src, "bench"))
+import study_runs as sr
+
+over = {"run.duration": 6, "checkpoint.interval": 4, "checkpoint.keep": 100, "seed": 5}
+def run():
+    return sr.run_case(efdem, 2, scene, work, "d", "direct", over)
+
+def fail(why):
+    sys.exit(f"FAIL: {why}")
+
+if not run():
+    fail("the first, uninterrupted run did not complete")
+ref = os.path.join(work, "ref.h5")
+shutil.copy(sr.run_file(work, "d"), ref)
+checkpoints = sorted(glob.glob(os.path.join(work, "d", "d_ckpt_*.h5")))
+if len(checkpoints) < 2:
+    fail(f"expected checkpoints every 4 samples, found {checkpoints}")
+for c in checkpoints[1:]:
+    os.remove(c)
+with h5py.File(sr.run_file(work, "d"), "a") as f:
+    f.attrs["end_status"] = "running"
+if sr.completed(work, "d"):
+    fail("a run file marked 'running' counts as completed")
+if not run():
+    fail("the run continued from its checkpoint did not complete")
+log = open(os.path.join(work, "d", "d.log")).read()
+if "restarted from" not in log:
+    fail("the second attempt did not restart from the checkpoint")
+code = subprocess.call(["/usr/bin/python3", compare, ref, sr.run_file(work, "d")])
+if code != 0:
+    fail("the continued run differs from the uninterrupted one")
+print("PASS: an incomplete study run continues from its checkpoint, bit for bit the uninterrupted run")
+
+# A checkpoint efdem refuses: the run starts again and completes, equal to the reference too.
+with h5py.File(sr.run_file(work, "d"), "a") as f:
+    f.attrs["end_status"] = "running"
+first = sorted(glob.glob(os.path.join(work, "d", "d_ckpt_*.h5")))[-1]
+for c in glob.glob(os.path.join(work, "d", "d_ckpt_*.h5")):
+    os.remove(c)
+open(first, "w").write("not a checkpoint\n")
+if not run():
+    fail("the run whose checkpoint was refused did not start again and complete")
+if subprocess.call(["/usr/bin/python3", compare, ref, sr.run_file(work, "d")]) != 0:
+    fail("the run started again differs from the reference")
+print("PASS: a refused checkpoint makes the study run start again")
+PY
