@@ -179,9 +179,8 @@ double CpiSettings::window() const {
 
 std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {
     if (projection == Projection::adaptive ||
-        (projection == Projection::fixed &&
-         (steps == 2 || multistep.slope == SlopeSource::pooled || multistep.healing_auto ||
-          multistep.lift_apart)))
+        (projection == Projection::fixed && (steps == 2 || multistep.slope == SlopeSource::pooled ||
+                                             multistep.healing_auto || multistep.lift_apart)))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
     if (projection == Projection::fixed)
         return std::make_unique<ProjectiveForwardEuler>(fixed, std::move(repair));
