@@ -77,7 +77,7 @@ def agreement(d, c):
         raise run_files.UsageError("no finite ensemble mean at the common sample times")
     floor = np.sqrt(se_d ** 2 + se_c ** 2)  # RMS difference of two exact independent ensembles
     inside_direct = np.abs(diff) <= Z95 * se_d
-    inside_difference = np.abs(diff) <= Z95 * np.sqrt(se_d ** 2 + se_c ** 2)
+    inside_difference = np.abs(diff) <= Z95 * floor
     return {
         "times": len(common), "t_first": float(common[0]), "t_last": float(common[-1]),
         "points": int(ok.sum()),

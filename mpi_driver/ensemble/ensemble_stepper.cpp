@@ -96,10 +96,7 @@ void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
 }
 
 void EnsembleStepper::lift(const Eigen::VectorXd& target, double new_time) {
-    const bool top = observable().needs_top_half();
-    const bool members = settings_.lift_members && observable().restricts_members();
-    broadcast({members ? Command::lift_members : Command::lift, new_time, top});
-    do_lift(new_time, top, &target, members);
+    root_lift(target, nullptr, new_time);
 }
 
 bool EnsembleStepper::lifts_apart() const {
@@ -109,9 +106,16 @@ bool EnsembleStepper::lifts_apart() const {
 void EnsembleStepper::lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
                                  double new_time) {
     EFDEM_EXPECTS(lifts_apart());
+    root_lift(target, &member_steps, new_time);
+}
+
+void EnsembleStepper::root_lift(const Eigen::VectorXd& target, const Eigen::MatrixXd* member_steps,
+                                double new_time) {
     const bool top = observable().needs_top_half();
-    broadcast({Command::lift_members, new_time, top});
-    do_lift(new_time, top, &target, true, &member_steps);
+    const bool members =
+        lifts_apart();  // cpi.lift = members or own, and an observable with members
+    broadcast({members ? Command::lift_members : Command::lift, new_time, top});
+    do_lift(new_time, top, &target, members, member_steps);
 }
 
 void EnsembleStepper::finish(int exit_code) {

@@ -237,6 +237,9 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     // serve()).
     /// Returns the samples taken (fewer than `samples` when a stop was agreed).
     long do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    /// lift() and lift_apart() on the root: the command to the other ranks, then do_lift().
+    void root_lift(const Eigen::VectorXd& target, const Eigen::MatrixXd* member_steps,
+                   double new_time);
     void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members,
                  const Eigen::MatrixXd* member_steps = nullptr);
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header,

@@ -20,10 +20,12 @@ namespace efdem::coarse {
 
 namespace {
 
-/// The ensemble's least-squares slope over the first n samples of a burst from t_a on, and its
-/// members' standard error (empty when the burst has no members or the slope failed).
+/// The ensemble's least-squares slope over the first n samples of a burst from t_a on, its
+/// members' own slopes over the same window (R x dim) and the standard error those give (both
+/// empty when the burst has no members or the slope failed).
 struct WindowFit {
     SlopeEstimate slope;
+    Eigen::MatrixXd member_slopes;
     Eigen::VectorXd se;
 };
 
@@ -31,9 +33,11 @@ WindowFit fit_window(const BurstSamples& b, double t_a, std::size_t n) {
     const std::span<const double> t(b.t.data(), n);
     WindowFit f;
     f.slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
-    if (f.slope.ok && b.members.size() == b.t.size())
-        f.se = member_slope_standard_error(t, std::span<const Eigen::MatrixXd>(b.members.data(), n),
-                                           t_a);
+    if (f.slope.ok && b.members.size() == b.t.size()) {
+        f.member_slopes = member_least_squares_slopes(
+            t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
+        f.se = slope_standard_error(f.member_slopes);
+    }
     return f;
 }
 
@@ -166,10 +170,10 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     out.node.tau = slope.t_mean;
     if (settings_.window_auto) out.noise = window_noise(rec.burst.t, rec.burst.members, t_window);
     if (settings_.lift_apart) {
-        // Each member's own slope over the same window, less their mean (the ensemble's).
-        Eigen::MatrixXd own = member_least_squares_slopes(rec.burst.t, rec.burst.members, t_window);
-        if (own.rows() > 0) own.rowwise() -= own.colwise().mean();
-        out.member_deviation = std::move(own);
+        // Each member's own slope over the window, less their mean (the ensemble's).
+        out.member_deviation = std::move(fit.member_slopes);
+        if (out.member_deviation.rows() > 0)
+            out.member_deviation.rowwise() -= out.member_deviation.colwise().mean();
     }
     out.decay = estimate_decay_rate(rec.burst.t, rec.burst.x, t_window);
     if (settings_.adaptive && out.decay.ok && out.decay.rate < 0.0) {
@@ -363,8 +367,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     if (settings_.adaptive) stepper.keep_state();
     if (settings_.lift_apart && stepper.lifts_apart() && member_deviation_.rows() > 0) {
         stepper.lift_apart(x, rec.dt * member_deviation_, t_end_ + rec.dt);
-        c.member_step = rec.dt * std::sqrt(member_deviation_.squaredNorm() /
-                                           static_cast<double>(member_deviation_.size()));
+        c.member_step = rec.dt * rms(member_deviation_.reshaped());
     } else
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
