@@ -110,3 +110,42 @@ def pareto_front(points):
             front.append(i)
             best = points[i][1]
     return front
+
+
+def error_against_truth(mean, members_ref):
+    """RMS over samples and nodes of mean - mu, mu the infinite-ensemble mean, estimated against a
+    reference ensemble (members_ref: samples x N x m, independent of `mean`): E|x - m_ref|^2 =
+    E|x - mu|^2 + var/N, so e^2 = RMS^2(x - m_ref) - mean(var)/N, var the members' unbiased
+    variance per sample and node. Clipped at 0 (an estimate below the reference's own noise)."""
+    members_ref = np.asarray(members_ref, float)
+    n = members_ref.shape[1]
+    if n < 2:
+        raise ValueError(f"error_against_truth needs a reference of >= 2 members, not {n}")
+    ref = members_ref.mean(axis=1)
+    var = members_ref.var(axis=1, ddof=1)
+    e2 = rms_error(mean, ref) ** 2 - float(np.mean(var)) / n
+    return math.sqrt(max(e2, 0.0))
+
+
+def subset_errors(members, size, draws=200, seed=1):
+    """The error against the infinite-ensemble mean of a direct ensemble of `size` realizations,
+    from random subsets of one larger ensemble (members: samples x N x m): each subset's mean
+    against the mean of the other N - size members, corrected for their noise as in
+    error_against_truth (with the variance of all N). Returns the RMS over `draws` subsets (all
+    C(N, size) when fewer) of that error, i.e. sqrt(E e^2)."""
+    import itertools
+
+    members = np.asarray(members, float)
+    n = members.shape[1]
+    if not 1 <= size <= n - 2:
+        raise ValueError(f"subset_errors: size {size} must be in [1, N - 2] = [1, {n - 2}]")
+    var = float(np.mean(members.var(axis=1, ddof=1)))
+    combos = list(itertools.combinations(range(n), size)) if math.comb(n, size) <= draws else None
+    rng = np.random.default_rng(seed)
+    e2 = []
+    for k in range(len(combos) if combos else draws):
+        pick = list(combos[k]) if combos else sorted(rng.choice(n, size, replace=False))
+        rest = [i for i in range(n) if i not in pick]
+        d = members[:, pick].mean(axis=1) - members[:, rest].mean(axis=1)
+        e2.append(float(np.mean(d * d)) - var / (n - size))
+    return math.sqrt(max(float(np.mean(e2)), 0.0))

@@ -25,6 +25,28 @@ class Metrics(unittest.TestCase):
         self.assertAlmostEqual(am.rms_error(ref + 0.3, ref), 0.3, places=14)
         self.assertEqual(am.rms_error(ref, ref), 0.0)
 
+    def test_subset_errors_scale_as_one_over_root_size(self):
+        # 24 members of pure noise (sd 1), 200 samples x 19 nodes: an ensemble of S has error
+        # 1/sqrt(S) against the true mean (0). Each draw's e^2 averages 3,800 values (relative sd
+        # of e^2 ~ sqrt(2/3800) = 2.3 %), 200 draws average further: 3 % on the RMS is > 3 sd.
+        m = np.random.default_rng(3).normal(size=(200, 24, 19))
+        for size in (1, 2, 4, 8, 16):
+            self.assertAlmostEqual(am.subset_errors(m, size) * math.sqrt(size), 1.0, delta=0.03)
+        with self.assertRaises(ValueError):
+            am.subset_errors(m, 23)
+
+    def test_error_against_truth_removes_the_references_noise(self):
+        # An independent ensemble of 8 against a reference of 24 (both sd-1 noise): the raw RMS is
+        # sqrt(1/8 + 1/24) = 0.408, the estimate against the truth 1/sqrt(8) = 0.354. One draw of
+        # 3,800 values: the estimate's relative sd is ~2.5 %, so 7 % is about 3 sd.
+        rng = np.random.default_rng(4)
+        ref = rng.normal(size=(200, 24, 19))
+        x = rng.normal(size=(200, 8, 19)).mean(axis=1)
+        self.assertAlmostEqual(am.rms_error(x, ref.mean(axis=1)), math.sqrt(1 / 8 + 1 / 24), delta=0.03)
+        self.assertAlmostEqual(am.error_against_truth(x, ref) * math.sqrt(8), 1.0, delta=0.07)
+        # A bias b adds in quadrature: b = 0.5 on every node gives sqrt(1/8 + 0.25) = 0.612.
+        self.assertAlmostEqual(am.error_against_truth(x + 0.5, ref), math.sqrt(1 / 8 + 0.25), delta=0.03)
+
     def test_split_floors_count_and_scale(self):
         # 8 members of pure noise (sd 1), 400 samples x 19 nodes: 35 splits, each the RMS of a
         # difference of two means of 4, whose sd is sqrt(2/4) = 0.707; with 7,600 values per
