@@ -49,7 +49,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
 
 DIRECTS = ("direct_a", "direct_b", "direct_c")
-STUDIES = ("slope_study_r4_u0.19_t600", "slope_study_r8_u0.19_t200", "slope_study_r4_u0.41_t200",
+STUDIES = ("slope_study_r4_u0.19_t600", "slope_study_r8_u0.19_t600", "slope_study_r8_u0.19_t200", "slope_study_r4_u0.41_t200",
            "slope_study_r8_u0.41_t200")
 
 

@@ -45,6 +45,7 @@ SCENES = [
     (TINY, ["mode=cpi", "cpi.projection=periods"]),
     (TINY, ["mode=cpi", "cpi.projection=adaptive", "cpi.integrator=adams_bashforth2", "cpi.tolerance=0.1", "cpi.dt_min=1", "cpi.dt_max=2",
             "ensemble.realizations_per_rank=2"]),
+    (TINY, ["mode=cpi", "cpi.projection=adaptive", "cpi.accuracy=1.5", "ensemble.realizations_per_rank=2"]),
     (TINY, ["mode=cpi", "cpi.observable=compact"]),
     (TINY, ["observe.bed=true", "observe.compact=true"]),
     (TINY, ["checkpoint.interval=2", "ensemble.on_failure=drop"]),

@@ -84,6 +84,12 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
             const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
             d.data(), static_cast<Eigen::Index>(d.size() / x.size()), m);
     }
+    if (f.exists(g + "budget/sigma")) {  // cpi.accuracy runs
+        s.budget.variance = real("budget/variance");
+        s.budget.truncation = real("budget/truncation");
+        s.budget.t_last = real("budget/t_last");
+        s.budget.sigma = real("budget/sigma");
+    }
     if (f.exists(g + "window")) {  // cpi.window_auto runs
         s.window = real("window");
         s.window_fast_time2 = real("window_fast_time2");

@@ -89,6 +89,13 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
         f.write(g + "member_deviation", std::span<const double>(d.data(), rows * cols),
                 {rows, cols});
     }
+    if (!std::isnan(s.budget.sigma)) {  // cpi.accuracy only
+        f.create_group(g + "budget");
+        real("budget/variance", s.budget.variance);
+        real("budget/truncation", s.budget.truncation);
+        real("budget/t_last", s.budget.t_last);
+        real("budget/sigma", s.budget.sigma);
+    }
     if (std::isnan(s.window)) return;  // cpi.window_auto only
     real("window", s.window);
     real("window_fast_time2", s.window_fast_time2);

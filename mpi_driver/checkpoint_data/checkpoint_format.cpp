@@ -59,6 +59,10 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
         h = fnv1a(s.member_deviation.data(),
                   static_cast<std::size_t>(s.member_deviation.size()) * sizeof(double), h);
     }
+    // cpi.accuracy only (files of other runs keep the checksum they had before it).
+    if (!std::isnan(s.budget.sigma))
+        for (double d : {s.budget.variance, s.budget.truncation, s.budget.t_last, s.budget.sigma})
+            h = hash_value(d, h);
     if (s.pool.empty()) return h;
     h = hash_value(static_cast<std::uint64_t>(s.pool.size()), h);
     for (const coarse::PooledBurst& b : s.pool) {

@@ -160,6 +160,20 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "cpi.lift = own: RMS over the realizations and nodes of DT (s_r - mean s), how far the "
          "jump moved the realizations apart (NaN: they moved alike)",
          step},
+        {"/cpi/controller/budget", "d_p",
+         "cpi.accuracy: the error the jumps may add to the trajectory, a x the ensemble's "
+         "standard error (NaN without cpi.accuracy)",
+         step},
+        {"/cpi/controller/ensemble_standard_error", "d_p",
+         "cpi.accuracy: the ensemble's standard error the budget is set from (RMS over the nodes "
+         "of sqrt(var/R))",
+         step},
+        {"/cpi/controller/budget_spent", "d_p",
+         "cpi.accuracy: the error the kept jumps have added so far, contracted where a decay is "
+         "measured",
+         step},
+        {"/cpi/controller/contraction_rate", "1/sqrt(d_p/g)",
+         "cpi.accuracy: the decay rate credited to the accumulated error (0: none measured)", step},
         {"/cpi/controller/pooled_bursts", "1",
          "bursts the step's slope used (1: the last burst's own)", step},
         {"/cpi/controller/error_truncation", "d_p", "estimated truncation error of the step (RMS)",

@@ -80,6 +80,8 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                  "mean, or " + lift + " with cpi.observable = icdf");
     // own: each realization jumps with its own slope (the multistep integrator measures them).
     s.cpi.multistep.lift_apart = lift == "own";
+    // cpi.accuracy measures the ensemble's noise from every burst whose members a lift kept apart.
+    s.cpi.multistep.spread_survives_lift = s.lift_members;
     if (lift == "own" && s.cpi.projection == coarse::CpiSettings::Projection::periods)
         cpi.fail("lift",
                  "= own moves each realization by its own slope's jump, which cpi.projection = "

@@ -415,6 +415,34 @@ TEST_CASE("CpiSettings reads the adaptive keys and refuses what adaptive would i
     CHECK(a.multistep.window_auto);
     CHECK(a.multistep.window_min == 2.0);   // 4 samples of 0.5
     CHECK(a.multistep.window_max == 80.0);  // 4 bursts of 10 + 10
+    // cpi.accuracy instead of cpi.tolerance: not both, positive, adaptive only; the warm-up then
+    // runs by time unless asked otherwise, and no drift is judged before the noise is measured.
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.accuracy = 1\n"),
+               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.accuracy") &&
+                   Catch::Contains("cpi.tolerance") && Catch::Contains("one of them"));
+    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.accuracy = 0\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.accuracy"));
+    CHECK_THAT(
+        refused("cpi.projection = fixed\ncpi.accuracy = 1\n"),
+        Catch::Contains("cpi.accuracy") && Catch::Contains("only with cpi.projection = adaptive"));
+    ParamTable acc = ParamTable::from_text("cpi.projection = adaptive\ncpi.accuracy = 1.5\n",
+                                           "scene.cfg", "/scenes");
+    const CpiSettings b = CpiSettings::from_params(acc.root().scope("cpi"), 0.5);
+    CHECK(b.multistep.accuracy == 1.5);
+    CHECK(!b.warmup_until_steady);
+    CHECK(std::isinf(b.multistep.drift_rate));
+    CHECK(b.make_integrator({})->name() == "adaptive_forward_euler");
+    // On the command line, either replaces the scene's other.
+    ParamTable over = ParamTable::from_text("cpi.projection = adaptive\ncpi.tolerance = 0.1\n",
+                                            "scene.cfg", "/scenes");
+    over.add_override("cpi.accuracy=2");
+    CHECK(CpiSettings::from_params(over.root().scope("cpi"), 0.5).multistep.accuracy == 2.0);
+    ParamTable back = ParamTable::from_text("cpi.projection = adaptive\ncpi.accuracy = 2\n",
+                                            "scene.cfg", "/scenes");
+    back.add_override("cpi.tolerance=0.2");
+    const CpiSettings t = CpiSettings::from_params(back.root().scope("cpi"), 0.5);
+    CHECK(std::isnan(t.multistep.accuracy));
+    CHECK(t.multistep.control.tolerance == 0.2);
 }
 
 TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drifting",

@@ -134,10 +134,12 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
   # carries the decay verdict of the code that wrote it (before 15fd576), which assesses the
   # first step's stability from a rate the current code counts as noise: that step's stability
   # record differs, its DT and every sample do not (compared).
-  # The window evidence's records (cpi.window_auto) and the lift apart's (cpi.lift = own) came
-  # after every stored checkpoint.
+  # The window evidence's records (cpi.window_auto), the lift apart's (cpi.lift = own) and the
+  # trajectory budget's (cpi.accuracy) came after every stored checkpoint.
   ignore=(--ignore cpi/controller/window_noise_ratio cpi/controller/window_noise_correlation
-          cpi/controller/window_next cpi/controller/member_step)
+          cpi/controller/window_next cpi/controller/member_step cpi/controller/budget
+          cpi/controller/ensemble_standard_error cpi/controller/budget_spent
+          cpi/controller/contraction_rate)
   [ "$version" = 4 ] || ignore+=(cpi/controller/error_statistical_jump cpi/controller/error_statistical_burst
                                 cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts
                                 cpi/controller/transient cpi/controller/transient_threshold

@@ -3,7 +3,7 @@
 # (ICDF and compact observables; adaptive Adams-Bashforth 2 with a rejection before
 # the checkpoint, whose controller state is in it; adaptive forward Euler from pooled slopes,
 # whose slope pool, evidence-sized healing and window and, with cpi.lift = own, each realization's
-# own slope deviation are in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
+# own slope deviation are in it; with cpi.accuracy, whose trajectory budget is in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
 # realizations on 2 ranks; and a run from settled beds ("settled"), whose restart builds its beds
 # without settling them (the checkpoint replaces every particle state).
 # Compared: the run HDF5 file (compare_runs.py) and the CSV files (byte for byte: the wall time is in the sidecar, not compared).
@@ -35,6 +35,7 @@ for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi
             "compact 1 00000002 4 mode=cpi,cpi.observable=compact,run.duration=8" \
             "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
             "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
+            "accuracy 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.accuracy=4,cpi.lift=members,cpi.dt_min=0.5,run.duration=24" \
             "settled 4 00000008 2 mode=direct,bed.settle=true,bed.settle.ke_threshold=1e-3,bed.settle.max_time=20"; do
   read -r mode every from nps overrides <<< "$spec"
   IFS=, read -r -a extra <<< "$overrides"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <fmt/format.h>
@@ -57,8 +58,8 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         s.periods.max_extension =
             cpi.get_or<double>("max_extension", 30.0, Bounds::closed(0.0, 1e7));
         on_grid("max_extension", s.periods.max_extension);
-        for (const char* key : {"tolerance", "dt_min", "dt_max", "safety", "growth", "window_auto",
-                                "window_max", "noisy_curvature"})
+        for (const char* key : {"tolerance", "accuracy", "dt_min", "dt_max", "safety", "growth",
+                                "window_auto", "window_max", "noisy_curvature"})
             if (cpi.contains(key))
                 cpi.fail(
                     key,
@@ -107,7 +108,30 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
     if (adaptive) {
         const double burst = healing + window;
         StepSizeSettings& c = m.control;
-        c.tolerance = for_cpi_run
+        // Either the error of one jump (cpi.tolerance, d_p) or of the whole trajectory as a
+        // multiple of the ensemble's standard error (cpi.accuracy, trajectory_budget.hpp).
+        // Both given: the one on the command line replaces the scene's other (as an override
+        // replaces its own key); both in the scene, or both on the command line, is an error.
+        bool use_accuracy = cpi.contains("accuracy");
+        if (use_accuracy && cpi.contains("tolerance")) {
+            const auto on_command_line = [&](const char* key) {
+                return cpi.location(key).file == "<command line>";
+            };
+            if (on_command_line("accuracy") == on_command_line("tolerance"))
+                cpi.fail("accuracy",
+                         "is given together with cpi.tolerance; the one sets every jump's "
+                         "tolerance from the trajectory's budget, the other fixes it",
+                         "one of them: cpi.accuracy (the whole trajectory, in the ensemble's "
+                         "standard errors) or cpi.tolerance (each jump, in d_p); given on the "
+                         "command line, either replaces the scene's other");
+            use_accuracy = on_command_line("accuracy");
+            // The replaced key still counts as read (and range-checked).
+            (void)cpi.get<double>(use_accuracy ? "tolerance" : "accuracy",
+                                  Bounds::open_closed(0.0, 1e6));
+        }
+        if (use_accuracy) m.accuracy = cpi.get<double>("accuracy", Bounds::open_closed(0.0, 1e3));
+        c.tolerance = !std::isnan(m.accuracy) ? 1.0  // replaced before every jump
+                      : for_cpi_run
                           ? cpi.get<double>("tolerance", Bounds::open_closed(0.0, 1e6))
                           : cpi.get_or<double>("tolerance", 1.0, Bounds::open_closed(0.0, 1e6));
         c.dt_min = cpi.get_or<double>("dt_min", 0.5 * burst, Bounds::open_closed(0.0, 1e7));
@@ -144,7 +168,10 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                         c.dt_min, c.dt_max));
             m.first_dt = s.fixed.dt;
         }
-        m.drift_rate = steady_drift_rate(c.tolerance, burst);
+        // cpi.accuracy: no drift threshold until the ensemble's noise is measured (the
+        // integrator then holds jumps by the budget per burst); the first burst makes none.
+        m.drift_rate = std::isnan(m.accuracy) ? steady_drift_rate(c.tolerance, burst)
+                                              : std::numeric_limits<double>::infinity();
         const Params debug = cpi.scope("debug");
         const std::string force =
             debug.get_or_choice("force", "none", {"none", "reject", "shrink"});
@@ -153,12 +180,15 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                                            : ForcedDecision::Kind::none;
         m.force.attempt = debug.get_or<long>("force_attempt", 1, Bounds::closed(1, 1000000));
     }
-    s.warmup_until_steady = cpi.get_or_choice("warmup_until", adaptive ? "steady" : "time",
+    // cpi.accuracy has no tolerance to judge the warm-up's drift by before the run has measured
+    // its noise: the warm-up then runs cpi.warmup (or, asked for, until its drift is in its noise).
+    const bool by_tolerance = adaptive && std::isnan(m.accuracy);
+    s.warmup_until_steady = cpi.get_or_choice("warmup_until", by_tolerance ? "steady" : "time",
                                               {"time", "steady"}) == "steady";
     s.warmup_max =
         cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::closed(0.0, 1e7));
     on_grid("warmup_max", s.warmup_max);
-    s.warmup_drift_rate = adaptive ? m.drift_rate : 0.0;
+    s.warmup_drift_rate = by_tolerance ? m.drift_rate : 0.0;
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
     return s;

@@ -21,6 +21,10 @@
 /// | cpi.max_extension | most a burst may be lengthened to see 2 periods               | 30      |
 /// | cpi.stability     | `warn`, `halve` or `stop` when DT is flagged                  | warn    |
 /// | cpi.tolerance     | adaptive: error one jump may add, RMS over the ICDF [d_p]     | required|
+/// |                   | (unless cpi.accuracy)                                         |         |
+/// | cpi.accuracy      | adaptive, instead of cpi.tolerance: the error the jumps may   | none    |
+/// |                   | add to the whole trajectory, in ensemble standard errors      |         |
+/// |                   | (trajectory_budget.hpp; warm-up then by time by default)      |         |
 /// | cpi.dt_min        | adaptive: shortest jump; below it a burst runs directly       | burst/2 |
 /// | cpi.dt_max        | adaptive: longest jump                                        | 8 burst |
 /// | cpi.safety        | adaptive: DT is planned for safety x tolerance                | 0.8     |

@@ -79,6 +79,18 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
     EFDEM_EXPECTS(!settings.window_auto ||
                   (settings.adaptive && settings.window_min > 0.0 &&
                    settings.window_min <= settings.window_max && settings.dt_quantum > 0.0));
+    EFDEM_EXPECTS(std::isnan(settings.accuracy) || settings.adaptive);
+    if (!std::isnan(settings.accuracy)) budget_.emplace(settings.accuracy);
+}
+
+double MultistepProjectiveIntegrator::contraction_rate() const {
+    if (!decay_.ok || !(decay_.rate < 0.0)) return 0.0;
+    return std::min(-decay_.rate, 1.0 / burst_length());
+}
+
+double MultistepProjectiveIntegrator::drift_rate() const {
+    if (budget_ && budget_->ready()) return budget_->budget() / burst_length();
+    return settings_.drift_rate;
 }
 
 double MultistepProjectiveIntegrator::window() const {
@@ -169,6 +181,19 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     }
     out.node.tau = slope.t_mean;
     if (settings_.window_auto) out.noise = window_noise(rec.burst.t, rec.burst.members, t_window);
+    if (budget_ && rec.burst.members.size() == rec.burst.t.size()) {
+        // The ensemble's standard error over the window: RMS over its samples.
+        double sum = 0.0;
+        int n = 0;
+        for (std::size_t i = 0; i < rec.burst.t.size(); ++i) {
+            if (rec.burst.t[i] < t_window - 1e-9 * std::max(1.0, std::abs(t_window))) continue;
+            const double s = TrajectoryBudget::standard_error(rec.burst.members[i]);
+            if (!std::isfinite(s)) continue;
+            sum += s * s;
+            ++n;
+        }
+        if (n > 0) out.sigma = std::sqrt(sum / n);
+    }
     if (settings_.lift_apart) {
         // Each member's own slope over the window, less their mean (the ensemble's).
         out.member_deviation = std::move(fit.member_slopes);
@@ -188,10 +213,10 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
                 res.statistic, res.threshold, out.decay.rate);
         }
     }
-    if (settings_.adaptive && std::isfinite(settings_.drift_rate)) {
+    if (settings_.adaptive && std::isfinite(drift_rate())) {
         // No jump from a slope that is not the slow dynamics': a fast transient, or a wave
         // the realizations share that the window does not average out.
-        const PhaseDrift d = phase_drift(rec.burst, t_window, settings_.drift_rate);
+        const PhaseDrift d = phase_drift(rec.burst, t_window, drift_rate());
         const WaveCoherence w = wave_coherence(rec.burst, t_start);
         out.wave_period = w.period;  // NaN unless the ensemble mean oscillates twice
         if (d.drifting) {
@@ -223,7 +248,33 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m, ControllerRe
     hold_kind_ = m.hold_kind;
     hold_ = m.hold;
     member_deviation_ = m.member_deviation;
+    // cpi.accuracy: the ensemble's noise from a burst whose members the lift did not gather
+    // onto one ICDF (the first, before any lift; every one when the lift keeps them apart).
+    if (budget_ && std::isfinite(m.sigma) && (!budget_->ready() || settings_.spread_survives_lift))
+        budget_->measure(m.sigma);
     judge_window(m, c);
+}
+
+void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
+                                                       ControllerRecord& c) {
+    if (!budget_ || !budget_->ready()) return;
+    const double rate = contraction_rate();
+    // An open-ended run: the budget is planned over ten of the longest cycles ahead.
+    const double horizon = std::isfinite(end_time())
+                               ? end_time()
+                               : t_end_ + 10.0 * (settings_.control.dt_max + burst_length());
+    double tol = 0.0;
+    if (horizon > t_end_)
+        tol = budget_->jump_tolerance(basis.model(t_end_, prior_curvature()), horizon,
+                                      burst_length(), settings_.control.dt_max, rate);
+    // Spent (or no noise at all): a tolerance no jump of cpi.dt_min meets, so bursts run
+    // directly.
+    const double floor = 1e-12 * std::max(budget_->budget(), 1e-300);
+    controller_.set_tolerance(std::max(tol, floor));
+    c.budget = budget_->budget();
+    c.ensemble_standard_error = budget_->state().sigma;
+    c.budget_spent = budget_->spent(t_end_, rate);
+    c.contraction_rate = rate;
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -332,6 +383,8 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     rec.slope = nodes.back().slope;
     rec.slope_standard_error = nodes.back().se;
     c.steps = static_cast<int>(nodes.size());
+    set_jump_tolerance(basis, c);
+    if (settings_.adaptive) c.tolerance = controller_.setup().control.tolerance;
     const long attempt = totals_.attempts + totals_.direct + 1;
     const bool forced_shrink =
         settings_.force.kind == ForcedDecision::Kind::shrink && settings_.force.attempt == attempt;
@@ -427,6 +480,11 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         } else if (settings_.steps == 1 && pool_.size() > 0) {
             pool_.commit(pool_.estimate(1), rec.dt);
         }
+        if (budget_ && budget_->ready()) {
+            const double rate = contraction_rate();  // the burst before the jump's
+            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation, rate);
+            c.budget_spent = budget_->spent(t_end_ + rec.dt, rate);
+        }
         accept_burst(m, c);
         ++totals_.accepted;
         totals_.dt_taken += rec.dt;
@@ -468,6 +526,12 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
                              ? fmt::format("fast noise about the slow path c = {:.3g}", fast_time2_)
                              : std::string("no fast noise about the slow path measured"),
                          noise_measurements_);
+    if (budget_ && budget_->ready())
+        s += fmt::format(
+            "; trajectory budget {:.3g} d_p (cpi.accuracy {:g} x the ensemble's standard error "
+            "{:.3g}), {:.3g} d_p spent",
+            budget_->budget(), budget_->accuracy(), budget_->state().sigma,
+            budget_->spent(t_end_, contraction_rate()));
     if (t.accepted == 0) return s;
     const double n = static_cast<double>(t.accepted);
     const double err = t.statistical + t.truncation;
@@ -501,6 +565,7 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
     s.healing = healing_;
     s.member_deviation = member_deviation_;
+    if (budget_) s.budget = budget_->state();
     if (settings_.window_auto) {
         s.window = window_;
         s.window_fast_time2 = fast_time2_;
@@ -518,6 +583,7 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     fast_time2_ = std::numeric_limits<double>::quiet_NaN();
     noise_measurements_ = 0;
     member_deviation_ = Eigen::MatrixXd();
+    if (budget_) budget_->restore({});
     controller_.set_burst(burst_length(), window());
     if (!state) return;  // nothing saved: as new
     const MultistepState& s = *state;
@@ -534,6 +600,8 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     // Checkpoints of runs without cpi.lift = own (or before it): the members move alike until
     // the next accepted burst measures them.
     if (settings_.lift_apart) member_deviation_ = s.member_deviation;
+    // Checkpoints of runs without cpi.accuracy: the budget starts with the next burst's noise.
+    if (budget_ && !std::isnan(s.budget.sigma)) budget_->restore(s.budget);
     // A restart with a smaller cpi.pool keeps the newest bursts.
     const std::size_t skip =
         s.pool.size() > pool_.capacity() ? s.pool.size() - pool_.capacity() : 0;

@@ -31,6 +31,7 @@
 
 #include <deque>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,6 +42,7 @@
 #include "coarse/equation_free/projective/projective_integrator.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
+#include "coarse/equation_free/projective/trajectory_budget.hpp"
 
 namespace efdem::coarse {
 
@@ -97,6 +99,14 @@ struct MultistepSettings {
     /// accepted burst's window) on top of the common increment: a member that has stopped
     /// stays where it stopped, and the members' mean lands where the projection put it.
     bool lift_apart = false;
+    /// cpi.accuracy (adaptive): the error the jumps may add to the whole trajectory, as a
+    /// multiple of the ensemble's standard error (trajectory_budget.hpp); every jump's
+    /// tolerance (control.tolerance is then only the first value) comes from it. NaN: off.
+    double accuracy = std::numeric_limits<double>::quiet_NaN();
+    /// cpi.accuracy: the lift keeps the members' spread (cpi.lift = members or own), so every
+    /// accepted burst measures the ensemble's standard error; false (cpi.lift = mean, which
+    /// lifts every realization onto one ICDF): only the first burst, before any lift, does.
+    bool spread_survives_lift = false;
     double window_min = 0.0, window_max = 0.0;  ///< 0 < window_min <= window_max
     static constexpr double window_inefficiency_limit = 0.25;
     /// Bursts whose measurements the fast-noise constant averages (a running mean).
@@ -147,6 +157,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         double wave_period = std::numeric_limits<double>::quiet_NaN();
         /// cpi.lift = own: each member's slope minus the ensemble slope over the window.
         Eigen::MatrixXd member_deviation;
+        /// The ensemble's standard error over the window (TrajectoryBudget::standard_error,
+        /// RMS over its samples); NaN without members.
+        double sigma = std::numeric_limits<double>::quiet_NaN();
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
@@ -167,6 +180,13 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// cpi.healing_auto: the healing of the next bursts from the burst after a lift at t_lift;
     /// the evidence goes into `c`.
     void judge_healing(const BurstSamples& burst, double t_lift, ControllerRecord& c);
+    /// cpi.accuracy: the contraction rate credited to the accumulated error, the decay rate
+    /// the last accepted burst resolved (>= 0; 0 when none; at most 1 / burst: faster is a
+    /// fast transient, not the slow dynamics).
+    double contraction_rate() const;
+    /// The drift rate a burst's phase signal is held back by: settings_.drift_rate, or with
+    /// cpi.accuracy the trajectory's budget per burst once the ensemble's noise is measured.
+    double drift_rate() const;
     /// The method's nodes (q_eff of them) and the error model of the next jump.
     std::vector<SlopeNode> method_nodes() const;
     double prior_curvature() const;
@@ -183,6 +203,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     JumpBasis jump_basis() const;
     /// Asks the controller for the next DT and writes its plan into `rec`; returns DT.
     double plan_dt(ProjectiveStepRecord& rec, const JumpBasis& basis) const;
+    /// cpi.accuracy: the next jump's tolerance from the trajectory's budget (into the
+    /// controller), and the budget's record (into `c`); nothing without cpi.accuracy.
+    void set_jump_tolerance(const JumpBasis& basis, ControllerRecord& c);
     /// The record's statistical parts of a jump of `dt`: charged, the jump's own, and what one
     /// burst's slope and the whole pool would have given (ControllerRecord).
     void record_statistical(ControllerRecord& c, const JumpBasis& basis, double dt) const;
@@ -192,12 +215,13 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     std::deque<SlopeNode> history_;  ///< accepted slopes, oldest first (at most steps + 1)
     /// history_.front() is the first burst's earlier window: for the curvature, not projected from.
     bool curvature_only_front_ = false;
-    double t_end_ = 0.0;                 ///< end of the last accepted burst
-    Eigen::VectorXd x_end_;              ///< X there
-    DecayRateEstimate decay_;            ///< from the last accepted burst
-    std::string hold_;                   ///< why no jump may start from it (empty: one may)
-    DtLimit hold_kind_ = DtLimit::none;  ///< fast_transient or in_phase_wave (none: one may)
-    StepSizeController controller_;      ///< every rule on DT: plan, caps, accept/reject, redo
+    double t_end_ = 0.0;                      ///< end of the last accepted burst
+    Eigen::VectorXd x_end_;                   ///< X there
+    DecayRateEstimate decay_;                 ///< from the last accepted burst
+    std::string hold_;                        ///< why no jump may start from it (empty: one may)
+    DtLimit hold_kind_ = DtLimit::none;       ///< fast_transient or in_phase_wave (none: one may)
+    StepSizeController controller_;           ///< every rule on DT: plan, caps, accept/reject, redo
+    std::optional<TrajectoryBudget> budget_;  ///< cpi.accuracy: the trajectory's error budget
     /// The accepted bursts' slopes and their commitments (kept with cpi.slope = burst too, to
     /// record what pooling would have given).
     SlopePool pool_;

@@ -47,7 +47,10 @@ bool MultistepState::operator==(const MultistepState& o) const {
            same_or_nan(healing, o.healing) && same_or_nan(window, o.window) &&
            same_or_nan(window_fast_time2, o.window_fast_time2) &&
            window_measurements == o.window_measurements &&
-           same(member_deviation, o.member_deviation);
+           same(member_deviation, o.member_deviation) &&
+           same_or_nan(budget.variance, o.budget.variance) &&
+           same_or_nan(budget.truncation, o.budget.truncation) &&
+           same_or_nan(budget.t_last, o.budget.t_last) && same_or_nan(budget.sigma, o.budget.sigma);
 }
 
 MultistepState MultistepState::from_layout(const std::vector<double>& r, const std::string& text) {

@@ -16,6 +16,7 @@
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
+#include "coarse/equation_free/projective/trajectory_budget.hpp"
 
 namespace efdem::coarse {
 
@@ -58,6 +59,9 @@ struct MultistepState {
     /// cpi.lift = own: each member's slope minus the ensemble slope over the last accepted
     /// burst's window (R x dim); empty in checkpoints of runs without it (or written before it).
     Eigen::MatrixXd member_deviation;
+    /// cpi.accuracy: the trajectory's error budget (trajectory_budget.hpp); sigma NaN in
+    /// checkpoints of runs without it (or written before it).
+    TrajectoryBudgetState budget;
 
     /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
     bool operator==(const MultistepState& other) const;

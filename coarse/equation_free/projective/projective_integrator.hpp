@@ -62,7 +62,7 @@ struct ControllerRecord {
     bool active = false;     ///< the step was made by the multistep integrator
     bool adaptive = false;   ///< DT chosen by the controller (else fixed)
     int steps = 0;           ///< q of the jump: 1 forward Euler, 2 Adams-Bashforth 2
-    double tolerance = nan;  ///< cpi.tolerance (NaN when fixed)
+    double tolerance = nan;  ///< cpi.tolerance, or the jump's from cpi.accuracy (NaN when fixed)
     bool accepted = false;   ///< the jump was kept
     /// Projection noise the budget charges: the growth of the accumulated error's standard
     /// deviation (slope_pool.hpp; with the last burst's slope, DT x its standard error).
@@ -85,6 +85,10 @@ struct ControllerRecord {
     /// cpi.lift = own: RMS over the realizations and components of DT (s_r - mean s), how far
     /// the jump moved the realizations apart (NaN: they moved alike).
     double member_step = nan;
+    /// cpi.accuracy (NaN otherwise): the trajectory's budget a x sigma, the ensemble's standard
+    /// error sigma it was set from, the error accumulated by the jumps kept so far (after this
+    /// one, when kept) and the contraction rate credited to it (trajectory_budget.hpp).
+    double budget = nan, ensemble_standard_error = nan, budget_spent = nan, contraction_rate = nan;
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
     Eigen::VectorXd statistical_nodes;  ///< per component

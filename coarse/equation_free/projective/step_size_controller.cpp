@@ -87,6 +87,11 @@ StepSizeController::StepSizeController(const StepSizeSetup& setup) : setup_(setu
     }
 }
 
+void StepSizeController::set_tolerance(double tolerance) {
+    EFDEM_EXPECTS(std::isfinite(tolerance) && tolerance > 0.0);
+    setup_.control.tolerance = tolerance;
+}
+
 void StepSizeController::set_burst(double burst, double window) {
     EFDEM_EXPECTS(window > 0.0 && window <= burst);
     setup_.burst = burst;

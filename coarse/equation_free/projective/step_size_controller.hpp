@@ -200,6 +200,9 @@ class StepSizeController {
     /// cpi.window_auto: the bursts from now on are `burst` long with a `window` (their end-of-run
     /// room and stability cycle). \pre 0 < window <= burst.
     void set_burst(double burst, double window);
+    /// cpi.accuracy: the tolerance of the jumps from now on (trajectory_budget.hpp).
+    /// \pre tolerance > 0 finite.
+    void set_tolerance(double tolerance);
 
   private:
     StepSizeSetup setup_;

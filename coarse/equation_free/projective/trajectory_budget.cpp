@@ -1,0 +1,95 @@
+#include "coarse/equation_free/projective/trajectory_budget.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/contracts.hpp"
+
+namespace efdem::coarse {
+
+namespace {
+
+/// (1 - e^(-x)) / x, 1 at x = 0: the mean of e^(-s) over s in [0, x].
+double mean_decay(double x) {
+    return x < 1e-8 ? 1.0 - 0.5 * x : -std::expm1(-x) / x;
+}
+
+}  // namespace
+
+TrajectoryBudget::TrajectoryBudget(double accuracy) : accuracy_(accuracy) {
+    EFDEM_EXPECTS(std::isfinite(accuracy) && accuracy > 0.0);
+}
+
+double TrajectoryBudget::standard_error(const Eigen::MatrixXd& members) {
+    const auto r = members.rows();
+    if (r < 2 || members.cols() == 0) return std::numeric_limits<double>::quiet_NaN();
+    const Eigen::RowVectorXd mean = members.colwise().mean();
+    const Eigen::RowVectorXd var =
+        (members.rowwise() - mean).colwise().squaredNorm() / static_cast<double>(r - 1);
+    return std::sqrt(var.mean() / static_cast<double>(r));
+}
+
+void TrajectoryBudget::measure(double sigma) {
+    EFDEM_EXPECTS(std::isfinite(sigma) && sigma >= 0.0);
+    state_.sigma = sigma;
+}
+
+bool TrajectoryBudget::ready() const {
+    return std::isfinite(state_.sigma);
+}
+
+double TrajectoryBudget::budget() const {
+    return accuracy_ * state_.sigma;
+}
+
+double TrajectoryBudget::spent(double t, double rate) const {
+    EFDEM_EXPECTS(rate >= 0.0);
+    if (std::isnan(state_.t_last)) return 0.0;
+    const double decay = std::exp(-rate * std::max(0.0, t - state_.t_last));
+    return (state_.truncation + std::sqrt(state_.variance)) * decay;
+}
+
+double TrajectoryBudget::jump_tolerance(const JumpErrorModel& model, double end_time, double burst,
+                                        double dt_max, double rate) const {
+    EFDEM_EXPECTS(ready() && burst > 0.0 && std::isfinite(dt_max) && dt_max > 0.0 && rate >= 0.0 &&
+                  std::isfinite(end_time) && end_time > model.t0);
+    const double h = end_time - model.t0;
+    const double since = std::isnan(state_.t_last) ? 0.0 : std::max(0.0, model.t0 - state_.t_last);
+    const double decay_end = std::exp(-rate * (since + h));
+    const double c1 = mean_decay(rate * h), c2 = mean_decay(2.0 * rate * h);
+    const double t_end = state_.truncation * decay_end;
+    const double v_end = state_.variance * decay_end * decay_end;
+    const double b = budget();
+    const auto at_end = [&](double dt) {
+        const JumpError e = jump_error(model, dt);
+        const double n = h / (dt + burst);
+        return t_end + n * e.truncation * c1 +
+               std::sqrt(v_end + n * e.statistical * e.statistical * c2);
+    };
+    const double cap = std::min(dt_max, h);
+    if (at_end(0.0) > b) return 0.0;  // spent: no jump fits
+    double lo = 0.0, hi = cap;        // at_end(lo) <= b
+    if (at_end(hi) <= b) {
+        lo = hi;
+    } else {
+        while (hi - lo > 1e-6 * hi) {
+            const double mid = 0.5 * (lo + hi);
+            (at_end(mid) <= b ? lo : hi) = mid;
+        }
+    }
+    return jump_error(model, lo).total();
+}
+
+void TrajectoryBudget::commit(double t_landed, double statistical, double truncation, double rate) {
+    EFDEM_EXPECTS(rate >= 0.0 && statistical >= 0.0 && truncation >= 0.0);
+    if (!std::isnan(state_.t_last)) {
+        const double decay = std::exp(-rate * std::max(0.0, t_landed - state_.t_last));
+        state_.variance *= decay * decay;
+        state_.truncation *= decay;
+    }
+    state_.variance += statistical * statistical;
+    state_.truncation += truncation;
+    state_.t_last = t_landed;
+}
+
+}  // namespace efdem::coarse

@@ -1,0 +1,86 @@
+#pragma once
+/// \file
+/// TrajectoryBudget (cpi.accuracy = a): the accuracy of the whole trajectory, stated as a
+/// multiple a of the ensemble's own standard error, turned into the tolerance of each jump
+/// (docs/error_control.md §9).
+///
+/// The ensemble's standard error sigma is the RMS over the coarse vector's components of
+/// sqrt(var_members / R) — what the ensemble mean of R realizations is uncertain by anyway. The
+/// error CPI adds to the trajectory may be at most B = a sigma at every time. What the jumps
+/// made so far have added is accumulated: their statistical parts as variances (a pooled
+/// slope's correlation with earlier jumps is already in the charged part, statistical_error()),
+/// their truncation parts linearly, both contracted by exp(-lambda t) where the run measures a
+/// resolved decay rate lambda of the slow dynamics (none measured: no credit). The next jump's
+/// DT is the largest for which jumps like it, repeated over the rest of the run (H to its end,
+/// one every DT + burst), keep the accumulated error at the end within B:
+///   T e^(-lambda H) + n tau(DT) c_1 + sqrt(V e^(-2 lambda H) + n s(DT)^2 c_2) <= B,
+///   n = H / (DT + burst), c_k = (1 - e^(-k lambda H)) / (k lambda H) (1 without contraction),
+/// and its tolerance is that jump's error s(DT) + tau(DT). Once the budget is spent the
+/// tolerance falls below what cpi.dt_min allows and the run goes on directly.
+///
+/// \code
+/// TrajectoryBudget b(1.0);
+/// b.measure(sigma);                                  // from a burst whose members were not lifted
+/// together const double tol = b.jump_tolerance(model, end_time, burst, dt_max, lambda);
+/// // ... jump, judge against tol, and when kept:
+/// b.commit(t_landed, statistical, truncation, lambda);
+/// \endcode
+
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/projective/step_size_controller.hpp"
+
+namespace efdem::coarse {
+
+/// What a TrajectoryBudget remembers between jumps (saved in a checkpoint).
+struct TrajectoryBudgetState {
+    static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    double variance = 0.0;    ///< accumulated statistical error squared at t_last [unit^2]
+    double truncation = 0.0;  ///< accumulated truncation error at t_last [unit]
+    double t_last = nan;      ///< when they were last updated (NaN: no jump yet)
+    double sigma = nan;       ///< the ensemble's standard error last measured (NaN: none yet)
+};
+
+class TrajectoryBudget {
+  public:
+    /// \pre accuracy > 0 finite.
+    explicit TrajectoryBudget(double accuracy);
+
+    /// The ensemble's standard error of members (R x dim, R >= 2): RMS over the components of
+    /// sqrt(unbiased variance / R). NaN when R < 2.
+    static double standard_error(const Eigen::MatrixXd& members);
+
+    /// Takes sigma (finite, >= 0) as the ensemble's standard error from now on.
+    void measure(double sigma);
+    bool ready() const;  ///< a sigma has been measured
+    double accuracy() const { return accuracy_; }
+    /// B = a sigma (NaN before a measurement).
+    double budget() const;
+    /// The accumulated error at time t (>= t_last), contracted at `rate` (>= 0) since t_last:
+    /// T e^(-rate dt) + sqrt(V) e^(-rate dt).
+    double spent(double t, double rate) const;
+
+    /**
+     * \brief The tolerance of the next jump, starting at model.t0, of a run that ends at
+     *        `end_time` with bursts of `burst` after each jump and jumps of at most `dt_max`
+     *        (see the file comment). 0 when the budget is spent (or none measured yet).
+     * \pre ready(), burst > 0, dt_max > 0 finite, rate >= 0, end_time > model.t0 finite.
+     */
+    double jump_tolerance(const JumpErrorModel& model, double end_time, double burst, double dt_max,
+                          double rate) const;
+
+    /// A jump kept that landed at t_landed with these parts of its error; the accumulated
+    /// error is first contracted at `rate` (>= 0) from t_last to t_landed.
+    void commit(double t_landed, double statistical, double truncation, double rate);
+
+    const TrajectoryBudgetState& state() const { return state_; }
+    void restore(const TrajectoryBudgetState& state) { state_ = state; }
+
+  private:
+    double accuracy_;
+    TrajectoryBudgetState state_;
+};
+
+}  // namespace efdem::coarse

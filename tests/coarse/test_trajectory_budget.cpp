@@ -1,0 +1,198 @@
+// cpi.accuracy (coarse/equation_free/projective/trajectory_budget.hpp): the ensemble's standard
+// error, each jump's tolerance from the trajectory's budget (closed form without contraction,
+// more room with it, none once spent), the accumulated error a Monte Carlo of budgeted jumps
+// ends with, and — through the integrator on a noisy SDE with a known mean — that the budget
+// charged is the error the jumps made and a looser accuracy costs less DEM time.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
+#include "coarse/equation_free/projective/trajectory_budget.hpp"
+#include "tests/coarse/toy_steppers.hpp"
+
+using namespace efdem;
+using namespace efdem::coarse;
+
+namespace {
+
+/// One forward-Euler node with slope standard error `se` on every one of `dim` components and
+/// no curvature: a jump of DT has statistical error DT se, no truncation.
+JumpErrorModel euler(double se, double t0, Eigen::Index dim = 4) {
+    return {{SlopeNode{t0, Eigen::VectorXd::Zero(dim), Eigen::VectorXd::Constant(dim, se)}},
+            t0,
+            std::numeric_limits<double>::quiet_NaN(),
+            1.0,
+            {}};
+}
+
+}  // namespace
+
+TEST_CASE("the ensemble's standard error is the RMS over components of sqrt(var / R)",
+          "[unit][coarse][trajectory_budget]") {
+    // Two members 2 apart on component 0 (unbiased variance 2), 4 apart on component 1 (8):
+    // sqrt(mean(2, 8) / 2) = sqrt(2.5).
+    Eigen::MatrixXd m(2, 2);
+    m << 0.0, 0.0, 2.0, 4.0;
+    CHECK(TrajectoryBudget::standard_error(m) == Approx(std::sqrt(2.5)).epsilon(1e-14));
+    CHECK(std::isnan(TrajectoryBudget::standard_error(Eigen::MatrixXd::Ones(1, 3))));
+}
+
+TEST_CASE("a jump's tolerance spreads the budget over the jumps left, as the closed form says",
+          "[unit][coarse][trajectory_budget]") {
+    // No contraction, nothing spent: n = H / (DT + b) jumps of error DT se each accumulate to
+    // sqrt(n) DT se = B, i.e. H se^2 DT^2 = B^2 (DT + b): DT from the quadratic, tolerance DT se.
+    TrajectoryBudget b(2.0);
+    b.measure(0.05);  // B = 0.1
+    const double se = 0.002, h = 400.0, burst = 20.0, big = 1e4;
+    const double bb = b.budget() * b.budget(), a = h * se * se;
+    const double dt = (bb + std::sqrt(bb * bb + 4.0 * a * bb * burst)) / (2.0 * a);
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.0) ==
+          Approx(dt * se).epsilon(1e-5));
+    // dt_max caps the jump, and so its tolerance.
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, 10.0, 0.0) ==
+          Approx(10.0 * se).epsilon(1e-12));
+    // A measured contraction lets the same budget hold larger jumps (old errors decay).
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.01) > 1.2 * dt * se);
+    // Half the budget's variance spent leaves sqrt(1/2) of the room: DT from H se^2 DT^2 =
+    // (B^2 / 2)(DT + b).
+    b.commit(100.0, b.budget() / std::sqrt(2.0), 0.0, 0.0);
+    const double half = 0.5 * bb;
+    const double dt_half = (half + std::sqrt(half * half + 4.0 * a * half * burst)) / (2.0 * a);
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.0) ==
+          Approx(dt_half * se).epsilon(1e-5));
+    // All of it spent (a truncation error as large as the budget): no jump fits.
+    b.commit(100.0, 0.0, b.budget(), 0.0);
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.0) == 0.0);
+}
+
+TEST_CASE("the accumulated error contracts at the credited rate",
+          "[unit][coarse][trajectory_budget]") {
+    TrajectoryBudget b(1.0);
+    b.measure(1.0);
+    CHECK(b.spent(5.0, 0.1) == 0.0);  // nothing committed yet
+    b.commit(10.0, 0.3, 0.1, 0.0);
+    CHECK(b.spent(10.0, 0.0) == Approx(0.4).epsilon(1e-14));
+    CHECK(b.spent(30.0, 0.05) == Approx(0.4 * std::exp(-1.0)).epsilon(1e-14));
+    // A second jump adds its statistical part in quadrature to the contracted first.
+    b.commit(30.0, 0.4, 0.0, 0.05);
+    const double e = std::exp(-1.0);
+    CHECK(b.spent(30.0, 0.0) == Approx(0.1 * e + std::sqrt(0.09 * e * e + 0.16)).epsilon(1e-14));
+}
+
+TEST_CASE("budgeted jumps end within the trajectory's budget",
+          "[unit][coarse][trajectory_budget]") {
+    // Monte Carlo of the budget's own model: each jump's error is normal with the standard
+    // deviation its tolerance allows (DT se), jumps follow the plan until the run ends. The end
+    // error's RMS over 4,000 runs (relative s.d. ~1.1 %) must lie within the budget (<= 1.03 B)
+    // and use most of it (>= 0.8 B: the last cycle, shorter than a jump and burst, spends less).
+    const double se = 0.002, burst = 20.0, t_end = 600.0;
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> normal;
+    double sum2 = 0.0, budget = 0.0;
+    const int runs = 4000;
+    for (int run = 0; run < runs; ++run) {
+        TrajectoryBudget b(1.5);
+        b.measure(0.08);
+        budget = b.budget();
+        double t = 30.0, err = 0.0;
+        while (t_end - t > burst) {
+            const double tol = b.jump_tolerance(euler(se, t), t_end, burst, 200.0, 0.0);
+            const double dt = std::min(tol / se, t_end - t - burst);
+            if (dt < 1.0) {  // below any dt_min: the rest runs directly
+                t = t_end;
+                break;
+            }
+            err += normal(rng) * dt * se;
+            b.commit(t + dt, dt * se, 0.0, 0.0);
+            t += dt + burst;
+        }
+        sum2 += err * err;
+    }
+    const double rms = std::sqrt(sum2 / runs);
+    INFO("end error RMS " << rms << " against the budget " << budget);
+    CHECK(rms <= 1.03 * budget);
+    CHECK(rms >= 0.8 * budget);
+}
+
+namespace {
+
+struct BudgetRun {
+    std::vector<double> accumulated;  ///< per seed and component: the sum of the jumps' errors
+    std::vector<double> spent;        ///< per seed: the budget's account of it at the end
+    double max_spent_over_budget = 0.0;
+    double work = 0.0;  ///< micro time run, all seeds
+    long jumps = 0;
+};
+
+/// Adaptive CPI with cpi.accuracy = a on an ensemble of 8 slow Ornstein-Uhlenbeck processes
+/// (k = 1e-4: the mean barely moves, the members' spread grows as a random walk), bursts 1 + 4,
+/// 300 time units.
+BudgetRun budget_run(double a, std::uint64_t seeds) {
+    const Eigen::Index dim = 19;
+    const Eigen::VectorXd k = Eigen::VectorXd::Constant(dim, 1e-4);
+    BudgetRun out;
+    for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
+        test::OuEnsembleStepper toy(k, 0.05, 8, 0.1, Eigen::VectorXd::Constant(dim, 3.0),
+                                    300 + seed);
+        MultistepSettings s;
+        s.burst.healing = 1.0;
+        s.burst.window = 4.0;
+        s.control = {.tolerance = 1.0, .dt_min = 2.5, .dt_max = 80.0};
+        s.dt_quantum = 0.1;
+        s.accuracy = a;
+        MultistepProjectiveIntegrator integrator(s);
+        integrator.set_end_time(300.0);
+        Eigen::VectorXd sum = Eigen::VectorXd::Zero(dim);
+        double spent = 0.0;
+        while (300.0 - toy.time() >= 5.0 - 1e-9) {
+            const ProjectiveStepRecord r = integrator.step(toy);
+            REQUIRE(r.advanced());
+            const ControllerRecord& c = r.controller;
+            if (std::isfinite(c.budget_spent)) {
+                spent = c.budget_spent;
+                out.max_spent_over_budget = std::max(out.max_spent_over_budget, spent / c.budget);
+            }
+            if (r.status != StepStatus::projected) continue;
+            ++out.jumps;
+            const Eigen::VectorXd exact = ((-k.array() * r.dt).exp() * r.x_end.array()).matrix();
+            sum += r.x_projected - exact;
+        }
+        for (Eigen::Index i = 0; i < dim; ++i) out.accumulated.push_back(sum[i]);
+        out.spent.push_back(spent);
+        out.work += toy.work();
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("cpi.accuracy: the budget charged is the error the jumps made, a looser one costs less",
+          "[unit][coarse][trajectory_budget]") {
+    // 12 seeds x 19 components. The accumulated true jump error's mean square against the mean
+    // of the budget's account (spent^2, its statistical part: no truncation resolves at
+    // k = 1e-4): 228 values estimate a variance to ~10 % (1 s.d.), the components of one seed
+    // share their jumps' DT, so the bounds are wide (0.6-1.6). The account never exceeds the
+    // budget by more than a kept jump's a posteriori excess (5 %).
+    const BudgetRun tight = budget_run(2.0, 12);
+    const BudgetRun loose = budget_run(8.0, 12);
+    for (const BudgetRun* run : {&tight, &loose}) {
+        double acc = 0.0, charged = 0.0;
+        for (double e : run->accumulated) acc += e * e;
+        acc /= static_cast<double>(run->accumulated.size());
+        for (double s : run->spent) charged += s * s;
+        charged /= static_cast<double>(run->spent.size());
+        INFO("jumps " << run->jumps << ", accumulated mean square " << acc << ", charged "
+                      << charged << ", max spent / budget " << run->max_spent_over_budget);
+        CHECK(run->jumps > 12);  // at least one jump per seed on average
+        CHECK(run->max_spent_over_budget <= 1.05);
+        CHECK(acc / charged > 0.6);
+        CHECK(acc / charged < 1.6);
+    }
+    INFO("DEM time: accuracy 2 " << tight.work << ", accuracy 8 " << loose.work);
+    CHECK(loose.work < 0.9 * tight.work);
+}
