@@ -89,6 +89,8 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
         s.budget.truncation = real("budget/truncation");
         s.budget.t_last = real("budget/t_last");
         s.budget.sigma = real("budget/sigma");
+        s.budget.last_rate = real("budget/last_rate");
+        s.budget.rate = real("budget/rate");
     }
     if (f.exists(g + "window")) {  // cpi.window_auto runs
         s.window = real("window");

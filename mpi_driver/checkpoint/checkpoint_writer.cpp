@@ -95,6 +95,8 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
         real("budget/truncation", s.budget.truncation);
         real("budget/t_last", s.budget.t_last);
         real("budget/sigma", s.budget.sigma);
+        real("budget/last_rate", s.budget.last_rate);
+        real("budget/rate", s.budget.rate);
     }
     if (std::isnan(s.window)) return;  // cpi.window_auto only
     real("window", s.window);

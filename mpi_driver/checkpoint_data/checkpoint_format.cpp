@@ -61,7 +61,8 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
     }
     // cpi.accuracy only (files of other runs keep the checksum they had before it).
     if (!std::isnan(s.budget.sigma))
-        for (double d : {s.budget.variance, s.budget.truncation, s.budget.t_last, s.budget.sigma})
+        for (double d : {s.budget.variance, s.budget.truncation, s.budget.t_last, s.budget.sigma,
+                         s.budget.last_rate, s.budget.rate})
             h = hash_value(d, h);
     if (s.pool.empty()) return h;
     h = hash_value(static_cast<std::uint64_t>(s.pool.size()), h);

@@ -25,7 +25,8 @@
 ///                           healing (the next burst's, cpi.healing_auto; absent before it);
 ///                           window, window_fast_time2, window_measurements (cpi.window_auto
 ///                           runs only); member_deviation (R x m, cpi.lift = own runs only);
-///                           budget/{variance, truncation, t_last, sigma} (cpi.accuracy runs
+///                           budget/{variance, truncation, t_last, sigma, last_rate, rate}
+///                           (cpi.accuracy runs
 ///                           only: the trajectory's error budget, trajectory_budget.hpp)
 ///                           (coarse::MultistepState)
 ///   /driver/integrator, /driver/integrator_text   formats 2 and 3: the same state as a

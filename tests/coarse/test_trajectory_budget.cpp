@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -51,37 +52,56 @@ TEST_CASE("a jump's tolerance spreads the budget over the jumps left, as the clo
     const double se = 0.002, h = 400.0, burst = 20.0, big = 1e4;
     const double bb = b.budget() * b.budget(), a = h * se * se;
     const double dt = (bb + std::sqrt(bb * bb + 4.0 * a * bb * burst)) / (2.0 * a);
-    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.0) ==
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big) ==
           Approx(dt * se).epsilon(1e-5));
     // dt_max caps the jump, and so its tolerance.
-    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, 10.0, 0.0) ==
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, 10.0) ==
           Approx(10.0 * se).epsilon(1e-12));
-    // A measured contraction lets the same budget hold larger jumps (old errors decay).
-    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.01) > 1.2 * dt * se);
     // Half the budget's variance spent leaves sqrt(1/2) of the room: DT from H se^2 DT^2 =
     // (B^2 / 2)(DT + b).
-    b.commit(100.0, b.budget() / std::sqrt(2.0), 0.0, 0.0);
+    b.commit(100.0, b.budget() / std::sqrt(2.0), 0.0);
     const double half = 0.5 * bb;
     const double dt_half = (half + std::sqrt(half * half + 4.0 * a * half * burst)) / (2.0 * a);
-    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.0) ==
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big) ==
           Approx(dt_half * se).epsilon(1e-5));
     // All of it spent (a truncation error as large as the budget): no jump fits.
-    b.commit(100.0, 0.0, b.budget(), 0.0);
-    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big, 0.0) == 0.0);
+    b.commit(100.0, 0.0, b.budget());
+    CHECK(b.jump_tolerance(euler(se, 100.0), 100.0 + h, burst, big) == 0.0);
 }
 
-TEST_CASE("the accumulated error contracts at the credited rate",
+TEST_CASE("the accumulated error contracts at the credited rate, earned by two bursts in a row",
           "[unit][coarse][trajectory_budget]") {
     TrajectoryBudget b(1.0);
     b.measure(1.0);
-    CHECK(b.spent(5.0, 0.1) == 0.0);  // nothing committed yet
-    b.commit(10.0, 0.3, 0.1, 0.0);
-    CHECK(b.spent(10.0, 0.0) == Approx(0.4).epsilon(1e-14));
-    CHECK(b.spent(30.0, 0.05) == Approx(0.4 * std::exp(-1.0)).epsilon(1e-14));
+    CHECK(b.spent(5.0) == 0.0);  // nothing committed yet
+    b.commit(10.0, 0.3, 0.1);
+    CHECK(b.spent(10.0) == Approx(0.4).epsilon(1e-14));
+    // One burst's decay earns nothing (a transient); a second resolved decay earns the smaller
+    // of the two, at most the cap; a burst without one takes the credit away.
+    b.credit(0.2, 0.1);
+    CHECK(b.rate() == 0.0);
+    b.credit(0.05, 0.1);
+    CHECK(b.rate() == 0.05);
+    CHECK(b.spent(30.0) == Approx(0.4 * std::exp(-1.0)).epsilon(1e-14));
+    b.credit(0.3, 0.1);
+    CHECK(b.rate() == 0.05);  // the smaller of the last two
+    b.credit(0.3, 0.1);
+    CHECK(b.rate() == 0.1);  // the cap
+    b.credit(std::numeric_limits<double>::quiet_NaN(), 0.1);
+    CHECK(b.rate() == 0.0);
     // A second jump adds its statistical part in quadrature to the contracted first.
-    b.commit(30.0, 0.4, 0.0, 0.05);
+    b.credit(0.05, 0.1);
+    b.credit(0.05, 0.1);
+    b.commit(30.0, 0.4, 0.0);
     const double e = std::exp(-1.0);
-    CHECK(b.spent(30.0, 0.0) == Approx(0.1 * e + std::sqrt(0.09 * e * e + 0.16)).epsilon(1e-14));
+    CHECK(b.spent(30.0) == Approx(0.1 * e + std::sqrt(0.09 * e * e + 0.16)).epsilon(1e-14));
+    // Contraction frees room for the next jump (the old errors have decayed), never promises
+    // any for the future: at the same account, more time since the last jump, more room.
+    const double se = 0.02;
+    const double soon = b.jump_tolerance(euler(se, 30.0), 400.0, 20.0, 1e4);
+    const double later = b.jump_tolerance(euler(se, 60.0), 430.0, 20.0, 1e4);
+    CHECK(soon < 0.5);  // the budget, not the horizon, sets it
+    CHECK(later > soon);
 }
 
 TEST_CASE("budgeted jumps end within the trajectory's budget",
@@ -101,14 +121,14 @@ TEST_CASE("budgeted jumps end within the trajectory's budget",
         budget = b.budget();
         double t = 30.0, err = 0.0;
         while (t_end - t > burst) {
-            const double tol = b.jump_tolerance(euler(se, t), t_end, burst, 200.0, 0.0);
+            const double tol = b.jump_tolerance(euler(se, t), t_end, burst, 200.0);
             const double dt = std::min(tol / se, t_end - t - burst);
             if (dt < 1.0) {  // below any dt_min: the rest runs directly
                 t = t_end;
                 break;
             }
             err += normal(rng) * dt * se;
-            b.commit(t + dt, dt * se, 0.0, 0.0);
+            b.commit(t + dt, dt * se, 0.0);
             t += dt + burst;
         }
         sum2 += err * err;

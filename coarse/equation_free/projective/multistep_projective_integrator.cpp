@@ -83,11 +83,6 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
     if (!std::isnan(settings.accuracy)) budget_.emplace(settings.accuracy);
 }
 
-double MultistepProjectiveIntegrator::contraction_rate() const {
-    if (!decay_.ok || !(decay_.rate < 0.0)) return 0.0;
-    return std::min(-decay_.rate, 1.0 / burst_length());
-}
-
 double MultistepProjectiveIntegrator::drift_rate() const {
     if (budget_ && budget_->ready()) return budget_->budget() / burst_length();
     return settings_.drift_rate;
@@ -252,13 +247,18 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m, ControllerRe
     // onto one ICDF (the first, before any lift; every one when the lift keeps them apart).
     if (budget_ && std::isfinite(m.sigma) && (!budget_->ready() || settings_.spread_survives_lift))
         budget_->measure(m.sigma);
+    // The decay the burst resolved (measure_burst() cleared one within its noise) may earn the
+    // accumulated error a contraction credit.
+    if (budget_)
+        budget_->credit(m.decay.ok && m.decay.rate < 0.0 ? -m.decay.rate
+                                                         : std::numeric_limits<double>::quiet_NaN(),
+                        1.0 / burst_length());
     judge_window(m, c);
 }
 
 void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
                                                        ControllerRecord& c) {
     if (!budget_ || !budget_->ready()) return;
-    const double rate = contraction_rate();
     // An open-ended run: the budget is planned over ten of the longest cycles ahead.
     const double horizon = std::isfinite(end_time())
                                ? end_time()
@@ -266,15 +266,15 @@ void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
     double tol = 0.0;
     if (horizon > t_end_)
         tol = budget_->jump_tolerance(basis.model(t_end_, prior_curvature()), horizon,
-                                      burst_length(), settings_.control.dt_max, rate);
+                                      burst_length(), settings_.control.dt_max);
     // Spent (or no noise at all): a tolerance no jump of cpi.dt_min meets, so bursts run
     // directly.
     const double floor = 1e-12 * std::max(budget_->budget(), 1e-300);
     controller_.set_tolerance(std::max(tol, floor));
     c.budget = budget_->budget();
     c.ensemble_standard_error = budget_->state().sigma;
-    c.budget_spent = budget_->spent(t_end_, rate);
-    c.contraction_rate = rate;
+    c.budget_spent = budget_->spent(t_end_);
+    c.contraction_rate = budget_->rate();
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -481,9 +481,8 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
             pool_.commit(pool_.estimate(1), rec.dt);
         }
         if (budget_ && budget_->ready()) {
-            const double rate = contraction_rate();  // the burst before the jump's
-            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation, rate);
-            c.budget_spent = budget_->spent(t_end_ + rec.dt, rate);
+            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation);
+            c.budget_spent = budget_->spent(t_end_ + rec.dt);
         }
         accept_burst(m, c);
         ++totals_.accepted;
@@ -530,8 +529,7 @@ std::string MultistepProjectiveIntegrator::summary(int realizations) const {
         s += fmt::format(
             "; trajectory budget {:.3g} d_p (cpi.accuracy {:g} x the ensemble's standard error "
             "{:.3g}), {:.3g} d_p spent",
-            budget_->budget(), budget_->accuracy(), budget_->state().sigma,
-            budget_->spent(t_end_, contraction_rate()));
+            budget_->budget(), budget_->accuracy(), budget_->state().sigma, budget_->spent(t_end_));
     if (t.accepted == 0) return s;
     const double n = static_cast<double>(t.accepted);
     const double err = t.statistical + t.truncation;

@@ -180,10 +180,6 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// cpi.healing_auto: the healing of the next bursts from the burst after a lift at t_lift;
     /// the evidence goes into `c`.
     void judge_healing(const BurstSamples& burst, double t_lift, ControllerRecord& c);
-    /// cpi.accuracy: the contraction rate credited to the accumulated error, the decay rate
-    /// the last accepted burst resolved (>= 0; 0 when none; at most 1 / burst: faster is a
-    /// fast transient, not the slow dynamics).
-    double contraction_rate() const;
     /// The drift rate a burst's phase signal is held back by: settings_.drift_rate, or with
     /// cpi.accuracy the trajectory's budget per burst once the ensemble's noise is measured.
     double drift_rate() const;

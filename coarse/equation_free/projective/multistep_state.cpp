@@ -50,7 +50,9 @@ bool MultistepState::operator==(const MultistepState& o) const {
            same(member_deviation, o.member_deviation) &&
            same_or_nan(budget.variance, o.budget.variance) &&
            same_or_nan(budget.truncation, o.budget.truncation) &&
-           same_or_nan(budget.t_last, o.budget.t_last) && same_or_nan(budget.sigma, o.budget.sigma);
+           same_or_nan(budget.t_last, o.budget.t_last) &&
+           same_or_nan(budget.sigma, o.budget.sigma) &&
+           same_or_nan(budget.last_rate, o.budget.last_rate) && budget.rate == o.budget.rate;
 }
 
 MultistepState MultistepState::from_layout(const std::vector<double>& r, const std::string& text) {

@@ -7,15 +7,6 @@
 
 namespace efdem::coarse {
 
-namespace {
-
-/// (1 - e^(-x)) / x, 1 at x = 0: the mean of e^(-s) over s in [0, x].
-double mean_decay(double x) {
-    return x < 1e-8 ? 1.0 - 0.5 * x : -std::expm1(-x) / x;
-}
-
-}  // namespace
-
 TrajectoryBudget::TrajectoryBudget(double accuracy) : accuracy_(accuracy) {
     EFDEM_EXPECTS(std::isfinite(accuracy) && accuracy > 0.0);
 }
@@ -42,29 +33,33 @@ double TrajectoryBudget::budget() const {
     return accuracy_ * state_.sigma;
 }
 
-double TrajectoryBudget::spent(double t, double rate) const {
-    EFDEM_EXPECTS(rate >= 0.0);
+double TrajectoryBudget::spent(double t) const {
     if (std::isnan(state_.t_last)) return 0.0;
-    const double decay = std::exp(-rate * std::max(0.0, t - state_.t_last));
+    const double decay = std::exp(-state_.rate * std::max(0.0, t - state_.t_last));
     return (state_.truncation + std::sqrt(state_.variance)) * decay;
 }
 
+void TrajectoryBudget::credit(double measured, double cap) {
+    EFDEM_EXPECTS(cap > 0.0);
+    const bool now = std::isfinite(measured) && measured > 0.0;
+    const bool before = std::isfinite(state_.last_rate) && state_.last_rate > 0.0;
+    state_.rate = now && before ? std::min({measured, state_.last_rate, cap}) : 0.0;
+    state_.last_rate = now ? measured : std::numeric_limits<double>::quiet_NaN();
+}
+
 double TrajectoryBudget::jump_tolerance(const JumpErrorModel& model, double end_time, double burst,
-                                        double dt_max, double rate) const {
-    EFDEM_EXPECTS(ready() && burst > 0.0 && std::isfinite(dt_max) && dt_max > 0.0 && rate >= 0.0 &&
+                                        double dt_max) const {
+    EFDEM_EXPECTS(ready() && burst > 0.0 && std::isfinite(dt_max) && dt_max > 0.0 &&
                   std::isfinite(end_time) && end_time > model.t0);
     const double h = end_time - model.t0;
     const double since = std::isnan(state_.t_last) ? 0.0 : std::max(0.0, model.t0 - state_.t_last);
-    const double decay_end = std::exp(-rate * (since + h));
-    const double c1 = mean_decay(rate * h), c2 = mean_decay(2.0 * rate * h);
-    const double t_end = state_.truncation * decay_end;
-    const double v_end = state_.variance * decay_end * decay_end;
+    const double d = std::exp(-state_.rate * since);  // what has decayed by now, not later
+    const double t_now = state_.truncation * d, v_now = state_.variance * d * d;
     const double b = budget();
     const auto at_end = [&](double dt) {
         const JumpError e = jump_error(model, dt);
         const double n = h / (dt + burst);
-        return t_end + n * e.truncation * c1 +
-               std::sqrt(v_end + n * e.statistical * e.statistical * c2);
+        return t_now + n * e.truncation + std::sqrt(v_now + n * e.statistical * e.statistical);
     };
     const double cap = std::min(dt_max, h);
     if (at_end(0.0) > b) return 0.0;  // spent: no jump fits
@@ -80,10 +75,10 @@ double TrajectoryBudget::jump_tolerance(const JumpErrorModel& model, double end_
     return jump_error(model, lo).total();
 }
 
-void TrajectoryBudget::commit(double t_landed, double statistical, double truncation, double rate) {
-    EFDEM_EXPECTS(rate >= 0.0 && statistical >= 0.0 && truncation >= 0.0);
+void TrajectoryBudget::commit(double t_landed, double statistical, double truncation) {
+    EFDEM_EXPECTS(statistical >= 0.0 && truncation >= 0.0);
     if (!std::isnan(state_.t_last)) {
-        const double decay = std::exp(-rate * std::max(0.0, t_landed - state_.t_last));
+        const double decay = std::exp(-state_.rate * std::max(0.0, t_landed - state_.t_last));
         state_.variance *= decay * decay;
         state_.truncation *= decay;
     }

@@ -9,14 +9,16 @@
 /// error CPI adds to the trajectory may be at most B = a sigma at every time. What the jumps
 /// made so far have added is accumulated: their statistical parts as variances (a pooled
 /// slope's correlation with earlier jumps is already in the charged part, statistical_error()),
-/// their truncation parts linearly, both contracted by exp(-lambda t) where the run measures a
-/// resolved decay rate lambda of the slow dynamics (none measured: no credit). The next jump's
-/// DT is the largest for which jumps like it, repeated over the rest of the run (H to its end,
-/// one every DT + burst), keep the accumulated error at the end within B:
-///   T e^(-lambda H) + n tau(DT) c_1 + sqrt(V e^(-2 lambda H) + n s(DT)^2 c_2) <= B,
-///   n = H / (DT + burst), c_k = (1 - e^(-k lambda H)) / (k lambda H) (1 without contraction),
-/// and its tolerance is that jump's error s(DT) + tau(DT). Once the budget is spent the
-/// tolerance falls below what cpi.dt_min allows and the run goes on directly.
+/// their truncation parts linearly, both contracted by exp(-lambda t) over the time since they
+/// were made, lambda the decay rate of the slow dynamics that two accepted bursts in a row
+/// resolved (credited_rate(); none: no credit). Contraction is credited to errors already made,
+/// over time already run — never to the future. The next jump's DT is the largest for which
+/// jumps like it, repeated over the rest of the run (H to its end, one every DT + burst), keep
+/// the accumulated error within B:
+///   T d + n tau(DT) + sqrt(V d^2 + n s(DT)^2) <= B,   n = H / (DT + burst),
+/// d = exp(-lambda (t0 - t_last)), and its tolerance is that jump's error s(DT) + tau(DT). Once
+/// the budget is spent the tolerance falls below what cpi.dt_min allows and the run goes on
+/// directly.
 ///
 /// \code
 /// TrajectoryBudget b(1.0);
@@ -41,6 +43,10 @@ struct TrajectoryBudgetState {
     double truncation = 0.0;  ///< accumulated truncation error at t_last [unit]
     double t_last = nan;      ///< when they were last updated (NaN: no jump yet)
     double sigma = nan;       ///< the ensemble's standard error last measured (NaN: none yet)
+    /// The decay rate the last accepted burst resolved (>= 0; NaN: none), and the rate credited
+    /// now (0: none), see credit().
+    double last_rate = nan;
+    double rate = 0.0;
 };
 
 class TrajectoryBudget {
@@ -58,22 +64,32 @@ class TrajectoryBudget {
     double accuracy() const { return accuracy_; }
     /// B = a sigma (NaN before a measurement).
     double budget() const;
-    /// The accumulated error at time t (>= t_last), contracted at `rate` (>= 0) since t_last:
-    /// T e^(-rate dt) + sqrt(V) e^(-rate dt).
-    double spent(double t, double rate) const;
+    /// The accumulated error at time t (>= t_last), contracted at rate() since t_last:
+    /// (T + sqrt(V)) e^(-rate dt).
+    double spent(double t) const;
+
+    /**
+     * \brief An accepted burst resolved a decay of its slope at `measured` (> 0, 1/time) or
+     *        none (NaN). The rate credited from now on is the smaller of this and the previous
+     *        burst's when both resolved one, at most `cap` (faster is a fast transient, not the
+     *        slow dynamics); else 0. A single burst's decay (a transient after a lift or after
+     *        the warm-up) earns no credit.
+     */
+    void credit(double measured, double cap);
+    double rate() const { return state_.rate; }
 
     /**
      * \brief The tolerance of the next jump, starting at model.t0, of a run that ends at
      *        `end_time` with bursts of `burst` after each jump and jumps of at most `dt_max`
-     *        (see the file comment). 0 when the budget is spent (or none measured yet).
-     * \pre ready(), burst > 0, dt_max > 0 finite, rate >= 0, end_time > model.t0 finite.
+     *        (see the file comment). 0 when the budget is spent.
+     * \pre ready(), burst > 0, dt_max > 0 finite, end_time > model.t0 finite.
      */
-    double jump_tolerance(const JumpErrorModel& model, double end_time, double burst, double dt_max,
-                          double rate) const;
+    double jump_tolerance(const JumpErrorModel& model, double end_time, double burst,
+                          double dt_max) const;
 
     /// A jump kept that landed at t_landed with these parts of its error; the accumulated
-    /// error is first contracted at `rate` (>= 0) from t_last to t_landed.
-    void commit(double t_landed, double statistical, double truncation, double rate);
+    /// error is first contracted at rate() from t_last to t_landed.
+    void commit(double t_landed, double statistical, double truncation);
 
     const TrajectoryBudgetState& state() const { return state_; }
     void restore(const TrajectoryBudgetState& state) { state_ = state; }
