@@ -350,7 +350,10 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     ControllerRecord& c = rec.controller;
     c.active = true;
     c.adaptive = settings_.adaptive;
-    c.tolerance = settings_.adaptive ? settings_.control.tolerance : ControllerRecord::nan;
+    // cpi.accuracy: no tolerance before the first burst has measured the ensemble's noise.
+    c.tolerance = settings_.adaptive && (!budget_ || budget_->ready())
+                      ? controller_.setup().control.tolerance
+                      : ControllerRecord::nan;
     EFDEM_EXPECTS(!settings_.adaptive || stepper.can_keep_state());
 
     Measured m;
