@@ -75,8 +75,8 @@ def analyse(results):
         rejected = sum(s == "rejected" for s in status)
         direct = sum(1 for s, lim in zip(status, c["limited_by"]) if s == "burst_only"
                      and sr.text(lim) == "tolerance below dt_min")
-        tol = np.asarray(c["tolerance"], float)
-        tol = tol[np.isfinite(tol)]
+        tol = np.asarray(c["tolerance"], float)[[s == "projected" for s in status]]  # of the jumps kept
+        tol = tol[np.isfinite(tol)] if len(tol) else np.array([float("nan")])
         last = lambda k: float(np.asarray(c[k], float)[np.isfinite(np.asarray(c[k], float))][-1])  # noqa: E731
         sigma, budget, spent = last("ensemble_standard_error"), last("budget"), last("budget_spent")
         speed = float(run["simulated_time"]) / float(run["dem_time"])
