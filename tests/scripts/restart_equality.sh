@@ -2,8 +2,8 @@
 # A restarted run's output equals the uninterrupted run's bit for bit, in direct and cpi mode
 # (ICDF and compact observables; adaptive Adams-Bashforth 2 with a rejection before
 # the checkpoint, whose controller state is in it; adaptive forward Euler from pooled slopes,
-# whose slope pool, evidence-sized healing and window and, with cpi.lift = own, each realization's
-# own slope deviation are in it; with cpi.accuracy, whose trajectory budget is in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
+# whose slope pool, evidence-sized healing and window, trajectory budget (cpi.accuracy) and, with
+# cpi.lift = own, each realization's own slope deviation are in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
 # realizations on 2 ranks; and a run from settled beds ("settled"), whose restart builds its beds
 # without settling them (the checkpoint replaces every particle state).
 # Compared: the run HDF5 file (compare_runs.py) and the CSV files (byte for byte: the wall time is in the sidecar, not compared).
@@ -34,8 +34,7 @@ same_output() {  # same_output PREFIX_A PREFIX_B
 for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi" \
             "compact 1 00000002 4 mode=cpi,cpi.observable=compact,run.duration=8" \
             "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
-            "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
-            "accuracy 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.accuracy=4,cpi.lift=members,cpi.dt_min=0.5,run.duration=24" \
+            "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.accuracy=4,cpi.dt_min=0.5,run.duration=24" \
             "settled 4 00000008 2 mode=direct,bed.settle=true,bed.settle.ke_threshold=1e-3,bed.settle.max_time=20"; do
   read -r mode every from nps overrides <<< "$spec"
   IFS=, read -r -a extra <<< "$overrides"
@@ -49,6 +48,12 @@ for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi
   fi
   ckpt="$work/$mode-ck_ckpt_$from.h5"
   [ -f "$ckpt" ] || { echo "FAIL: no checkpoint $ckpt"; ls "$work"; exit 1; }
+  if [ "$mode" = pooled ]; then  # the budget is in the checkpoint, and jumps follow the restart
+    /usr/bin/python3 -c "import h5py, sys; h5py.File(sys.argv[1], 'r')['/driver/integrator/budget/sigma']" "$ckpt" \
+      || { echo "FAIL: no trajectory budget in $ckpt"; exit 1; }
+    after=$(sed -n '/checkpoint .*_ckpt_'"$from"'/,$p' "$work/$mode-ck.log" | grep -c ", projected," || true)
+    [ "$after" -ge 1 ] || { echo "FAIL: no jump after the checkpoint in $mode-ck.log"; exit 1; }
+  fi
   for np in ${nps//,/ }; do
     k=$((4 / np))
     run $np "$work/$mode-np$np.log" "$@" "$efdem" "$scene" "${common[@]}" ensemble.realizations_per_rank=$k \
