@@ -71,10 +71,7 @@ def analyse(results):
         e = math.sqrt(np.mean([ss.rms_on(run, d) ** 2 for d in directs])) if directs else float("nan")
         c = run["controller"]
         status = run["status"]
-        kept = sum(s == "projected" for s in status)
-        rejected = sum(s == "rejected" for s in status)
-        direct = sum(1 for s, lim in zip(status, c["limited_by"]) if s == "burst_only"
-                     and sr.text(lim) == "tolerance below dt_min")
+        kept, rejected, direct = ss.step_counts(run)
         tol = np.asarray(c["tolerance"], float)[[s == "projected" for s in status]]  # of the jumps kept
         tol = tol[np.isfinite(tol)] if len(tol) else np.array([float("nan")])
         last = lambda k: float(np.asarray(c[k], float)[np.isfinite(np.asarray(c[k], float))][-1])  # noqa: E731

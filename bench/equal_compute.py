@@ -48,6 +48,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
 
+sys.path.insert(0, HERE)
+import study_runs as sr  # noqa: E402
+
 DIRECTS = ("direct_a", "direct_b", "direct_c")
 STUDIES = ("slope_study_r4_u0.19_t600", "slope_study_r8_u0.19_t600", "slope_study_r8_u0.19_t200", "slope_study_r4_u0.41_t200",
            "slope_study_r8_u0.41_t200")
@@ -64,10 +67,6 @@ def cpu():
     return platform.machine()
 
 
-def text(v):
-    return v.decode() if isinstance(v, bytes) else str(v)
-
-
 def load(path):
     with h5py.File(path, "r") as f:
         a = f.attrs
@@ -75,7 +74,7 @@ def load(path):
                 "realizations": int(a["realizations"]), "ranks": int(a["ranks"]),
                 "dem_time": float(a["dem_time"]), "wall": float(a["wall_seconds"]),
                 "overhead": float(a["lift_seconds"]) + float(a["restrict_seconds"]),
-                "mode": text(a["mode"]), "status": text(a.get("end_status", ""))}
+                "mode": sr.text(a["mode"]), "status": sr.text(a.get("end_status", ""))}
 
 
 def members_at(t_ref, members, t):

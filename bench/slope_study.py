@@ -144,6 +144,17 @@ def load(path):
     return d
 
 
+def step_counts(run):
+    """A CPI run's jumps kept, jumps rejected, and bursts run directly because the tolerance
+    allowed DT < cpi.dt_min."""
+    status, limited = run["status"], run["controller"]["limited_by"]
+    kept = sum(s == "projected" for s in status)
+    rejected = sum(s == "rejected" for s in status)
+    direct = sum(1 for s, lim in zip(status, limited)
+                 if s == "burst_only" and sr.text(lim) == "tolerance below dt_min")
+    return int(kept), int(rejected), int(direct)
+
+
 def rms_on(run, ref, window=None):
     """RMS(run - ref) over run's samples that ref has (and within window = (t0, t1))."""
     keep, y = am.align(ref["t"], ref["mean"], run["t"])
@@ -187,19 +198,17 @@ def analyse(args, realizations):
         c = r["controller"]
         kept = np.asarray(c["accepted"]) == 1
         proj = np.array([s == "projected" for s in r["status"]])
-        rej = np.array([s == "rejected" for s in r["status"]])
-        n_direct = int(sum(1 for s, lim in zip(r["status"], c["limited_by"])
-                           if s == "burst_only" and sr.text(lim) == "tolerance below dt_min"))
+        n_proj, n_rej, n_direct = step_counts(r)
         speed = float(r["simulated_time"]) / float(r["dem_time"])
         wall = np.mean(dem_direct) / float(r["wall_seconds"]) if dem_direct else float("nan")
         mean_dt = float(np.mean(r["dt"][proj])) if proj.any() else float("nan")
         stat = [float(np.nanmean(c[k][kept])) if kept.any() and k in c else float("nan")
                 for k in ("error_statistical", "error_statistical_jump", "error_statistical_burst")]
         summary["runs"][name] = {"e": e, "e_quarters": eq, "speedup_dem": speed, "speedup_wall": wall,
-                                 "kept": int(proj.sum()), "rejected": int(rej.sum()), "direct": n_direct,
+                                 "kept": n_proj, "rejected": n_rej, "direct": n_direct,
                                  "mean_dt": mean_dt, "statistical": stat}
         lines.append(f"| {name} | {e:.3f} | {e / floor:.2f} | " + " / ".join(f"{a / b:.2f}" for a, b in zip(eq, fq))
-                     + f" | {speed:.2f} | {wall:.2f} | {int(proj.sum())} / {int(rej.sum())} / {n_direct} | "
+                     + f" | {speed:.2f} | {wall:.2f} | {n_proj} / {n_rej} / {n_direct} | "
                      f"{mean_dt:.1f} | " + " / ".join(f"{s:.3f}" for s in stat) + " |")
     os.makedirs(args.results, exist_ok=True)
     with open(os.path.join(args.results, "analysis.md"), "w") as f:

@@ -19,16 +19,16 @@ keeps a member whose slope is 0 where it is; mean and members move it).
 import argparse
 import glob
 import os
+import sys
 
 import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import study_runs as sr  # noqa: E402
+
 FROZEN = 1e-6  # d_p: largest change of any quantile of a bed at rest (measured: 1e-13 to 7e-13)
-
-
-def text(v):
-    return v.decode() if isinstance(v, bytes) else str(v)
 
 
 def stop_times(t, icdf):
@@ -62,8 +62,8 @@ def analyse(folder):
                 continue
             t = f["samples/time"][:]
             icdf = f["samples/icdf"][:]
-            mode = text(f.attrs.get("mode", "?"))
-            overrides = text(f.attrs.get("overrides", ""))
+            mode = sr.text(f.attrs.get("mode", "?"))
+            overrides = sr.text(f.attrs.get("overrides", ""))
         lift = next((w.split("=")[1] for w in overrides.split() if w.startswith("cpi.lift=")), "mean")
         stops = stop_times(t, icdf)
         span = t[-1] - t[0]

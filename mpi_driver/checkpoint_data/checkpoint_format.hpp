@@ -26,8 +26,8 @@
 ///                           window, window_fast_time2, window_measurements (cpi.window_auto
 ///                           runs only); member_deviation (R x m, cpi.lift = own runs only);
 ///                           budget/{variance, truncation, t_last, sigma, last_rate, rate}
-///                           (cpi.accuracy runs
-///                           only: the trajectory's error budget, trajectory_budget.hpp)
+///                           (cpi.accuracy runs only: the trajectory's error budget,
+///                           trajectory_budget.hpp)
 ///                           (coarse::MultistepState)
 ///   /driver/integrator, /driver/integrator_text   formats 2 and 3: the same state as a
 ///                           positional vector and three lines of text

@@ -176,19 +176,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     }
     out.node.tau = slope.t_mean;
     if (settings_.window_auto) out.noise = window_noise(rec.burst.t, rec.burst.members, t_window);
-    if (budget_ && rec.burst.members.size() == rec.burst.t.size()) {
-        // The ensemble's standard error over the window: RMS over its samples.
-        double sum = 0.0;
-        int n = 0;
-        for (std::size_t i = 0; i < rec.burst.t.size(); ++i) {
-            if (rec.burst.t[i] < t_window - 1e-9 * std::max(1.0, std::abs(t_window))) continue;
-            const double s = TrajectoryBudget::standard_error(rec.burst.members[i]);
-            if (!std::isfinite(s)) continue;
-            sum += s * s;
-            ++n;
-        }
-        if (n > 0) out.sigma = std::sqrt(sum / n);
-    }
+    if (budget_) out.sigma = TrajectoryBudget::standard_error(rec.burst, t_window);
     if (settings_.lift_apart) {
         // Each member's own slope over the window, less their mean (the ensemble's).
         out.member_deviation = std::move(fit.member_slopes);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "coarse/equation_free/ensemble_statistics.hpp"
+#include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {
@@ -12,12 +14,23 @@ TrajectoryBudget::TrajectoryBudget(double accuracy) : accuracy_(accuracy) {
 }
 
 double TrajectoryBudget::standard_error(const Eigen::MatrixXd& members) {
-    const auto r = members.rows();
-    if (r < 2 || members.cols() == 0) return std::numeric_limits<double>::quiet_NaN();
-    const Eigen::RowVectorXd mean = members.colwise().mean();
-    const Eigen::RowVectorXd var =
-        (members.rowwise() - mean).colwise().squaredNorm() / static_cast<double>(r - 1);
-    return std::sqrt(var.mean() / static_cast<double>(r));
+    if (members.rows() < 2 || members.cols() == 0) return std::numeric_limits<double>::quiet_NaN();
+    return rms(ensemble_standard_error(members));
+}
+
+double TrajectoryBudget::standard_error(const BurstSamples& burst, double t_from) {
+    if (burst.members.size() != burst.t.size()) return std::numeric_limits<double>::quiet_NaN();
+    const double eps = 1e-9 * std::max(1.0, std::abs(t_from));
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t i = 0; i < burst.t.size(); ++i) {
+        if (burst.t[i] < t_from - eps) continue;
+        const double s = standard_error(burst.members[i]);
+        if (!std::isfinite(s)) continue;
+        sum += s * s;
+        ++n;
+    }
+    return n > 0 ? std::sqrt(sum / n) : std::numeric_limits<double>::quiet_NaN();
 }
 
 void TrajectoryBudget::measure(double sigma) {

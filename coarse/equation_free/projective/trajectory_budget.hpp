@@ -2,7 +2,7 @@
 /// \file
 /// TrajectoryBudget (cpi.accuracy = a): the accuracy of the whole trajectory, stated as a
 /// multiple a of the ensemble's own standard error, turned into the tolerance of each jump
-/// (docs/error_control.md §9).
+/// (docs/error_control.md §10).
 ///
 /// The ensemble's standard error sigma is the RMS over the coarse vector's components of
 /// sqrt(var_members / R) — what the ensemble mean of R realizations is uncertain by anyway. The
@@ -11,7 +11,7 @@
 /// slope's correlation with earlier jumps is already in the charged part, statistical_error()),
 /// their truncation parts linearly, both contracted by exp(-lambda t) over the time since they
 /// were made, lambda the decay rate of the slow dynamics that two accepted bursts in a row
-/// resolved (credited_rate(); none: no credit). Contraction is credited to errors already made,
+/// resolved (credit(); none: no credit). Contraction is credited to errors already made,
 /// over time already run — never to the future. The next jump's DT is the largest for which
 /// jumps like it, repeated over the rest of the run (H to its end, one every DT + burst), keep
 /// the accumulated error within B:
@@ -22,16 +22,19 @@
 ///
 /// \code
 /// TrajectoryBudget b(1.0);
-/// b.measure(sigma);                                  // from a burst whose members were not lifted
-/// together const double tol = b.jump_tolerance(model, end_time, burst, dt_max, lambda);
+/// // From a burst whose members no lift gathered onto one coarse vector:
+/// b.measure(TrajectoryBudget::standard_error(burst, t_window));
+/// b.credit(lambda, 1.0 / burst_length);  // every accepted burst: its resolved decay, or NaN
+/// const double tol = b.jump_tolerance(model, end_time, burst_length, dt_max);
 /// // ... jump, judge against tol, and when kept:
-/// b.commit(t_landed, statistical, truncation, lambda);
+/// b.commit(t_landed, statistical, truncation);
 /// \endcode
 
 #include <limits>
 
 #include <Eigen/Core>
 
+#include "coarse/equation_free/coarse_stepper.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
 
 namespace efdem::coarse {
@@ -55,8 +58,11 @@ class TrajectoryBudget {
     explicit TrajectoryBudget(double accuracy);
 
     /// The ensemble's standard error of members (R x dim, R >= 2): RMS over the components of
-    /// sqrt(unbiased variance / R). NaN when R < 2.
+    /// sqrt(unbiased variance / R) (ensemble_standard_error()). NaN when R < 2.
     static double standard_error(const Eigen::MatrixXd& members);
+    /// The same over a burst's samples from t_from on: the RMS of the samples' standard errors
+    /// (NaN when the burst carries no members, or none of R >= 2, from t_from on).
+    static double standard_error(const BurstSamples& burst, double t_from);
 
     /// Takes sigma (finite, >= 0) as the ensemble's standard error from now on.
     void measure(double sigma);
