@@ -34,8 +34,21 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.window_auto", "false"},
     {"cpi.window_max", nullptr},  // read only with cpi.window_auto
     {"cpi.noisy_curvature", "counted"},
+    {"cpi.at_rest", "lift"},  // hold: realizations at rest are not lifted (issue 34)
 };
 // clang-format on
+
+/// Keys that only a cpi run acts on (the cpi block is read in every mode): in a direct run and
+/// its checkpoint they may differ or be missing without changing what is simulated.
+constexpr const char* kCpiOnlyKeys[] = {"cpi.at_rest"};
+
+bool ignored_in(const std::map<std::string, std::string>& now, const std::string& key) {
+    const auto mode = now.find("mode");
+    if (mode == now.end() || mode->second != "direct") return false;
+    for (const char* k : kCpiOnlyKeys)
+        if (key == k) return true;
+    return false;
+}
 
 bool as_before_the_key(const std::string& key, const std::string& value) {
     for (const auto& [k, v] : kAddedKeys)
@@ -76,7 +89,7 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
     const auto then = parse_lines(h.parameters), now = parse_lines(parameters_now);
     std::vector<std::string> changes;
     for (const auto& [key, value] : now) {
-        if (may_change_on_restart(key)) continue;
+        if (may_change_on_restart(key) || ignored_in(now, key)) continue;
         const auto it = then.find(key);
         if (it == then.end()) {
             if (as_before_the_key(key, value)) continue;
@@ -91,7 +104,7 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
         }
     }
     for (const auto& [key, value] : then)
-        if (!may_change_on_restart(key) && !now.contains(key))
+        if (!may_change_on_restart(key) && !ignored_in(now, key) && !now.contains(key))
             changes.push_back(fmt::format("{} missing (checkpoint: {})", key, value));
     if (changes.empty()) return {};
     std::string list;

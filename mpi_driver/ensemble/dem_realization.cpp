@@ -57,6 +57,12 @@ void DemRealization::apply_lift(const LiftPayload& lifted) {
     coarse::apply_colours(system_, lifted.bytes, observed_, other_);
 }
 
+bool DemRealization::at_rest() const {
+    const double limit = kRestSpeed * kRestSpeed;
+    const auto v = system_.particles().v();
+    return std::all_of(v.begin(), v.end(), [limit](const auto& u) { return norm2(u) < limit; });
+}
+
 void DemRealization::after_sample(long samples_taken) {
     if (vtk_ && samples_taken % output_.vtk_every == 0) vtk_->write(system_);
     if (thermo_ && samples_taken % output_.thermo_every == 0) thermo_->write(system_);

@@ -18,6 +18,14 @@
 ///            them on top (less the rows' mean: the mean still lands on X).
 ///
 /// A lift can be limited to some realizations (`only`: a realization rebuilt after a failure).
+///
+/// Realizations at rest (cpi.at_rest = hold, Realization::at_rest: a DEM bed the gas no longer
+/// moves) are left where they are: labels and state untouched, only their clocks follow the jump.
+/// The others carry the ensemble's whole increment, so that the ensemble mean still lands on X:
+/// with n lifted of which n_M move, the moving ones go to (n X - sum_rest X_r) / n_M (mean), or
+/// each by (n X - sum_all X_r) / n_M on top of its own X_r (members), the member steps centred
+/// over the moving ones (own). A realization that has stopped stays where it stopped, as it
+/// would in a direct run: an absorbing state is not lifted away (docs/accuracy_vs_cost.md).
 
 #include <cstdint>
 #include <vector>
@@ -46,6 +54,9 @@ class EnsembleLifting {
         double new_time = 0;    ///< every lifted realization's clock afterwards
         bool top_half = false;  ///< the observable's lifting target needs the top-half ICDF
         bool members = false;   ///< cpi.lift = members (not with `only`)
+        /// cpi.at_rest = hold: realizations at rest are not lifted (not with `only`); needs an
+        /// observable that restricts members (their own X_r).
+        bool hold_at_rest = false;
         const Eigen::VectorXd* target = nullptr;  ///< root: the coarse X; elsewhere null
         /// Root, with members: one row per lifted realization in realization order (the
         /// burst's members), added to its move; null, a row count that differs from the lifted

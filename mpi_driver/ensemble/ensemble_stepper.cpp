@@ -77,10 +77,10 @@ void EnsembleStepper::fail(const std::string& message, long realization) const {
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
-    double buf[3] = {static_cast<double>(static_cast<int>(m.command)), m.value,
-                     m.top_half ? 1.0 : 0.0};
-    MPI_Bcast(buf, 3, MPI_DOUBLE, 0, layout_.mpi().comm());
-    return {static_cast<Command>(static_cast<int>(buf[0])), buf[1], buf[2] != 0.0};
+    double buf[4] = {static_cast<double>(static_cast<int>(m.command)), m.value,
+                     m.top_half ? 1.0 : 0.0, m.hold_at_rest ? 1.0 : 0.0};
+    MPI_Bcast(buf, 4, MPI_DOUBLE, 0, layout_.mpi().comm());
+    return {static_cast<Command>(static_cast<int>(buf[0])), buf[1], buf[2] != 0.0, buf[3] != 0.0};
 }
 
 // --- the root's side of the commands --------------------------------------------------------
@@ -114,8 +114,10 @@ void EnsembleStepper::root_lift(const Eigen::VectorXd& target, const Eigen::Matr
     const bool top = observable().needs_top_half();
     const bool members =
         lifts_apart();  // cpi.lift = members or own, and an observable with members
-    broadcast({members ? Command::lift_members : Command::lift, new_time, top});
-    do_lift(new_time, top, &target, members, member_steps);
+    // Holding needs each realization's own coarse vector: only with an observable that has them.
+    const bool hold = settings_.hold_at_rest && observable().restricts_members();
+    broadcast({members ? Command::lift_members : Command::lift, new_time, top, hold});
+    do_lift(new_time, top, &target, members, hold, member_steps);
 }
 
 void EnsembleStepper::finish(int exit_code) {
@@ -188,10 +190,10 @@ void EnsembleStepper::serve() {
                 do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr);
                 break;
             case Command::lift:
-                do_lift(m.value, m.top_half, nullptr, false);
+                do_lift(m.value, m.top_half, nullptr, false, m.hold_at_rest);
                 break;
             case Command::lift_members:
-                do_lift(m.value, m.top_half, nullptr, true);
+                do_lift(m.value, m.top_half, nullptr, true, m.hold_at_rest);
                 break;
             case Command::checkpoint:
                 do_checkpoint(std::lround(m.value), nullptr, false);
@@ -281,8 +283,9 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
 }
 
 void EnsembleStepper::do_lift(double new_time, bool top_half, const Eigen::VectorXd* target,
-                              bool members, const Eigen::MatrixXd* member_steps) {
+                              bool members, bool hold, const Eigen::MatrixXd* member_steps) {
     EnsembleLifting::Request request;
+    request.hold_at_rest = hold;
     request.new_time = new_time;
     request.top_half = top_half;
     request.members = members;

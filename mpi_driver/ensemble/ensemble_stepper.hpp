@@ -86,6 +86,10 @@ struct StepperSettings {
     /// a direct ensemble) instead of all collapsing onto X. Needs an observable that restricts
     /// members (the ICDF). A realization rebuilt after a failure is still lifted to X itself.
     bool lift_members = false;
+    /// cpi.at_rest = hold: a lift leaves every realization at rest (Realization::at_rest) where
+    /// it is and moves the others by the ensemble's whole increment (EnsembleLifting). Needs an
+    /// observable that restricts members; with one that does not, every realization is lifted.
+    bool hold_at_rest = false;
 };
 
 class EnsembleStepper final : public coarse::CoarseStepper {
@@ -230,6 +234,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
         Command command;
         double value;
         bool top_half;
+        bool hold_at_rest = false;  ///< a lift: leave the realizations at rest where they are
     };
     Message broadcast(Message m) const;
 
@@ -241,7 +246,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     void root_lift(const Eigen::VectorXd& target, const Eigen::MatrixXd* member_steps,
                    double new_time);
     void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members,
-                 const Eigen::MatrixXd* member_steps = nullptr);
+                 bool hold, const Eigen::MatrixXd* member_steps = nullptr);
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header,
                                         bool at_resume_point);
     void do_keep();

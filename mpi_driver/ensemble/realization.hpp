@@ -66,6 +66,10 @@ class Realization {
     /// Sizes (reals, bytes) of the payload apply_lift() expects.
     virtual std::pair<std::size_t, std::size_t> lift_output_sizes() const = 0;
     virtual void apply_lift(const LiftPayload& lifted) = 0;
+    /// Whether the realization is at rest: a state its micro model does not leave by itself (a
+    /// DEM bed whose gas no longer moves any particle). A lift with cpi.at_rest = hold leaves it
+    /// where it is. Default: never at rest.
+    virtual bool at_rest() const { return false; }
     /// Called after every sample with the running sample count (per-realization outputs).
     virtual void after_sample(long samples_taken) { (void)samples_taken; }
     /// Sets the scene parameter `key` (a DEM realization: one of dem::run_parameters(),

@@ -299,15 +299,18 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
     std::vector<std::int64_t> changed(static_cast<std::size_t>(realizations_), 0);
     std::vector<double> deviation(static_cast<std::size_t>(realizations_),
                                   std::numeric_limits<double>::quiet_NaN());
+    std::vector<std::int64_t> at_rest(static_cast<std::size_t>(realizations_), 0);
     std::string messages;
     for (std::size_t k = 0; k < lift.changed.size() && k < changed.size(); ++k) {
         changed[k] = lift.changed[k];
+        if (k < lift.at_rest.size()) at_rest[k] = lift.at_rest[k];
         deviation[k] = lift.max_deviation[k];
         if (!lift.messages[k].empty())
             messages += fmt::format("realization {}: {}\n", k, lift.messages[k]);
     }
     series("/cpi/lift_changed", {r}, T::integer).append(std::span<const std::int64_t>(changed));
     series("/cpi/lift_max_deviation", {r}, T::real).append(std::span<const double>(deviation));
+    series("/cpi/lift_at_rest", {r}, T::integer).append(std::span<const std::int64_t>(at_rest));
     series("/cpi/lift_message", {}, T::text).append_text(messages);
     file_.flush();
 }

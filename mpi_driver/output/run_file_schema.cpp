@@ -195,6 +195,8 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/cpi/lift_changed", "1", "labels lifting changed in each realization", step_r},
         {"/cpi/lift_max_deviation", "d_p",
          "largest |achieved - target| of the lifted ICDF per realization", step_r},
+        {"/cpi/lift_at_rest", "1",
+         "1 where the realization was at rest and left where it was (cpi.at_rest = hold)", step_r},
         {"/cpi/lift_message", "text", "realizations whose target was repaired or clipped, and why",
          step},
         // /steady: mode = steady | continuation. One row of /steady/iterate per iterate of

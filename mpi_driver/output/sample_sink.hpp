@@ -57,6 +57,7 @@ struct LiftRecord {
     std::vector<long> changed;          ///< labels changed, per realization
     std::vector<double> max_deviation;  ///< max |Q_L,lifted - target| per realization [d_p]
     std::vector<std::string> messages;  ///< non-empty where a target was repaired or clipped
+    std::vector<char> at_rest;  ///< 1 where the realization was at rest and left where it was
 };
 
 /// Where the root's samples and survived failures go (a RunRecorder, or a test's list).

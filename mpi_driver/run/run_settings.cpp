@@ -78,6 +78,19 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                      " moves each realization from its own coarse state, and cpi.observable = " +
                      s.observable + " cannot restrict a realization on its own",
                  "mean, or " + lift + " with cpi.observable = icdf");
+    // A realization the gas no longer moves is in a state the DEM never leaves (U_s = 0.19: the
+    // heavy spheres gather at the bottom and the bed defluidizes); a lift would move it on with
+    // the others. hold leaves it where it is (EnsembleLifting), which needs its own coarse state.
+    const bool own_states = restricts_members(s.observable, s.observe.quantiles);
+    const std::string at_rest =
+        cpi.get_or_choice("at_rest", own_states ? "hold" : "lift", {"hold", "lift"});
+    if (at_rest == "hold" && s.is_cpi() && !own_states)
+        cpi.fail("at_rest",
+                 "= hold leaves a realization at rest where it is and moves the others by the "
+                 "ensemble's increment, and cpi.observable = " +
+                     s.observable + " cannot restrict a realization on its own",
+                 "lift, or hold with cpi.observable = icdf");
+    s.hold_at_rest = at_rest == "hold";
     // own: each realization jumps with its own slope (the multistep integrator measures them).
     s.cpi.multistep.lift_apart = lift == "own";
     // cpi.accuracy measures the ensemble's noise from every burst whose members a lift kept apart.

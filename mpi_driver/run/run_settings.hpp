@@ -97,6 +97,9 @@ struct RunSettings {
     /// own (cpi.multistep.lift_apart) also by DT times its own slope's deviation from the
     /// ensemble slope; `mean` (default): all lifted to X.
     bool lift_members = false;
+    /// cpi.at_rest = hold (default where the observable restricts members): a lift leaves the
+    /// realizations at rest where they are; lift: every realization is lifted.
+    bool hold_at_rest = false;
     /// The other cpi.* keys, read by the coarse layer.
     coarse::CpiSettings cpi;
     /// mode = steady | continuation: the steady.* and continuation.* keys.

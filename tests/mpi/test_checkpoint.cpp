@@ -127,6 +127,18 @@ TEST_CASE("a restart may change run length, output and layout keys, not physics"
         check_restart("c.h5", h, h.parameters + "cpi.noisy_curvature = ignored\n", 4, false),
         Catch::Contains("cpi.noisy_curvature = ignored (not in the checkpoint, whose run did "
                         "cpi.noisy_curvature = counted)"));
+    // cpi.at_rest acts only in a cpi run: a direct run continues from a checkpoint written
+    // before the key whatever its value; a cpi run only at the old behaviour (lift).
+    CheckpointHeader direct = h, cpi = h;
+    direct.parameters += "mode = direct\n";
+    cpi.parameters += "mode = cpi\n";
+    CHECK(check_restart("c.h5", direct, direct.parameters + "cpi.at_rest = hold\n", 4, false)
+              .empty());
+    CHECK(check_restart("c.h5", cpi, cpi.parameters + "cpi.at_rest = lift\n", 4, false).empty());
+    CHECK_THROWS_WITH(
+        check_restart("c.h5", cpi, cpi.parameters + "cpi.at_rest = hold\n", 4, false),
+        Catch::Contains("cpi.at_rest = hold (not in the checkpoint, whose run did cpi.at_rest = "
+                        "lift)"));
 }
 
 TEST_CASE("checkpoint file names sort in writing order and exclude .tmp files",

@@ -112,3 +112,64 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
         CHECK(std::abs(before[9] - 11.0) > 0.2);  // and it was not there before
     }
 }
+
+TEST_CASE("a DEM realization at rest is held by a lift (cpi.at_rest = hold); the others are lifted",
+          "[mpi][lifting]") {
+    // Realization 2's particles are at rest (speeds below DemRealization::kRestSpeed; a spin about
+    // any axis does not count), the others move. A lift with hold leaves its labels exactly as they
+    // were and lifts the other three, whose mean target then carries realization 2's share.
+    const MpiComm world(MPI_COMM_WORLD);
+    REQUIRE(4 % world.size() == 0);
+    const EnsembleLayout layout(world, 4 / world.size());
+    std::vector<std::unique_ptr<Realization>> local;
+    std::vector<DemRealization*> dem;
+    for (int j = 0; j < layout.per_rank(); ++j) {
+        const long index = layout.first_index() + j;
+        auto r = std::make_unique<DemRealization>(random_column(index), 0, 1, RealizationOutput{});
+        if (index == 2) {
+            auto& p = r->system().particles();
+            for (auto& v : p.v()) v = Vec3{0.0, 0.0, 0.0};
+            for (auto& w : p.omega()) w = Vec3{0.0, 0.0, 0.03};  // spins survive a bed at rest
+            p.v()[7] = Vec3{0.0, 0.0, 0.9 * DemRealization::kRestSpeed};
+            CHECK(r->at_rest());
+            p.v()[7] = Vec3{0.0, 0.0, 1.1 * DemRealization::kRestSpeed};
+            CHECK(!r->at_rest());  // one particle above the threshold: moving
+            p.v()[7] = Vec3{0.0, 0.0, 0.0};
+        }
+        CHECK(r->at_rest() == (index == 2));
+        dem.push_back(r.get());
+        local.push_back(std::move(r));
+    }
+    std::vector<std::vector<dem::SpeciesId>> labels_before;
+    for (auto* d : dem)
+        labels_before.emplace_back(d->system().particles().species().begin(),
+                                   d->system().particles().species().end());
+    StepperSettings ss;
+    ss.sample_interval = 0.01;
+    ss.steps_per_sample = 100;
+    ss.hold_at_rest = true;
+    coarse::IcdfObservable observable(19);
+    const ColourLifter lifter;
+    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, nullptr, nullptr);
+    const coarse::ProbabilityGrid grid(19);
+    if (world.is_root()) {
+        stepper.lift(3.0 + 16.0 * grid.values().array(), 3.0);  // as in the test above
+        const LiftRecord& lift = stepper.last_lift();
+        REQUIRE(lift.at_rest.size() == 4);
+        for (int r = 0; r < 4; ++r) {
+            CHECK(lift.at_rest[static_cast<std::size_t>(r)] == (r == 2 ? 1 : 0));
+            CHECK((lift.changed[static_cast<std::size_t>(r)] > 0) == (r != 2));
+        }
+        CHECK(lift.messages[2].find("at rest") != std::string::npos);
+        stepper.finish();
+    } else {
+        stepper.serve();
+    }
+    for (std::size_t j = 0; j < dem.size(); ++j) {
+        const auto& p = dem[j]->system().particles();
+        const std::vector<dem::SpeciesId> now(p.species().begin(), p.species().end());
+        INFO("realization " << layout.first_index() + static_cast<long>(j));
+        CHECK(dem[j]->time() == 3.0);  // every clock follows the jump
+        CHECK((now == labels_before[j]) == (layout.first_index() + static_cast<long>(j) == 2));
+    }
+}

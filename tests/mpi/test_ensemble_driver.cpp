@@ -4,6 +4,7 @@
 // projective integrator bit for bit, members (each realization's coarse vector) included.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <limits>
 #include <memory>
 
@@ -141,25 +142,32 @@ class SerialToyStepper final : public coarse::CoarseStepper {
 /// The R toy realizations of this rank behind an EnsembleStepper (5 substeps per sample,
 /// the toy's state as a 3-node "ICDF", exact lifting); `lift_members`: cpi.lift = members.
 struct ToyEnsemble {
-    ToyEnsemble(const MpiComm& world, bool lift_members)
+    /// `at_rest`: the realizations that are at rest from the start, held by a lift unless
+    /// `hold` is false (cpi.at_rest = lift).
+    ToyEnsemble(const MpiComm& world, bool lift_members, const std::vector<long>& at_rest = {},
+                bool hold = true)
         : layout(world, per_rank(world)),
-          stepper(layout, realizations(layout), settings(lift_members), observable, lifter, nullptr,
+          stepper(layout, realizations(layout, at_rest),
+                  settings(lift_members, hold && !at_rest.empty()), observable, lifter, nullptr,
                   nullptr) {}
-    static std::vector<std::unique_ptr<Realization>> realizations(const EnsembleLayout& layout) {
+    static std::vector<std::unique_ptr<Realization>> realizations(const EnsembleLayout& layout,
+                                                                  const std::vector<long>& rest) {
         std::vector<std::unique_ptr<Realization>> local;
         for (int j = 0; j < layout.per_rank(); ++j) {
             const long r = layout.first_index() + j;
-            local.push_back(
-                std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH));
+            auto toy = std::make_unique<test::ToyRealization>(r, toy_matrix(), toy_start(r), kH);
+            toy->set_at_rest(std::find(rest.begin(), rest.end(), r) != rest.end());
+            local.push_back(std::move(toy));
         }
         return local;
     }
-    static StepperSettings settings(bool lift_members) {
+    static StepperSettings settings(bool lift_members, bool hold_at_rest) {
         StepperSettings ss;
         ss.sample_interval = 5 * kH;
         ss.steps_per_sample = 5;
         ss.quantiles = 3;
         ss.lift_members = lift_members;
+        ss.hold_at_rest = hold_at_rest;
         return ss;
     }
     /// The other ranks serve the root's commands until it finishes them; true on the root.
@@ -307,5 +315,101 @@ TEST_CASE("cpi.lift = own moves each realization by its own step on top of the c
         Eigen::VectorXd y = own2.row(r).transpose() + increment2;
         for (int k = 0; k < 5; ++k) y += kH * (a * y);
         CHECK((mismatched.members[0].row(r).transpose() - y).cwiseAbs().maxCoeff() < 1e-14);
+    }
+}
+
+TEST_CASE("cpi.at_rest = hold leaves a realization at rest where it is; the others land the mean",
+          "[mpi][ensemble][cpi]") {
+    // Realization 1 is at rest (a toy that does not move); the ensemble is lifted to X*. Held,
+    // it keeps its state bit for bit and its clock follows the jump; the three others carry the
+    // whole increment: with lift = mean each goes to (4 X* - X_1) / 3, with members each by
+    // (4 X* - sum X_r) / 3 from its own X_r, with own also by its step less the moving rows'
+    // mean (the held row's step is not used). In every case the mean of the four is X*
+    // (to rounding: sums of four numbers of order 1, 1e-14), as without holding.
+    const MpiComm world(MPI_COMM_WORLD);
+    for (const char* mode : {"mean", "members", "own"}) {
+        const bool members = std::string(mode) != "mean";
+        ToyEnsemble toy(world, members, {1});
+        if (!toy.root_or_serve()) continue;
+        INFO("cpi.lift = " << mode);
+        EnsembleStepper& stepper = toy.stepper;
+        coarse::BurstSamples before, after;
+        stepper.run(0.5, before);
+        const Eigen::MatrixXd own = before.members.back();  // R x 3, the states now
+        const Eigen::Vector3d target(2.0, 0.3, 0.7);
+        Eigen::MatrixXd steps = Eigen::MatrixXd::Zero(kRealizations, 3);
+        steps << 0.5, 0.0, 0.1,  //
+            9.0, 9.0, 9.0,       // the held realization's: not used
+            0.0, -0.3, 0.0,      //
+            0.1, 0.0, 0.5;
+        const double new_time = stepper.time() + 1.0;
+        if (std::string(mode) == "own")
+            stepper.lift_apart(target, steps, new_time);
+        else
+            stepper.lift(target, new_time);
+        const LiftRecord lifted = stepper.last_lift();
+        stepper.run(5 * kH, after);  // the toy's next sample: states advanced by 5 Euler substeps
+        stepper.finish();
+        REQUIRE(lifted.at_rest.size() == static_cast<std::size_t>(kRealizations));
+        const Eigen::VectorXd sum = own.colwise().sum().transpose();
+        const Eigen::VectorXd increment = (kRealizations * target - sum) / 3.0;
+        const Eigen::Vector3d mean_step = (steps.row(0) + steps.row(2) + steps.row(3)) / 3.0;
+        const Eigen::MatrixXd a = toy_matrix();
+        Eigen::VectorXd lifted_mean = Eigen::VectorXd::Zero(3);
+        for (int r = 0; r < kRealizations; ++r) {
+            Eigen::VectorXd y = own.row(r).transpose();
+            if (r == 1) {
+                CHECK(lifted.at_rest[1] == 1);
+                CHECK(lifted.changed[1] == 0);
+            } else {
+                CHECK(lifted.at_rest[static_cast<std::size_t>(r)] == 0);
+                if (!members)
+                    y = (kRealizations * target - own.row(1).transpose()) / 3.0;
+                else
+                    y += increment;
+                if (std::string(mode) == "own") y += steps.row(r).transpose() - mean_step;
+            }
+            lifted_mean += y / kRealizations;
+            if (r != 1)  // the held toy does not move
+                for (int k = 0; k < 5; ++k) y += kH * (a * y);
+            if (r == 1)
+                CHECK(after.members[0].row(r).transpose() == y);  // bit for bit
+            else
+                CHECK((after.members[0].row(r).transpose() - y).cwiseAbs().maxCoeff() < 1e-14);
+        }
+        CHECK((lifted_mean - target).cwiseAbs().maxCoeff() < 1e-14);
+        CHECK(after.t.back() == Approx(new_time + 5 * kH).margin(1e-12));
+    }
+}
+
+TEST_CASE("cpi.at_rest = hold with every realization at rest lifts none; lift (off) lifts all",
+          "[mpi][ensemble][cpi]") {
+    const MpiComm world(MPI_COMM_WORLD);
+    {
+        // All at rest: nothing can carry the increment, so nothing moves; the clocks jump.
+        ToyEnsemble toy(world, false, {0, 1, 2, 3});
+        if (toy.root_or_serve()) {
+            coarse::BurstSamples before, after;
+            toy.stepper.run(0.5, before);
+            toy.stepper.lift(Eigen::Vector3d(2.0, 0.3, 0.7), toy.stepper.time() + 1.0);
+            const LiftRecord lifted = toy.stepper.last_lift();
+            toy.stepper.run(5 * kH, after);
+            toy.stepper.finish();
+            CHECK(after.members[0] == before.members.back());
+            CHECK(std::count(lifted.at_rest.begin(), lifted.at_rest.end(), 1) == kRealizations);
+        }
+    }
+    {
+        // Without hold (the settings' default, as cpi.at_rest = lift) a toy at rest is lifted.
+        ToyEnsemble toy(world, false, {1}, false);
+        if (toy.root_or_serve()) {
+            coarse::BurstSamples before, after;
+            toy.stepper.run(0.5, before);
+            const Eigen::Vector3d target(2.0, 0.3, 0.7);
+            toy.stepper.lift(target, toy.stepper.time() + 1.0);
+            toy.stepper.run(5 * kH, after);
+            toy.stepper.finish();
+            CHECK(after.members[0].row(1).transpose() == Eigen::VectorXd(target));  // at rest
+        }
     }
 }

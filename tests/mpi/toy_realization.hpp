@@ -22,7 +22,7 @@ class ToyRealization final : public mpi_driver::Realization {
     long particles() const override { return 1; }
     void advance(long steps) override {
         for (long s = 0; s < steps; ++s) {
-            x_ += h_ * (a_ * x_);
+            if (!at_rest_) x_ += h_ * (a_ * x_);  // at rest: a state the toy does not leave
             t_ += h_;
         }
         steps_ += steps;
@@ -59,6 +59,8 @@ class ToyRealization final : public mpi_driver::Realization {
         t_ = s.time;
         steps_ = s.step;
     }
+    bool at_rest() const override { return at_rest_; }
+    void set_at_rest(bool rest) { at_rest_ = rest; }
     const Eigen::VectorXd& state() const { return x_; }
     long steps() const { return steps_; }
 
@@ -69,6 +71,7 @@ class ToyRealization final : public mpi_driver::Realization {
     double h_;
     double t_ = 0;
     long steps_ = 0;
+    bool at_rest_ = false;
 };
 
 /// Lifting of the toy: the state becomes the target exactly.

@@ -57,11 +57,11 @@ EOF
   done
 }
 
-# cpi.noisy_curvature = counted: what the stored checkpoints' runs did (the rejection in them came
-# from a curvature within its noise).
+# cpi.noisy_curvature = counted, cpi.at_rest = lift: what the stored checkpoints' runs did (the
+# rejection in them came from a curvature within its noise; they lifted every realization).
 adaptive=(mode=cpi cpi.projection=adaptive cpi.integrator=adams_bashforth2 cpi.tolerance=0.06
-          cpi.dt_min=0.5 run.duration=24 cpi.noisy_curvature=counted)
-fixed=(mode=cpi)
+          cpi.dt_min=0.5 run.duration=24 cpi.noisy_curvature=counted cpi.at_rest=lift)
+fixed=(mode=cpi cpi.at_rest=lift)
 run 2 "$work/adaptive-ref.log" "$@" "$efdem" "$scene" "${adaptive[@]}" ensemble.realizations_per_rank=2 \
   output.directory="$work" output.prefix=adaptive-ref checkpoint.interval=2 checkpoint.keep=10
 run 2 "$work/fixed-ref.log" "$@" "$efdem" "$scene" "${fixed[@]}" ensemble.realizations_per_rank=2 \
@@ -135,11 +135,12 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
   # first step's stability from a rate the current code counts as noise: that step's stability
   # record differs, its DT and every sample do not (compared).
   # The window evidence's records (cpi.window_auto), the lift apart's (cpi.lift = own) and the
-  # trajectory budget's (cpi.accuracy) came after every stored checkpoint.
+  # trajectory budget's (cpi.accuracy) and the lift's realizations at rest (cpi.at_rest) came
+  # after every stored checkpoint.
   ignore=(--ignore cpi/controller/window_noise_ratio cpi/controller/window_noise_correlation
           cpi/controller/window_next cpi/controller/member_step cpi/controller/budget
           cpi/controller/ensemble_standard_error cpi/controller/budget_spent
-          cpi/controller/contraction_rate)
+          cpi/controller/contraction_rate cpi/lift_at_rest)
   [ "$version" = 4 ] || ignore+=(cpi/controller/error_statistical_jump cpi/controller/error_statistical_burst
                                 cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts
                                 cpi/controller/transient cpi/controller/transient_threshold
