@@ -6,6 +6,7 @@
 /// never sees particles: an ensemble of DEM realizations and a toy ODE look the same.
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -85,6 +86,16 @@ class CoarseStepper {
     virtual bool lifts_apart() const { return false; }
     virtual void lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
                             double new_time);
+
+    /**
+     * \brief The time of the first sample from which the micro model has been at an end state,
+     *        one it never leaves by itself (every realization at rest: a DEM bed the gas no
+     *        longer moves), up to the last sample; NaN when it is not (the default: never).
+     *
+     * Lifts that hold realizations at rest keep such a state. cpi.finish = steady ends a run
+     * there.
+     */
+    virtual double end_state_since() const { return std::numeric_limits<double>::quiet_NaN(); }
 
     /// \name Going back: reject-and-redo of adaptive projective integration.
     /// keep_state() keeps the whole micro state (every realization, the random streams, the

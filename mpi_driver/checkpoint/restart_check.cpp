@@ -35,6 +35,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.window_max", nullptr},  // read only with cpi.window_auto
     {"cpi.noisy_curvature", "counted"},
     {"cpi.at_rest", "lift"},  // hold: realizations at rest are not lifted (issue 34)
+    {"cpi.finish", "duration"},  // steady: end at the end state (issue 34)
 };
 // clang-format on
 

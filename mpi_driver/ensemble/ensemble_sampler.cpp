@@ -9,6 +9,9 @@
 namespace efdem::mpi_driver {
 
 namespace {
+/// Per realization and sample: centre of mass, lowest and highest centre, mean height, at rest.
+constexpr Eigen::Index kScalars = 5;
+
 /// The rows of `all` listed in `rows` (all rows when every realization is in the ensemble).
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Index>& rows) {
     if (all.size() == 0 || static_cast<Eigen::Index>(rows.size()) == all.rows()) return all;
@@ -70,14 +73,16 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
             // Dropped: a row of NaN in the record, not in the means.
             icdf.push_back(Eigen::VectorXd::Constant(m, nan));
             if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
-            scalars.push_back(Eigen::Vector4d::Constant(nan));
+            scalars.push_back(Eigen::VectorXd::Constant(kScalars, nan));
             if (bed_width > 0) bed.push_back(Eigen::VectorXd::Constant(bed_width, nan));
             continue;
         }
         Observation o = r->observe(grid_, top);
         icdf.push_back(std::move(o.icdf));
         if (top) top_icdf.push_back(std::move(o.top));
-        scalars.push_back(Eigen::Vector4d(o.com, o.z_min, o.z_max, o.mean_height));
+        Eigen::VectorXd row(kScalars);
+        row << o.com, o.z_min, o.z_max, o.mean_height, r->at_rest() ? 1.0 : 0.0;
+        scalars.push_back(std::move(row));
         if (bed_width > 0) {
             EFDEM_ASSERT(static_cast<Eigen::Index>(o.bed.size()) == bed_width);
             bed.push_back(Eigen::Map<const Eigen::VectorXd>(o.bed.data(), bed_width));
@@ -107,6 +112,7 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
     rec.mean = coarse::ensemble_mean(used_icdf);
     rec.variance = coarse::ensemble_variance(used_icdf, rec.mean);
     rec.com = all_scalar_rows.col(0);
+    rec.at_rest = all_scalar_rows.col(4);
     if (settings_.bed) {
         rec.bed = bed_record(all_bed_rows, *settings_.bed);
         rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(),

@@ -258,6 +258,7 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
         if (const SampleRecord* rec =
                 sampler_.take(local_, failures_.active(), time(), top_half, out)) {
             const double start = MPI_Wtime();
+            note_rest(*rec);
             snapshots_.record(*rec);
             record_seconds_ += MPI_Wtime() - start;  // recording counts as restriction
             if (progress_) progress_->update(rec->time, particle_steps_, "");
@@ -280,6 +281,16 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
         }
     }
     return samples;
+}
+
+void EnsembleStepper::note_rest(const SampleRecord& rec) {
+    bool all = rec.realizations_used > 0;
+    for (Eigen::Index r = 0; r < rec.at_rest.size(); ++r)
+        if (!std::isnan(rec.at_rest[r]) && rec.at_rest[r] != 1.0) all = false;
+    if (!all)
+        at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
+    else if (std::isnan(at_rest_since_))
+        at_rest_since_ = rec.time;
 }
 
 void EnsembleStepper::do_lift(double new_time, bool top_half, const Eigen::VectorXd* target,
@@ -332,6 +343,7 @@ EnsembleSnapshot EnsembleStepper::snapshot(const char* when) const {
 }
 
 void EnsembleStepper::return_to(const EnsembleSnapshot& s, const char* when, bool keep_membership) {
+    at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
     try {
         EnsembleSnapshots::restore_realizations(local_, s.realizations);
     } catch (const std::exception& e) {

@@ -40,6 +40,7 @@
 /// in the middle of a coarse step is checkpointed where the step began, and the restarted run
 /// redoes the step exactly as the uninterrupted run did it.
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -137,6 +138,9 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     StepperState saved_state() const;
     void restore_state(const StepperState& state);
     long samples_taken() const { return samples_taken_; }
+    /// Root: the first sample from which every realization in the ensemble has been at rest
+    /// (Realization::at_rest), up to the last; NaN when one moves (or none is left).
+    double end_state_since() const override { return at_rest_since_; }
 
     /// Non-root ranks: execute the root's commands until finish(). Collective.
     void serve();
@@ -242,6 +246,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     // serve()).
     /// Returns the samples taken (fewer than `samples` when a stop was agreed).
     long do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    /// Root: at_rest_since_ from a new sample.
+    void note_rest(const SampleRecord& rec);
     /// lift() and lift_apart() on the root: the command to the other ranks, then do_lift().
     void root_lift(const Eigen::VectorXd& target, const Eigen::MatrixXd* member_steps,
                    double new_time);
@@ -280,6 +286,9 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     std::filesystem::path last_checkpoint_;  ///< every rank: the newest checkpoint written
     double last_checkpoint_time_ = 0;
     long samples_taken_ = 0;  ///< every rank
+    /// Root: end_state_since(); forgotten when a state is gone back to (re-judged from the next
+    /// sample on: a bed at rest stays so).
+    double at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
     double particle_steps_ = 0;
     double micro_time_ = 0;
     double total_particles_ = 0;

@@ -210,6 +210,12 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
     series("/samples/icdf", {r, m}, T::real)
         .append(std::span<const double>(icdf.data(), static_cast<std::size_t>(icdf.size())));
     series("/samples/com", {r}, T::real).append(as_span(s.com));
+    if (s.at_rest.size() == static_cast<Eigen::Index>(realizations_)) {
+        std::vector<std::int64_t> rest(static_cast<std::size_t>(realizations_));
+        for (std::size_t k = 0; k < rest.size(); ++k)
+            rest[k] = s.at_rest[static_cast<Eigen::Index>(k)] == 1.0 ? 1 : 0;
+        series("/samples/at_rest", {r}, T::integer).append(std::span<const std::int64_t>(rest));
+    }
     series("/samples/realizations_used", {}, T::integer).append_integer(s.realizations_used);
     if (s.top_mean.size() == m_)
         series("/samples/top_mean", {m}, T::real).append(as_span(s.top_mean));

@@ -30,6 +30,9 @@ struct SampleRecord {
     Eigen::VectorXd variance;      ///< unbiased ensemble variance per node (zeros when R = 1)
     Eigen::MatrixXd realizations;  ///< R x m: each realization's ICDF
     Eigen::VectorXd com;           ///< R: centre-of-mass height of each realization
+    /// R: 1 where the realization is at rest (Realization::at_rest), 0 where it moves, NaN where
+    /// it was dropped.
+    Eigen::VectorXd at_rest;
     /// observe.bed: each realization's bed quantities and their mean over the realizations in
     /// the ensemble; empty otherwise.
     BedRecord bed;

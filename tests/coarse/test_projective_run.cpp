@@ -100,6 +100,37 @@ class FailingPrimaryStepper final : public CoarseStepper {
     test::LinearToyStepper toy_;
     double t_fail_;
 };
+
+/// A linear toy that reaches an end state at t_rest: from then on it does not move (its state
+/// stays what it was at t_rest, lifts included) and end_state_since() says since when.
+class RestingStepper final : public CoarseStepper {
+  public:
+    RestingStepper(test::LinearToyStepper toy, double t_rest)
+        : toy_(std::move(toy)), t_rest_(t_rest) {}
+    double time() const override { return toy_.time(); }
+    void run(double duration, BurstSamples& out) override {
+        const std::size_t first = out.size();
+        toy_.run(duration, out);
+        for (std::size_t k = first; k < out.size(); ++k)
+            if (out.t[k] >= t_rest_ - 1e-9) {
+                if (std::isnan(since_)) {
+                    since_ = out.t[k];
+                    rest_ = out.x[k];
+                }
+                out.x[k] = rest_;
+            }
+    }
+    void lift(const Eigen::VectorXd& target, double new_time) override {
+        toy_.lift(std::isnan(since_) ? target : rest_, new_time);
+    }
+    double end_state_since() const override { return since_; }
+
+  private:
+    test::LinearToyStepper toy_;
+    double t_rest_;
+    double since_ = std::numeric_limits<double>::quiet_NaN();
+    Eigen::VectorXd rest_;
+};
 }  // namespace
 
 TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the warm-up first",
@@ -506,4 +537,41 @@ TEST_CASE("a direct run reads the cpi block without checking it against the samp
     } catch (const InputError& e) {
         CHECK(e.key() == "cpi.healing");
     }
+}
+
+TEST_CASE("cpi.finish = steady ends the run after the coarse step that finds the end state",
+          "[unit][coarse][run]") {
+    // The toy comes to rest at t = 33 (inside the burst of the fourth cycle, 30-32... 40-42:
+    // bursts at 0-2, 10-12, 20-22, 30-32, 40-42): the first sample at rest is t = 40.1, in the
+    // fifth coarse step, after which the run ends at 50 (that step's jump) instead of 100; the
+    // status names the time of the end state. Without the key the same toy runs to 100.
+    for (const bool finish : {true, false}) {
+        RestingStepper toy(slow_toy(), 33.0);
+        CpiSettings settings = fixed_settings();
+        settings.finish_at_end_state = finish;
+        ProjectiveRun run(settings, toy, variable("x"));
+        const ProjectiveRunOutcome out = run.run(100.0);
+        INFO("cpi.finish = " << (finish ? "steady" : "duration"));
+        if (finish) {
+            CHECK(out.end_state_time == Approx(40.1).margin(1e-9));
+            CHECK(out.coarse_steps == 5);
+            CHECK(toy.time() == Approx(50.0).margin(1e-9));
+            CHECK(out.end_status.rfind("completed (end state at t = 40.1, 40.1 time units", 0) ==
+                  0);
+        } else {
+            CHECK(std::isnan(out.end_state_time));
+            CHECK(out.end_status == "completed");
+            CHECK(toy.time() == Approx(100.0).margin(1e-9));
+        }
+    }
+    // The key: duration (default) or steady, nothing else.
+    const auto read = [](const std::string& value) {
+        ParamTable table = ParamTable::from_text("cpi.finish = " + value + "\n", "scene.cfg", "/s");
+        return CpiSettings::from_params(table.root().scope("cpi"), 0.5);
+    };
+    CHECK(read("steady").finish_at_end_state);
+    CHECK_FALSE(read("duration").finish_at_end_state);
+    CHECK_THAT(test::input_error([&] { read("never"); }).what(),
+               Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.finish") &&
+                   Catch::Contains("duration") && Catch::Contains("steady"));
 }

@@ -135,12 +135,12 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
   # first step's stability from a rate the current code counts as noise: that step's stability
   # record differs, its DT and every sample do not (compared).
   # The window evidence's records (cpi.window_auto), the lift apart's (cpi.lift = own) and the
-  # trajectory budget's (cpi.accuracy) and the lift's realizations at rest (cpi.at_rest) came
-  # after every stored checkpoint.
+  # trajectory budget's (cpi.accuracy) and the realizations at rest (each sample's, and the
+  # lift's: cpi.at_rest) came after every stored checkpoint.
   ignore=(--ignore cpi/controller/window_noise_ratio cpi/controller/window_noise_correlation
           cpi/controller/window_next cpi/controller/member_step cpi/controller/budget
           cpi/controller/ensemble_standard_error cpi/controller/budget_spent
-          cpi/controller/contraction_rate cpi/lift_at_rest)
+          cpi/controller/contraction_rate cpi/lift_at_rest samples/at_rest)
   [ "$version" = 4 ] || ignore+=(cpi/controller/error_statistical_jump cpi/controller/error_statistical_burst
                                 cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts
                                 cpi/controller/transient cpi/controller/transient_threshold

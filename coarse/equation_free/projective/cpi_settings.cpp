@@ -189,6 +189,8 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::closed(0.0, 1e7));
     on_grid("warmup_max", s.warmup_max);
     s.warmup_drift_rate = by_tolerance ? m.drift_rate : 0.0;
+    s.finish_at_end_state =
+        cpi.get_or_choice("finish", "duration", {"duration", "steady"}) == "steady";
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
     return s;

@@ -40,6 +40,8 @@
 /// | cpi.window_max    | adaptive: the longest window cpi.window_auto may choose       | 4 burst |
 /// | cpi.noisy_curvature | adaptive: a posteriori curvature within its noise `ignored` | ignored |
 /// |                   | or `counted` as truncation error (runs before it: counted)    |         |
+/// | cpi.finish        | `duration` (run to run.duration) or `steady`: end where the    | duration|
+/// |                   | stepper reaches an end state (every realization at rest)      |         |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance
@@ -85,6 +87,10 @@ struct CpiSettings {
     /// threshold the integrator holds a jump back by, multistep.drift_rate); 0 otherwise (no
     /// tolerance: steady only when the drift is within its noise).
     double warmup_drift_rate = 0.0;
+    /// cpi.finish = steady: the run ends after the first coarse step whose last sample finds
+    /// the stepper at an end state (CoarseStepper::end_state_since: every realization at rest),
+    /// with the time it was reached in the end status.
+    bool finish_at_end_state = false;
     /// Projection = fixed: healing, window, DT, stability policy.
     ProjectiveEulerSettings fixed;
     /// Projection = periods: healing, window, k, burst extension, stability policy.

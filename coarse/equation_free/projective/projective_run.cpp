@@ -74,6 +74,17 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
         ++state_.coarse_steps;
         if (rec.status == StepStatus::projected && rec.dt > 0) ++out.jumps;
         for (auto* o : observers_) o->step_done(*this, rec);
+        if (settings_.finish_at_end_state && !std::isnan(stepper_.end_state_since())) {
+            // Nothing changes from here on however long the run: the end state is reached.
+            out.end_state_time = stepper_.end_state_since();
+            const std::string what = fmt::format(
+                "end state at t = {:.6g}, {:.6g} time units after the start: every realization "
+                "at rest",
+                out.end_state_time, out.end_state_time - state_.t_origin);
+            out.end_status = "completed (" + what + ")";
+            log::info("cpi.finish = steady: {}", what);
+            break;
+        }
         if (rec.advanced()) {
             state_.without_progress = 0;
             continue;

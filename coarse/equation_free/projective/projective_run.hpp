@@ -12,6 +12,8 @@
 ///   t_end exactly; a rest shorter than one burst ends the run early, with a log line;
 /// * stop conditions: StepStatus::stopped_unstable, or kMaxStepsWithoutProgress consecutive
 ///   steps without a jump (the run would silently have become a direct run);
+/// * cpi.finish = steady: the run ends after the coarse step whose last sample finds the stepper
+///   at an end state (every realization at rest), with the time it was reached;
 /// * observable fallback: when a step is rejected as invalid_burst and a fallback coarse
 ///   variable exists (e.g. the compact (A,B,C,D) fit failed; the full ICDF is always defined),
 ///   the stepper is switched to it and the run continues on it for good;
@@ -104,6 +106,9 @@ struct ProjectiveRunOutcome {
     long jumps = 0;             ///< projective jumps (DT > 0, accepted) made by this call of run()
     double simulated_time = 0;  ///< stepper time at the end minus t_origin
     bool fell_back = false;
+    /// cpi.finish = steady: when the end state was reached (CoarseStepper::end_state_since);
+    /// NaN when the run ended otherwise.
+    double end_state_time = std::numeric_limits<double>::quiet_NaN();
 };
 
 class ProjectiveRun {
