@@ -27,9 +27,17 @@ import study_runs as sr  # noqa: E402
 
 RESULTS = os.path.join(HERE, "results", "whole_process")
 DIRECT = (("direct_a", 101), ("direct_b", 202), ("direct_c", 303))
+# The CPI runs: adaptive with the accuracy key (no per-bed tolerance), realizations at rest held
+# (cpi.at_rest = hold, the default) and the run ended at the end state (cpi.finish = steady).
+ADAPTIVE = {"cpi.projection": "adaptive", "cpi.accuracy": 1.5, "cpi.healing": 10, "cpi.window": 10,
+            "cpi.finish": "steady"}
+SLOW = {
+    "members_hold": {**ADAPTIVE, "cpi.lift": "members"},  # each realization kept apart
+    "mean_hold": {**ADAPTIVE, "cpi.lift": "mean"},  # the paper's lift, those at rest held
+}
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own)
 CASES = {
-    "demo_u0.19_r4": ("demo_bed.cfg", 0.19, 1000.0, 4, {}),
+    "demo_u0.19_r4": ("demo_bed.cfg", 0.19, 1000.0, 4, SLOW),
 }
 
 

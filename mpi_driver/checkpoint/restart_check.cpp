@@ -88,6 +88,15 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
                                "ensemble.realizations_per_rank); restart with the same number",
                                h.realizations, realizations_now));
     const auto then = parse_lines(h.parameters), now = parse_lines(parameters_now);
+    // Not physics: a run of one mode has no state (integrator, run-file groups) to continue one
+    // of another, so not even restart.allow_physics_change allows it.
+    const auto mode_then = then.find("mode"), mode_now = now.find("mode");
+    if (mode_then != then.end() && mode_now != now.end() && mode_then->second != mode_now->second)
+        throw InputError(
+            where, fmt::format("checkpoint was written by a mode = {} run and this run has mode = "
+                               "{}; a restart continues the run that wrote the checkpoint, in its "
+                               "mode (restart with mode = {})",
+                               mode_then->second, mode_now->second, mode_then->second));
     std::vector<std::string> changes;
     for (const auto& [key, value] : now) {
         if (may_change_on_restart(key) || ignored_in(now, key)) continue;

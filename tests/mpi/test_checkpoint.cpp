@@ -135,6 +135,14 @@ TEST_CASE("a restart may change run length, output and layout keys, not physics"
     CHECK(check_restart("c.h5", direct, direct.parameters + "cpi.at_rest = hold\n", 4, false)
               .empty());
     CHECK(check_restart("c.h5", cpi, cpi.parameters + "cpi.at_rest = lift\n", 4, false).empty());
+    // A restart continues a run in its own mode, whatever restart.allow_physics_change says (a
+    // direct checkpoint continued as cpi ended in an HDF5 error creating /cpi).
+    for (const bool allow : {false, true})
+        CHECK_THROWS_WITH(
+            check_restart("c.h5", direct, h.parameters + "mode = cpi\n", 4, allow),
+            Catch::Contains("c.h5") &&
+                Catch::Contains("written by a mode = direct run and this run has mode = cpi") &&
+                Catch::Contains("restart with mode = direct"));
     CHECK_THROWS_WITH(
         check_restart("c.h5", cpi, cpi.parameters + "cpi.at_rest = hold\n", 4, false),
         Catch::Contains("cpi.at_rest = hold (not in the checkpoint, whose run did cpi.at_rest = "
