@@ -18,12 +18,24 @@ Cost (AMD EPYC, 2 shared cores, R = 4): a demo-bed direct run of 1,000 units ~50
 direct run of 600 units ~2 h.
 """
 import argparse
+import json
+import math
 import os
 import sys
 
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+import stop_times as st  # noqa: E402
 import study_runs as sr  # noqa: E402
+
+MEDIAN = 9  # the node p = 0.5 of the 19-node grid
 
 RESULTS = os.path.join(HERE, "results", "whole_process")
 DIRECT = (("direct_a", 101), ("direct_b", 202), ("direct_c", 303))
@@ -67,6 +79,152 @@ def make(args, case):
             sr.archive(work, name, dest)
 
 
+def load(path):
+    with h5py.File(path, "r") as f:
+        d = {k: sr.text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
+        d["t"], d["mean"], d["icdf"] = f["samples/time"][:], f["samples/mean"][:], f["samples/icdf"][:]
+        d["rest"] = f["samples/at_rest"][:] if "samples/at_rest" in f else None
+    return d
+
+
+def stops(run):
+    """Per realization: when it came to rest for good (NaN: moving at the end). From
+    /samples/at_rest where the run has it, else from its ICDF (bench/stop_times.py)."""
+    if run["rest"] is None:
+        return st.stop_times(run["t"], run["icdf"])
+    out = []
+    for r in range(run["rest"].shape[1]):
+        moving = np.nonzero(run["rest"][:, r] == 0)[0]
+        out.append(float("nan") if len(moving) and moving[-1] == len(run["t"]) - 1
+                   else float(run["t"][moving[-1] + 1] if len(moving) else run["t"][0]))
+    return out
+
+
+def held_to(run, t):
+    """The run's ensemble mean at the times t; past its last sample a run that ended at its end
+    state is held there (nothing changes in an end state)."""
+    idx = np.searchsorted(run["t"], t - 1e-6)
+    ok = idx < len(run["t"])
+    out = np.empty((len(t), run["mean"].shape[1]))
+    out[ok] = run["mean"][idx[ok]]
+    out[~ok] = run["mean"][-1] if run["end_state"] else np.nan
+    exact = ok & (np.abs(run["t"][np.minimum(idx, len(run["t"]) - 1)] - t) < 1e-6)
+    out[ok & ~exact] = np.nan
+    return out
+
+
+def rms(a, b, t, window):
+    sel = (t >= window[0]) & (t < window[1]) & np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+    return math.sqrt(float(np.mean((a[sel] - b[sel]) ** 2))) if sel.any() else float("nan")
+
+
+def analyse_case(args, case):
+    scene, us, duration, realizations, cpi = CASES[case]
+    folder = os.path.join(args.results, case)
+    runs = {name: load(os.path.join(folder, name + ".h5")) for name in runs_of(case)
+            if sr.archived(os.path.join(folder, name + ".h5"))}
+    for run in runs.values():
+        run["end_state"] = "end state at" in run["end_status"]
+    directs = [runs[n] for n, _ in DIRECT if n in runs]
+    if not directs:
+        return None, []
+    t = directs[0]["t"]
+    quarters = [(duration * k / 4, duration * (k + 1) / 4 + 1e-6) for k in range(4)]
+    whole = (0.0, duration + 1e-6)
+    means = [held_to(d, t) for d in directs]
+    pairs = [(i, j) for i in range(len(directs)) for j in range(i + 1, len(directs))]
+    floor = {w: float(np.mean([rms(means[i], means[j], t, w) for i, j in pairs])) if pairs else float("nan")
+             for w in quarters + [whole]}
+    # The end state of the direct ensembles: every realization's median light height at the end,
+    # pooled over the ensembles (their own seeds: independent), with its standard error.
+    direct_medians = np.concatenate([d["icdf"][-1, :, MEDIAN] for d in directs])
+    d_mean, d_se = float(direct_medians.mean()), float(direct_medians.std(ddof=1) / math.sqrt(len(direct_medians)))
+    direct_stops = [s for d in directs for s in stops(d)]
+    last_stop = max(direct_stops) if all(np.isfinite(direct_stops)) else float("nan")
+    summary = {"case": case, "floor": floor[whole], "floor_quarters": [floor[w] for w in quarters],
+               "direct_end_median": d_mean, "direct_end_median_se": d_se,
+               "direct_stopped": int(np.isfinite(direct_stops).sum()), "direct_realizations": len(direct_stops),
+               "direct_all_at_rest_at": last_stop, "cpi": {}}
+    lines = [f"## {case}: {scene.split('_')[0]} bed, U_s = {us}, R = {realizations}, {duration:g} time units\n",
+             f"Direct ensembles: {len(directs)} (seeds {', '.join(str(s) for n, s in DIRECT if n in runs)}); noise "
+             f"floor (RMS between two direct ensembles' mean ICDF, mean over {len(pairs)} pair(s)): "
+             f"{floor[whole]:.3f} d_p over the run, by quarter " + " / ".join(f"{floor[w]:.3f}" for w in quarters)
+             + ".\n",
+             f"Direct realizations at rest for good by the end: {summary['direct_stopped']} of {len(direct_stops)} "
+             "(stop times " + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_stops) + "). "
+             f"End state (median light height at the end, pooled): {d_mean:.2f} +- {d_se:.2f} d_p.\n",
+             "| CPI run | ended | e / floor by quarter | e / floor | end-state median [d_p] | off the directs' [s.e.] "
+             "| realizations at rest (stop times) | DEM-time speed-up (same span) | to the end state: direct / CPI "
+             "DEM time | wall-time speed-up |", "|---" * 10 + "|"]
+    for name in cpi:
+        if name not in runs:
+            continue
+        run = runs[name]
+        x = held_to(run, t)
+        e = {w: math.sqrt(np.mean([rms(x, m, t, w) ** 2 for m in means])) for w in quarters + [whole]}
+        med = run["icdf"][-1, :, MEDIAN]
+        c_mean, c_se = float(med.mean()), float(med.std(ddof=1) / math.sqrt(len(med)))
+        off = (c_mean - d_mean) / math.sqrt(d_se ** 2 + c_se ** 2)
+        cpi_stops = stops(run)
+        span = float(run["simulated_time"])
+        dem = float(run["dem_time"])
+        speed = span / dem
+        # DEM time to the end state: a direct ensemble's is when its last realization came to rest.
+        to_end = (last_stop / dem) if run["end_state"] and np.isfinite(last_stop) else float("nan")
+        direct_wall = np.mean([float(d["wall_seconds"]) / float(d["simulated_time"]) for d in directs]) * span
+        wall = direct_wall / float(run["wall_seconds"])
+        ended = f"end state at {float(run['t'][-1]):g}" if run["end_state"] else f"{span:g} (duration)"
+        summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole], "e_over_floor_quarters":
+                                [e[w] / floor[w] for w in quarters], "end_median": c_mean, "end_median_se": c_se,
+                                "off_se": off, "stops": cpi_stops, "speedup_dem": speed,
+                                "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"]}
+        lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / floor[w]:.2f}" for w in quarters)
+                     + f" | {e[whole] / floor[whole]:.2f} | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
+                     f"{int(np.isfinite(cpi_stops).sum())} of {len(cpi_stops)} ("
+                     + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
+                     + f") | {speed:.2f} | {to_end:.2f} | {wall:.2f} |")
+    lines.append("")
+    plot(folder, case, t, directs, {n: runs[n] for n in cpi if n in runs})
+    return summary, lines
+
+
+def plot(folder, case, t, directs, cpis):
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for k, d in enumerate(directs):
+        ax.plot(d["t"], d["icdf"][:, :, MEDIAN], color="0.75", lw=0.6, label="direct realizations" if k == 0 else None)
+        ax.plot(d["t"], d["mean"][:, MEDIAN], color="k", lw=1.2, label="direct ensembles' means" if k == 0 else None)
+    for (name, run), colour in zip(cpis.items(), ("C0", "C3", "C2", "C1")):
+        ax.plot(run["t"], run["mean"][:, MEDIAN], color=colour, lw=1.5, label=f"CPI {name}")
+        ax.plot(run["t"], run["icdf"][:, :, MEDIAN], color=colour, lw=0.5, alpha=0.5, ls="none", marker=".", ms=1)
+    ax.set_xlabel("t [sqrt(d_p/g)]")
+    ax.set_ylabel("median light height [d_p]")
+    ax.set_title(case)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(folder, "whole_process.png"), dpi=120)
+    plt.close(fig)
+
+
+def analyse(args):
+    out, summary = ["# The whole demixing (issue 34)\n",
+                    "Made by `/usr/bin/python3 bench/whole_process.py --efdem build/mpi_driver/efdem` (resumable; "
+                    "`--analyse-only` redoes this page). e: RMS over the ICDF nodes and the samples of the CPI "
+                    "run's ensemble mean minus each direct ensemble's, averaged in square over the directs; a run "
+                    "that ended at its end state is held there to the end of the span. Wall-time speed-ups are from "
+                    "a shared 2-core AMD EPYC machine whose load varies: the DEM-time ones are the measure.\n"], {}
+    for case in CASES:
+        s, lines = analyse_case(args, case)
+        if s:
+            summary[case] = s
+            out += lines
+    os.makedirs(args.results, exist_ok=True)
+    with open(os.path.join(args.results, "analysis.md"), "w") as f:
+        f.write("\n".join(out) + "\n")
+    with open(os.path.join(args.results, "analysis.json"), "w") as f:
+        json.dump(summary, f, indent=1, default=float)
+    print("\n".join(out))
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--efdem", default=os.path.join(HERE, "..", "build", "mpi_driver", "efdem"))
@@ -79,6 +237,7 @@ def main():
     if not args.analyse_only:
         for case in args.case or CASES:
             make(args, case)
+    analyse(args)
 
 
 if __name__ == "__main__":
