@@ -229,6 +229,10 @@ std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem
                                      first + count - 1));
         const auto checksum = f.read_integers("/realizations/checksum");
         const auto time = f.read_doubles("/realizations/time");
+        // Written since the rest judgement (ensemble.at_rest); before it, none was still.
+        const auto still = f.exists("/realizations/still_samples")
+                               ? f.read_integers("/realizations/still_samples")
+                               : std::vector<std::int64_t>(static_cast<std::size_t>(rows), 0);
         hsize_t n_off = 0, p_off = 0;
         for (long r = 0; r < first; ++r) {
             n_off += static_cast<hsize_t>(meta[6 * r + 2]);
@@ -242,6 +246,7 @@ std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem
             s.index = m[0];
             s.step = m[1];
             s.time = time.at(static_cast<std::size_t>(r));
+            s.still_samples = still.at(static_cast<std::size_t>(r));
             auto block = [&](const char* name) {
                 return vectors(f.read_doubles(fmt::format("/realizations/{}", name), n_off, n));
             };

@@ -272,7 +272,7 @@ void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
         p_total += static_cast<hsize_t>(all[2 * r + 1]);
     }
 
-    std::vector<std::int64_t> meta, checksum, tags, pair_tags;
+    std::vector<std::int64_t> meta, checksum, tags, pair_tags, still;
     std::vector<double> time, pair_xi;
     std::vector<std::uint8_t> species;
     std::vector<double> blocks[8];  // x, v, omega, force, torque, reference, wall_floor, wall_lid
@@ -282,6 +282,7 @@ void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
                                  static_cast<std::int64_t>(s.pairs.size()),
                                  s.reference.empty() ? 0 : 1, s.wall[0].empty() ? 0 : 1});
         checksum.push_back(to_stored(s.checksum()));
+        still.push_back(s.still_samples);
         time.push_back(s.time);
         const std::vector<Vec3>* arrays[8] = {&s.x,      &s.v,         &s.omega,   &s.force,
                                               &s.torque, &s.reference, &s.wall[0], &s.wall[1]};
@@ -301,6 +302,7 @@ void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
     const auto first = static_cast<hsize_t>(layout_.first_index());
     f.write_block("/realizations/meta", H5T_NATIVE_INT64, R, 6, first, meta);
     f.write_block("/realizations/checksum", H5T_NATIVE_INT64, R, 1, first, checksum);
+    f.write_block("/realizations/still_samples", H5T_NATIVE_INT64, R, 1, first, still);
     f.write_block("/realizations/time", H5T_NATIVE_DOUBLE, R, 1, first, time);
     const char* names[8] = {"x",      "v",         "omega",      "force",
                             "torque", "reference", "wall_floor", "wall_lid"};

@@ -75,7 +75,9 @@ std::string parameter_lines(const ParamTable& table) {
 bool may_change_on_restart(const std::string& key) {
     for (const char* scope : {"output.", "checkpoint.", "restart.", "debug.", "watchdog."})
         if (key.rfind(scope, 0) == 0) return true;
-    return key == "run.duration" || key == "ensemble.realizations_per_rank";
+    // ensemble.at_rest: pausing a bed at rest changes its state by floating-point drift alone.
+    return key == "run.duration" || key == "ensemble.realizations_per_rank" ||
+           key == "ensemble.at_rest";
 }
 
 std::string check_restart(const std::filesystem::path& path, const CheckpointHeader& h,

@@ -34,7 +34,8 @@
 ///   /output/<suffix>        the run's output files (HDF5, CSV) as they were at the checkpoint,
 ///                           named by what follows output.prefix (".h5", "_mean_icdf.csv", ...)
 ///   /realizations/...       per realization (global index order): meta (index, step,
-///                           particles, pairs), time, checksum; per particle (rows offset by
+///                           particles, pairs), time, checksum, still_samples (since the rest
+///                           judgement; absent: 0); per particle (rows offset by
 ///                           the particle counts) x, v, omega, force, torque, reference,
 ///                           wall_floor, wall_lid, tag, species; per pair pair_tags, pair_xi
 

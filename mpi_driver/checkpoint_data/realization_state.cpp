@@ -29,6 +29,8 @@ std::uint64_t RealizationState::checksum() const {
         h = fnv1a(&p.xi, sizeof p.xi, h);
     }
     for (const auto& w : wall) h = fnv1a_array(w, h);
+    // Only when set: the checksums of the checkpoints written before it stay valid.
+    if (still_samples != 0) h = fnv1a(&still_samples, sizeof still_samples, h);
     return h;
 }
 
@@ -79,6 +81,7 @@ std::vector<std::uint8_t> pack(const RealizationState& s) {
     put_array(out, s.species);
     put_array(out, s.pairs);
     for (const auto& w : s.wall) put_array(out, w);
+    put(out, s.still_samples);
     return out;
 }
 
@@ -93,6 +96,7 @@ RealizationState unpack(const std::vector<std::uint8_t>& bytes) {
     r.get_array(s.species);
     r.get_array(s.pairs);
     for (auto& w : s.wall) r.get_array(w);
+    s.still_samples = r.get<long>();
     EFDEM_EXPECTS(r.at == bytes.size());
     return s;
 }

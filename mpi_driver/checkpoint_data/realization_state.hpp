@@ -25,6 +25,9 @@ struct RealizationState {
     std::vector<Vec3> reference;                          ///< positions of the last list build
     std::vector<dem::PairHistoryRecord> pairs;            ///< active pair springs by tags
     std::vector<Vec3> wall[dem::ContactHistory::kWalls];  ///< per particle (empty: none)
+    /// Consecutive sample intervals at whose end the realization was still (DemRealization:
+    /// its rest judgement); checkpoints written before it hold none (0).
+    long still_samples = 0;
 
     std::size_t particles() const { return x.size(); }
     /// FNV-1a over every array and scalar above: a checkpoint stores it, a restart verifies it.

@@ -55,12 +55,24 @@ std::pair<std::size_t, std::size_t> DemRealization::lift_output_sizes() const {
 
 void DemRealization::apply_lift(const LiftPayload& lifted) {
     coarse::apply_colours(system_, lifted.bytes, observed_, other_);
+    still_samples_ = 0;  // other masses: its balance is judged again
 }
 
-bool DemRealization::at_rest() const {
-    const double limit = kRestSpeed * kRestSpeed;
-    const auto v = system_.particles().v();
-    return std::all_of(v.begin(), v.end(), [limit](const auto& u) { return norm2(u) < limit; });
+void DemRealization::advance(long steps) {
+    system_.run(steps);
+    still_samples_ = still() ? still_samples_ + 1 : 0;
+}
+
+bool DemRealization::still() const {
+    const dem::Particles& p = system_.particles();
+    const auto v = p.v();
+    const auto f = p.force();
+    const auto inv_mass = p.inv_mass();
+    for (std::size_t i = 0; i < v.size(); ++i)
+        if (norm2(v[i]) >= kRestSpeed * kRestSpeed ||
+            norm2(f[i]) * inv_mass[i] * inv_mass[i] >= kRestAcceleration * kRestAcceleration)
+            return false;
+    return true;
 }
 
 void DemRealization::after_sample(long samples_taken) {
@@ -70,6 +82,7 @@ void DemRealization::after_sample(long samples_taken) {
 
 void DemRealization::set_parameter(const std::string& key, double value) {
     system_.set_parameter(key, value);
+    still_samples_ = 0;
 }
 
 RealizationState DemRealization::save_state() const {
@@ -78,6 +91,7 @@ RealizationState DemRealization::save_state() const {
     s.index = index();
     s.time = system_.time();
     s.step = system_.step_count();
+    s.still_samples = still_samples_;
     s.x.assign(p.x().begin(), p.x().end());
     s.v.assign(p.v().begin(), p.v().end());
     s.omega.assign(p.omega().begin(), p.omega().end());
@@ -120,6 +134,7 @@ void DemRealization::restore_state(const RealizationState& s) {
         new_to_old[k] = it->second;
     }
     p.permute(new_to_old);
+    still_samples_ = s.still_samples;
     std::copy(s.x.begin(), s.x.end(), p.x().begin());
     std::copy(s.v.begin(), s.v.end(), p.v().begin());
     std::copy(s.omega.begin(), s.omega.end(), p.omega().begin());

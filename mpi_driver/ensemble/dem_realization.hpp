@@ -44,19 +44,32 @@ class DemRealization final : public Realization {
     void set_time(double t) override { system_.set_time(t); }
     double dt() const override { return system_.dt(); }
     long particles() const override { return static_cast<long>(system_.particles().size()); }
-    void advance(long steps) override { system_.run(steps); }
+    /// Runs `steps` DEM steps, then judges whether the bed is still (still_samples()).
+    void advance(long steps) override;
     Observation observe(const coarse::ProbabilityGrid& grid, bool top_half) const override;
     LiftPayload lift_input() const override;
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
     void apply_lift(const LiftPayload& lifted) override;
-    /// Every particle's translational speed below kRestSpeed. A bed that the gas no longer
-    /// fluidizes comes to rest exactly (speeds ~1e-11 sqrt(g d_p) at U_s = 0.19, while the
-    /// slowest moving bed measured had 8e-3) and stays so: its light ICDF then moves by
-    /// ~1e-13 d_p (bench/stop_times.py). Spins about the contact normal survive at rest and do
+    /// Still now: every particle's translational speed below kRestSpeed and its acceleration
+    /// (force over mass, from the forces of the current state and effects) below
+    /// kRestAcceleration. A bed that the gas no longer fluidizes comes to rest exactly (measured
+    /// at U_s = 0.19: speeds ~1e-11 sqrt(g d_p), accelerations 7e-9 g, while the slowest moving
+    /// bed had 8e-3 and 4e-4) and stays so: its light ICDF then moves by ~1e-13 d_p
+    /// (bench/stop_times.py). A bed still whose forces changed (a settled bed when the gas comes
+    /// on) is not in balance, so not still. Spins about the contact normal survive at rest and do
     /// not count.
-    bool at_rest() const override;
+    bool still() const;
+    /// At rest: still at the end of the last kRestSamples sample intervals in a row (advance()):
+    /// a settling bed's motion can pass below both thresholds for one sample and pick up again
+    /// (measured once on the tiny bed without gas: still at one sample, moving for the next five,
+    /// then still for good). A lift or a parameter change starts the count again.
+    bool at_rest() const override { return still_samples_ >= kRestSamples; }
+    long still_samples() const { return still_samples_; }
+    static constexpr long kRestSamples = 4;
     /// [sqrt(g d_p)]: four decades below a moving bed, five above one at rest.
     static constexpr double kRestSpeed = 1e-6;
+    /// [g]: two decades below a moving bed, two above one at rest.
+    static constexpr double kRestAcceleration = 1e-6;
     void after_sample(long samples_taken) override;
     /// key: gas_drag.superficial_velocity (the gas_drag effect must be listed).
     void set_parameter(const std::string& key, double value) override;
@@ -74,6 +87,7 @@ class DemRealization final : public Realization {
     std::optional<dem::BedObservationSettings> bed_;
     std::optional<dem::VtkSeriesWriter> vtk_;
     std::unique_ptr<dem::ThermoLog> thermo_;
+    long still_samples_ = 0;  ///< see still_samples(); part of the checkpoint
 };
 
 /// Minimal-change recolouring (physics.md §9) of one realization: payload in = heights (reals)

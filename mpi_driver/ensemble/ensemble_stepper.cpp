@@ -233,10 +233,17 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
     const bool can_redo = has_resume_point();
     std::vector<RealizationFailure> failed;
     for (long s = 0; s < samples; ++s) {
+        long paused = 0;  // particles of this rank's realizations at rest, not advanced
         for (auto& r : local_) {
             if (!failures_.is_active(r->index())) {
                 // Dropped after a failure: not advanced, but its clock keeps time.
                 r->set_time(r->time() + static_cast<double>(settings_.steps_per_sample) * r->dt());
+                continue;
+            }
+            if (settings_.pause_at_rest && r->at_rest()) {
+                // At rest for good: only its clock moves on.
+                r->set_time(r->time() + static_cast<double>(settings_.steps_per_sample) * r->dt());
+                paused += r->particles();
                 continue;
             }
             try {
@@ -253,7 +260,10 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
         const int signal = failures_.agree(local_, failed, stop_signal_received(), can_redo, sink_);
         failed.clear();
         micro_time_ += static_cast<double>(settings_.steps_per_sample) * local_.front()->dt();
-        particle_steps_ += static_cast<double>(settings_.steps_per_sample) * total_particles_;
+        if (settings_.pause_at_rest)  // what was computed: the paused particles left out
+            MPI_Allreduce(MPI_IN_PLACE, &paused, 1, MPI_LONG, MPI_SUM, layout_.mpi().comm());
+        particle_steps_ += static_cast<double>(settings_.steps_per_sample) *
+                           (total_particles_ - static_cast<double>(paused));
         if (failures_.pending()) return s;  // cpi: the step is redone from its resume point
         if (const SampleRecord* rec =
                 sampler_.take(local_, failures_.active(), time(), top_half, out)) {

@@ -91,6 +91,10 @@ struct StepperSettings {
     /// it is and moves the others by the ensemble's whole increment (EnsembleLifting). Needs an
     /// observable that restricts members; with one that does not, every realization is lifted.
     bool hold_at_rest = false;
+    /// ensemble.at_rest = pause: a realization at rest (Realization::at_rest) is not advanced;
+    /// its clock keeps time (a bed at rest stays so: its state would change by floating-point
+    /// drift alone). Its particle-steps are not counted.
+    bool pause_at_rest = false;
 };
 
 class EnsembleStepper final : public coarse::CoarseStepper {

@@ -41,8 +41,9 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "failure)",
          sample_r_node},
         {"/samples/at_rest", "1",
-         "1 where the realization is at rest (every particle slower than 1e-6 sqrt(g d_p): a bed "
-         "the gas no longer moves), 0 where it moves or was dropped",
+         "1 where the realization is at rest (every particle slower than 1e-6 sqrt(g d_p) and "
+         "accelerated by less than 1e-6 g at the end of 4 sample intervals in a row: a bed the gas "
+         "no longer moves), 0 where it moves or was dropped",
          sample_r},
         {"/samples/com", "d_p",
          "each realization's mass-weighted centre-of-mass height (the travelling-wave phase "

@@ -118,6 +118,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     ss.parameter = s.steady.parameter;
     ss.lift_members = s.lift_members && s.is_cpi();
     ss.hold_at_rest = s.hold_at_rest && s.is_cpi();  // a steady solve lifts every realization
+    ss.pause_at_rest = s.pause_at_rest && !s.is_steady();
     // The run's start (progress counts from there; on the non-root ranks it is not used).
     const double t0 =
         resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();

@@ -220,6 +220,9 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
             "follow "
             "its donor's trajectory (the DEM is deterministic) and correlate the ensemble",
             "abort or drop in direct mode; abort, drop or replace in cpi mode");
+    // A realization at rest stays so (nothing in the DEM moves a bed the gas no longer lifts):
+    // advancing it computes nothing but floating-point drift of ~1e-13 d_p per sample.
+    s.pause_at_rest = ensemble.get_or_choice("at_rest", "pause", {"pause", "simulate"}) == "pause";
     s.on_failure.max_failures = ensemble.get_or<long>("max_failures", -1, Bounds::closed(-1, 1e9));
     if (s.on_failure.action == FailurePolicy::Action::abort && ensemble.contains("max_failures"))
         ensemble.fail("max_failures", "is read only with ensemble.on_failure = drop or replace",

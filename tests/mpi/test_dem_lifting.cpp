@@ -115,9 +115,10 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
 
 TEST_CASE("a DEM realization at rest is held by a lift (cpi.at_rest = hold); the others are lifted",
           "[mpi][lifting]") {
-    // Realization 2's particles are at rest (speeds below DemRealization::kRestSpeed; a spin about
-    // any axis does not count), the others move. A lift with hold leaves its labels exactly as they
-    // were and lifts the other three, whose mean target then carries realization 2's share.
+    // Realization 2's particles are at rest (speeds below DemRealization::kRestSpeed, no force, for
+    // kRestSamples sample intervals; a spin about any axis does not count), the others move. A lift
+    // with hold leaves its labels exactly as they were and lifts the other three, whose mean target
+    // then carries realization 2's share.
     const MpiComm world(MPI_COMM_WORLD);
     REQUIRE(4 % world.size() == 0);
     const EnsembleLayout layout(world, 4 / world.size());
@@ -131,10 +132,23 @@ TEST_CASE("a DEM realization at rest is held by a lift (cpi.at_rest = hold); the
             for (auto& v : p.v()) v = Vec3{0.0, 0.0, 0.0};
             for (auto& w : p.omega()) w = Vec3{0.0, 0.0, 0.03};  // spins survive a bed at rest
             p.v()[7] = Vec3{0.0, 0.0, 0.9 * DemRealization::kRestSpeed};
-            CHECK(r->at_rest());
+            CHECK(r->still());
             p.v()[7] = Vec3{0.0, 0.0, 1.1 * DemRealization::kRestSpeed};
-            CHECK(!r->at_rest());  // one particle above the threshold: moving
+            CHECK(!r->still());  // one particle above the threshold: moving
             p.v()[7] = Vec3{0.0, 0.0, 0.0};
+            // Still, but not in balance (e.g. a settled bed when the gas comes on): not still.
+            p.force()[3] = Vec3{0.0, 0.0, 1.1 * DemRealization::kRestAcceleration * p.mass()[3]};
+            CHECK(!r->still());
+            p.force()[3] = Vec3{0.0, 0.0, 0.9 * DemRealization::kRestAcceleration * p.mass()[3]};
+            CHECK(r->still());
+            p.force()[3] = Vec3{0.0, 0.0, 0.0};
+            // At rest once still at the end of kRestSamples sample intervals in a row (this
+            // column has no effects: a bed without speed or force stays so).
+            for (long k = 0; k < DemRealization::kRestSamples; ++k) {
+                CHECK(!r->at_rest());
+                r->advance(1);
+            }
+            CHECK(r->still_samples() == DemRealization::kRestSamples);
         }
         CHECK(r->at_rest() == (index == 2));
         dem.push_back(r.get());

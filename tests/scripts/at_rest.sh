@@ -2,16 +2,23 @@
 # Realizations at rest (issue 34): the tiny bed without gas settles from its lattice start and comes
 # to rest (every particle slower than 1e-6 sqrt(g d_p)) after ~26-30 time units (measured
 # 2026-12-04; /samples/at_rest). Asserted on real DEM ensembles of 2 realizations on 2 ranks:
-#  1. direct: a realization at rest stays at rest (an absorbing state of the DEM, the premise of
-#     cpi.at_rest = hold and cpi.finish = steady): once at_rest is 1 it stays 1, and its light ICDF
-#     moves by less than 1e-6 d_p for good (measured: 2e-10 and 1e-12; a settling bed moves by
-#     > 1e-4 per sample, a fluidized one by ~1e-2);
-#  2. cpi with cpi.finish = steady and run.duration = 200: the run ends at the end state, long
+#  1. direct, every realization advanced (ensemble.at_rest = simulate): a realization at rest
+#     stays at rest (an absorbing state of the DEM, the premise of cpi.at_rest = hold,
+#     cpi.finish = steady and ensemble.at_rest = pause): once at_rest is 1 it stays 1, and its
+#     light ICDF moves by less than 1e-6 d_p for good (measured: 2e-10 and 1e-12; a settling bed
+#     moves by > 1e-4 per sample, a fluidized one by ~1e-2);
+#  2. ensemble.at_rest = pause (the default) against simulate, direct: the ICDFs agree to 1e-6 d_p
+#     (a paused bed is one at rest left alone; measured 1.7e-10) and the paused run counts fewer
+#     particle-steps, by exactly the realization-samples at rest but the last sample's (a
+#     realization is paused from the sample that finds it at rest; measured 99 of 320);
+#  3. cpi with cpi.finish = steady and run.duration = 200: the run ends at the end state, long
 #     before 200 (status "completed (end state at t = ...)"), every realization at rest at the last
 #     sample, and the time named is where the last unbroken run of samples with both at rest
 #     began (a lift relabels a realization that still moves, and the bed's vibration can pass
-#     below the threshold and above it again while it decays: measured 55.25 first, 59.0 for good);
-#  3. the lifts on the way held the realizations at rest (/cpi/lift_at_rest) and left their
+#     below the threshold and above it again while it decays);
+#  5. a restart with paused realizations continues the run bit for bit (their still count is in
+#     the checkpoint, /realizations/still_samples), on another layout;
+#  4. the lifts on the way held the realizations at rest (/cpi/lift_at_rest) and left their
 #     labels: their ICDF moved by less than 1e-6 d_p across those lifts (a relabelling moves it by
 #     about a light particle's spacing, ~1e-2 d_p; a bed slower than 1e-6 sqrt(g d_p) moves less
 #     than 1e-6 in a sample interval).
@@ -19,8 +26,23 @@
 source "$(dirname "$0")/lib.sh" "$@"
 common=(ensemble.realizations_per_rank=1 gas_drag.superficial_velocity=0.0)
 timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=40 \
-  "${common[@]}" output.directory="$work" output.prefix=direct > "$work/direct.log" 2>&1 \
-  || { cat "$work/direct.log"; echo "FAIL: the direct run failed"; exit 1; }
+  "${common[@]}" output.directory="$work" output.prefix=direct checkpoint.interval=40 checkpoint.keep=10 \
+  > "$work/direct.log" 2>&1 || { cat "$work/direct.log"; echo "FAIL: the direct run failed"; exit 1; }
+# 5. A restart from t = 30, where both realizations have been still for a while (paused, their count
+#    in the checkpoint), on another layout (1 rank x 2), continues the paused run bit for bit.
+ckpt="$work/direct_ckpt_00000120.h5"
+/usr/bin/python3 -c "import h5py, sys; s = h5py.File(sys.argv[1], 'r')['/realizations/still_samples'][:]
+sys.exit(0 if (s >= 4).any() else f'FAIL: no realization at rest in the checkpoint: {s.ravel()}')" "$ckpt" || exit 1
+timeout 300 "$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=40 \
+  ensemble.realizations_per_rank=2 gas_drag.superficial_velocity=0.0 output.directory="$work" \
+  output.prefix=restarted restart="$ckpt" > "$work/restarted.log" 2>&1 \
+  || { cat "$work/restarted.log"; echo "FAIL: the restart failed"; exit 1; }
+/usr/bin/python3 "$here/compare_runs.py" "$work/direct.h5" "$work/restarted.h5" || { echo "FAIL: the restart differs"; exit 1; }
+cmp -s "$work/direct_mean_icdf.csv" "$work/restarted_mean_icdf.csv" || { echo "FAIL: its CSV differs"; exit 1; }
+echo "PASS: a restart with paused realizations continues the run bit for bit"
+timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=40 \
+  "${common[@]}" ensemble.at_rest=simulate output.directory="$work" output.prefix=simulated \
+  > "$work/simulated.log" 2>&1 || { cat "$work/simulated.log"; echo "FAIL: the simulate run failed"; exit 1; }
 timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi run.duration=200 \
   "${common[@]}" cpi.finish=steady output.directory="$work" output.prefix=cpi > "$work/cpi.log" 2>&1 \
   || { cat "$work/cpi.log"; echo "FAIL: the cpi run failed"; exit 1; }
@@ -31,7 +53,8 @@ import sys
 import h5py
 import numpy as np
 work = sys.argv[1]
-with h5py.File(f"{work}/direct.h5", "r") as f:
+# 1. judged where every realization is advanced (ensemble.at_rest = simulate)
+with h5py.File(f"{work}/simulated.h5", "r") as f:
     t, rest, icdf = f["samples/time"][:], f["samples/at_rest"][:], f["samples/icdf"][:]
 for r in range(rest.shape[1]):
     first = np.nonzero(rest[:, r])[0]
@@ -44,6 +67,23 @@ for r in range(rest.shape[1]):
     if drift > 1e-6:
         sys.exit(f"FAIL: direct realization {r} at rest from t = {t[k]:.2f}: its ICDF moved {drift:.2e} d_p")
     print(f"direct realization {r}: at rest from t = {t[k]:.2f}, ICDF drift since {drift:.1e} d_p")
+icdf_sim, rest_sim = icdf, rest
+with h5py.File(f"{work}/simulated.h5", "r") as f:
+    steps_sim = float(f.attrs["particle_steps"])
+with h5py.File(f"{work}/direct.h5", "r") as f:  # 2. paused (the default)
+    steps_paused = float(f.attrs["particle_steps"])
+    rest, icdf = f["samples/at_rest"][:], f["samples/icdf"][:]
+    per_sample = steps_sim / (len(t) * rest.shape[1])  # particle-steps of one realization-sample
+    interval = float(t[1] - t[0])
+gap = np.abs(icdf_sim - icdf).max()
+# Paused from the sample after the one that found it at rest: every at-rest flag but the last
+# sample's saves one realization-sample.
+saved = int(rest[:-1].sum())
+if gap > 1e-6 or not np.array_equal(rest, rest_sim) or abs((steps_sim - steps_paused) / per_sample - saved) > 1e-6:
+    sys.exit(f"FAIL: pause vs simulate: ICDFs {gap:.2e} d_p apart, at rest alike {np.array_equal(rest, rest_sim)}, "
+             f"particle-steps saved {(steps_sim - steps_paused) / per_sample:.3f} realization-samples, expected {saved}")
+print(f"pause vs simulate: ICDFs {gap:.1e} d_p apart; {saved} realization-samples of "
+      f"{rest.size} not computed ({100 * saved / rest.size:.0f} %)")
 with h5py.File(f"{work}/cpi.h5", "r") as f:
     status = f.attrs["end_status"]
     status = status.decode() if isinstance(status, bytes) else str(status)
