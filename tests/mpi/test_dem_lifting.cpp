@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 
 #include "coarse/dem_adapters/realization_observables.hpp"
@@ -37,21 +38,34 @@ dem::System random_column(long realization) {
     o.realization = realization;
     return dem::System(species, dem::Domain{5, 5}, std::move(p), {}, o);
 }
+
+/// This rank's share of the four random columns on MPI_COMM_WORLD (4 / ranks each), each passed
+/// to `prepare` (if any) first.
+struct Columns {
+    explicit Columns(const std::function<void(DemRealization&, long)>& prepare = {}) {
+        for (int j = 0; j < layout.per_rank(); ++j) {
+            const long index = layout.first_index() + j;
+            auto r =
+                std::make_unique<DemRealization>(random_column(index), 0, 1, RealizationOutput{});
+            if (prepare) prepare(*r, index);
+            dem.push_back(r.get());
+            local.push_back(std::move(r));
+        }
+    }
+    MpiComm world{MPI_COMM_WORLD};
+    EnsembleLayout layout{world, 4 / world.size()};
+    std::vector<std::unique_ptr<Realization>> local;
+    std::vector<DemRealization*> dem;
+};
 }  // namespace
 
 TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to the target",
           "[mpi][lifting]") {
-    const MpiComm world(MPI_COMM_WORLD);
-    REQUIRE(4 % world.size() == 0);
-    const EnsembleLayout layout(world, 4 / world.size());
-    std::vector<std::unique_ptr<Realization>> local;
-    std::vector<DemRealization*> dem;
-    for (int j = 0; j < layout.per_rank(); ++j) {
-        auto r = std::make_unique<DemRealization>(random_column(layout.first_index() + j), 0, 1,
-                                                  RealizationOutput{});
-        dem.push_back(r.get());
-        local.push_back(std::move(r));
-    }
+    Columns columns;
+    REQUIRE(4 % columns.world.size() == 0);
+    const MpiComm& world = columns.world;
+    const EnsembleLayout& layout = columns.layout;
+    std::vector<DemRealization*>& dem = columns.dem;
     // Record what lifting must not touch.
     std::vector<std::vector<Vec3>> x_before, v_before;
     for (auto* d : dem) {
@@ -65,7 +79,8 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
     ss.steps_per_sample = 100;
     coarse::IcdfObservable observable(19);
     const ColourLifter lifter;
-    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, nullptr, nullptr);
+    EnsembleStepper stepper(layout, std::move(columns.local), ss, observable, lifter, nullptr,
+                            nullptr);
     const coarse::ProbabilityGrid grid(19);
     Eigen::VectorXd target, before;
     if (world.is_root()) {
@@ -119,41 +134,36 @@ TEST_CASE("a DEM realization at rest is held by a lift (cpi.at_rest = hold); the
     // kRestSamples sample intervals; a spin about any axis does not count), the others move. A lift
     // with hold leaves its labels exactly as they were and lifts the other three, whose mean target
     // then carries realization 2's share.
-    const MpiComm world(MPI_COMM_WORLD);
-    REQUIRE(4 % world.size() == 0);
-    const EnsembleLayout layout(world, 4 / world.size());
-    std::vector<std::unique_ptr<Realization>> local;
-    std::vector<DemRealization*> dem;
-    for (int j = 0; j < layout.per_rank(); ++j) {
-        const long index = layout.first_index() + j;
-        auto r = std::make_unique<DemRealization>(random_column(index), 0, 1, RealizationOutput{});
+    Columns columns([](DemRealization& r, long index) {
         if (index == 2) {
-            auto& p = r->system().particles();
+            auto& p = r.system().particles();
             for (auto& v : p.v()) v = Vec3{0.0, 0.0, 0.0};
             for (auto& w : p.omega()) w = Vec3{0.0, 0.0, 0.03};  // spins survive a bed at rest
             p.v()[7] = Vec3{0.0, 0.0, 0.9 * DemRealization::kRestSpeed};
-            CHECK(r->still());
+            CHECK(r.still());
             p.v()[7] = Vec3{0.0, 0.0, 1.1 * DemRealization::kRestSpeed};
-            CHECK(!r->still());  // one particle above the threshold: moving
+            CHECK(!r.still());  // one particle above the threshold: moving
             p.v()[7] = Vec3{0.0, 0.0, 0.0};
             // Still, but not in balance (e.g. a settled bed when the gas comes on): not still.
             p.force()[3] = Vec3{0.0, 0.0, 1.1 * DemRealization::kRestAcceleration * p.mass()[3]};
-            CHECK(!r->still());
+            CHECK(!r.still());
             p.force()[3] = Vec3{0.0, 0.0, 0.9 * DemRealization::kRestAcceleration * p.mass()[3]};
-            CHECK(r->still());
+            CHECK(r.still());
             p.force()[3] = Vec3{0.0, 0.0, 0.0};
             // At rest once still at the end of kRestSamples sample intervals in a row (this
             // column has no effects: a bed without speed or force stays so).
             for (long k = 0; k < DemRealization::kRestSamples; ++k) {
-                CHECK(!r->at_rest());
-                r->advance(1);
+                CHECK(!r.at_rest());
+                r.advance(1);
             }
-            CHECK(r->still_samples() == DemRealization::kRestSamples);
+            CHECK(r.still_samples() == DemRealization::kRestSamples);
         }
-        CHECK(r->at_rest() == (index == 2));
-        dem.push_back(r.get());
-        local.push_back(std::move(r));
-    }
+        CHECK(r.at_rest() == (index == 2));
+    });
+    REQUIRE(4 % columns.world.size() == 0);
+    const MpiComm& world = columns.world;
+    const EnsembleLayout& layout = columns.layout;
+    std::vector<DemRealization*>& dem = columns.dem;
     std::vector<std::vector<dem::SpeciesId>> labels_before;
     for (auto* d : dem)
         labels_before.emplace_back(d->system().particles().species().begin(),
@@ -164,7 +174,8 @@ TEST_CASE("a DEM realization at rest is held by a lift (cpi.at_rest = hold); the
     ss.hold_at_rest = true;
     coarse::IcdfObservable observable(19);
     const ColourLifter lifter;
-    EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, nullptr, nullptr);
+    EnsembleStepper stepper(layout, std::move(columns.local), ss, observable, lifter, nullptr,
+                            nullptr);
     const coarse::ProbabilityGrid grid(19);
     if (world.is_root()) {
         stepper.lift(3.0 + 16.0 * grid.values().array(), 3.0);  // as in the test above
