@@ -112,8 +112,9 @@ Eigen::VectorXd achieved_light_icdf(std::span<const double> heights,
 
 LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                         std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
-                        RandomStream& rng) {
+                        RandomStream& rng, std::span<const std::uint8_t> moving) {
     EFDEM_EXPECTS(heights.size() == colours.size());
+    EFDEM_EXPECTS(moving.empty() || moving.size() == colours.size());
     EFDEM_EXPECTS(target_icdf.size() == grid.size());
     EFDEM_EXPECTS(std::all_of(colours.begin(), colours.end(),
                               [](std::uint8_t c) { return c == kLight || c == kHeavy; }));
@@ -180,13 +181,21 @@ LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const doub
             candidates[k].reserve(static_cast<std::size_t>(
                 excess[k] > 0 ? light_now[k] : population[k] - light_now[k]));
     }
+    // With `moving`, an interval's moving candidates are drawn first, the still ones only for
+    // what is left: the same counts, labels changed where the bed moves.
+    std::vector<std::vector<std::size_t>> still(moving.empty() ? 0 : n_intervals);
     for (std::size_t j = 0; j < heights.size(); ++j) {
         const Count e = excess[interval[j]];
-        if (e != 0 && (colours[j] == kLight) == (e > 0)) candidates[interval[j]].push_back(j);
+        if (e == 0 || (colours[j] == kLight) != (e > 0)) continue;
+        (moving.empty() || moving[j] ? candidates : still)[interval[j]].push_back(j);
     }
     for (std::size_t k = 0; k < n_intervals; ++k) {
         if (excess[k] == 0) continue;
-        switch_random(candidates[k], std::abs(excess[k]), result.colours, rng);
+        const Count first =
+            std::min<Count>(std::abs(excess[k]), static_cast<Count>(candidates[k].size()));
+        switch_random(candidates[k], first, result.colours, rng);
+        if (first < std::abs(excess[k]))
+            switch_random(still[k], std::abs(excess[k]) - first, result.colours, rng);
         result.n_changed += static_cast<std::size_t>(std::abs(excess[k]));
     }
 

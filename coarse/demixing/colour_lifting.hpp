@@ -87,11 +87,17 @@ struct LiftResult {
  * bursts of 2-3e5 time steps per realization. Wall time doubled on a loaded shared core.
  * Reproduce: efdem_unit_tests "[.benchmark]".
  *
+ * `moving` (optional, one flag per particle): step 3 draws an interval's switches from its
+ * moving particles first and from the still ones only for what is left, so that a bed whose
+ * lower part has come to rest is relabelled where it moves (cpi.relabel = moving): the same
+ * interval counts, so the same n_changed and the same guarantees; only which particles switch
+ * differs. Empty: every candidate alike (the default, as before the option).
+ *
  * \pre heights.size() == colours.size(); colours in {kHeavy, kLight};
- *      target_icdf.size() == grid.size().
+ *      target_icdf.size() == grid.size(); moving empty or of colours' size.
  */
 LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                         std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
-                        RandomStream& rng);
+                        RandomStream& rng, std::span<const std::uint8_t> moving = {});
 
 }  // namespace efdem::coarse

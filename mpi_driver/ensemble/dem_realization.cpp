@@ -45,8 +45,13 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid, bool to
 }
 
 LiftPayload DemRealization::lift_input() const {
-    auto hc = coarse::heights_and_colours(system_.particles(), observed_);
-    return {std::move(hc.heights), std::move(hc.colours)};
+    const dem::Particles& p = system_.particles();
+    auto hc = coarse::heights_and_colours(p, observed_);
+    // Then one flag per particle: moving (ColourLifter relabels those first, cpi.relabel).
+    std::vector<std::uint8_t> bytes = std::move(hc.colours);
+    bytes.reserve(2 * p.size());
+    for (const auto& v : p.v()) bytes.push_back(norm2(v) > kMovingSpeed * kMovingSpeed ? 1 : 0);
+    return {std::move(hc.heights), std::move(bytes)};
 }
 
 std::pair<std::size_t, std::size_t> DemRealization::lift_output_sizes() const {
@@ -165,7 +170,14 @@ void DemRealization::restore_state(const RealizationState& s) {
 
 LiftOutcome ColourLifter::lift(const Eigen::VectorXd& target, const LiftPayload& input,
                                const coarse::ProbabilityGrid& grid, RandomStream& rng) const {
-    coarse::LiftResult r = coarse::lift_colours(target, input.reals, input.bytes, grid, rng);
+    // input.bytes: the colours, then the moving flags (DemRealization::lift_input).
+    const std::span<const std::uint8_t> bytes(input.bytes);
+    const std::size_t n = input.reals.size();
+    EFDEM_EXPECTS(bytes.size() == n || bytes.size() == 2 * n);
+    const auto moving = prefer_moving_ && bytes.size() == 2 * n ? bytes.subspan(n)
+                                                                : std::span<const std::uint8_t>{};
+    coarse::LiftResult r =
+        coarse::lift_colours(target, input.reals, bytes.first(n), grid, rng, moving);
     LiftOutcome out;
     out.changed = static_cast<long>(r.n_changed);
     out.max_deviation = r.max_deviation;

@@ -123,7 +123,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     const double t0 =
         resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
-    const ColourLifter lifter;
+    const ColourLifter lifter(s.relabel_moving && s.is_cpi());
     // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).
     EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter,
                             recorders.get(), mpi.is_root() && !s.is_steady() ? &progress : nullptr);

@@ -91,6 +91,9 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                      s.observable + " cannot restrict a realization on its own",
                  "lift, or hold with cpi.observable = icdf");
     s.hold_at_rest = at_rest == "hold";
+    // Where a bed has partly come to rest, a relabelling there kicks it back into motion
+    // (bench/lift_restart.py): moving relabels the moving particles of each height interval first.
+    s.relabel_moving = cpi.get_or_choice("relabel", "any", {"any", "moving"}) == "moving";
     // own: each realization jumps with its own slope (the multistep integrator measures them).
     s.cpi.multistep.lift_apart = lift == "own";
     // cpi.accuracy measures the ensemble's noise from every burst whose members a lift kept apart.

@@ -100,6 +100,9 @@ struct RunSettings {
     /// cpi.at_rest = hold (default where the observable restricts members): a lift leaves the
     /// realizations at rest where they are; lift: every realization is lifted.
     bool hold_at_rest = false;
+    /// cpi.relabel = moving: the colour lift relabels each height interval's moving particles
+    /// first (ColourLifter); any (default): every candidate alike.
+    bool relabel_moving = false;
     /// ensemble.at_rest = pause (default): a realization at rest is not advanced, only its clock
     /// (direct and cpi runs); simulate: it is advanced like the others.
     bool pause_at_rest = true;

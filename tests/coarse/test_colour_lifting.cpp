@@ -122,6 +122,60 @@ TEST_CASE("lifting to a realizable target: counts, minimality, §9 step 5", "[un
     }
 }
 
+TEST_CASE("with moving flags, an interval relabels its moving particles first (cpi.relabel)",
+          "[unit][coarse]") {
+    // The lower half of the bed is still (a bed that has partly come to rest), the upper half
+    // moves. The same target with and without the flags: the same interval counts, so the same
+    // number of labels changed and the same species count; with the flags, every interval that
+    // has enough moving candidates changes only moving particles, and a still particle changes
+    // only in an interval whose moving candidates ran out.
+    efdem::RandomStream rng(32, 0, "test-lifting");
+    for (int trial = 0; trial < 20; ++trial) {
+        const Bed bed = random_bed(rng, 2000, 0.5);
+        const Labels s = demixed_labels(rng, bed, 0.5);
+        const Eigen::VectorXd target = quantiles(light_heights(bed, s), kGrid);
+        Labels moving(bed.z.size());
+        for (std::size_t j = 0; j < bed.z.size(); ++j)
+            moving[j] = bed.z[j] > 25.0 || rng.uniform() < 0.2 ? 1 : 0;
+        efdem::RandomStream a(33, trial, "lifting"), b(33, trial, "lifting");
+        const LiftResult any = lift_colours(target, bed.z, bed.colour, kGrid, a);
+        const LiftResult pref = lift_colours(target, bed.z, bed.colour, kGrid, b, moving);
+        INFO("trial " << trial);
+        REQUIRE(pref.status == any.status);
+        CHECK(pref.n_changed == any.n_changed);
+        CHECK(std::count(pref.colours.begin(), pref.colours.end(), kLight) == bed.n_light());
+        CHECK(interval_light_counts(bed, pref.colours, pref.target) ==
+              interval_light_counts(bed, any.colours, any.target));
+        // Per interval: the switched particles, and the moving candidates it had.
+        const Eigen::VectorXd& cuts = pref.target;
+        const std::size_t intervals = static_cast<std::size_t>(cuts.size()) + 1;
+        std::vector<long> switched_still(intervals, 0), switched(intervals, 0),
+            moving_candidates(intervals, 0);
+        const auto before = interval_light_counts(bed, bed.colour, cuts);
+        const auto after = interval_light_counts(bed, pref.colours, cuts);
+        long still_changed_any = 0, still_changed_pref = 0;
+        for (std::size_t j = 0; j < bed.z.size(); ++j) {
+            const auto k = static_cast<std::size_t>(
+                std::upper_bound(cuts.data(), cuts.data() + cuts.size(), bed.z[j]) - cuts.data());
+            const bool too_many_light = before[k] > after[k];
+            const bool candidate =
+                (bed.colour[j] == kLight) == too_many_light && before[k] != after[k];
+            if (candidate && moving[j]) ++moving_candidates[k];
+            if (pref.colours[j] != bed.colour[j]) {
+                ++switched[k];
+                if (!moving[j]) ++switched_still[k];
+            }
+            if (!moving[j]) {
+                still_changed_any += any.colours[j] != bed.colour[j];
+                still_changed_pref += pref.colours[j] != bed.colour[j];
+            }
+        }
+        for (std::size_t k = 0; k < intervals; ++k)
+            CHECK(switched_still[k] == std::max(0L, switched[k] - moving_candidates[k]));
+        CHECK(still_changed_pref <= still_changed_any);
+    }
+}
+
 TEST_CASE("a target equal to the current ICDF changes no label", "[unit][coarse]") {
     efdem::RandomStream rng(32, 0, "test-lifting");
     for (std::size_t n : {10u, 31u, 100u, 1000u, 10000u, 100000u}) {
