@@ -52,6 +52,8 @@ SLOW = {
     # members_hold, relabelling where the beds move (no realization came to rest under CPI with
     # every candidate alike: the lifts kick beds that are about to stop, bench/lift_restart.py)
     "members_moving": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving"},
+    # the same with another seed: one draw does not set a default
+    "members_moving_s505": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "seed": 505},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own)
 CASES = {
