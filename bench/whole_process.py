@@ -10,12 +10,14 @@ there; an interrupted run continues from its newest checkpoint.
     /usr/bin/python3 bench/whole_process.py --analyse-only
 
 Each case has three direct ensembles with their own seeds (101, 202, 303: the noise floor from three
-pairs) and the CPI runs of its CPI list (seed 404, paired with each other). "Stopped demixing" is
-judged per realization as in bench/stop_times.py: a realization whose light-particle ICDF never
-moves again by more than 1e-6 d_p (a bed at rest moves by 1e-13).
+pairs) and the CPI runs of its CPI list (seed 404 unless a run says otherwise, paired with each
+other). "Stopped demixing": from a run's /samples/at_rest where it has it (every particle still at
+the end of 4 sample intervals in a row), else as in bench/stop_times.py (the light ICDF never moves
+again by more than 1e-6 d_p). Until a case's own direct runs are there, the shorter runs of the
+same seeds from an earlier study (EARLIER) stand in, and the comparison covers their span.
 
-Cost (AMD EPYC, 2 shared cores, R = 4): a demo-bed direct run of 1,000 units ~50 min; a tall-bed
-direct run of 600 units ~2 h.
+Cost (AMD EPYC, 2 shared cores, R = 4): a demo-bed direct run of 1,000 units ~50 min, a CPI run
+13-50 min (the load varies); a tall-bed direct run of 600 units ~2 h.
 """
 import argparse
 import json
