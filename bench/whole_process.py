@@ -219,6 +219,20 @@ def analyse_case(args, case):
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
                      + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-") + " |")
     lines.append("")
+    # While some directs are short, the state at the end of the run against those that got there.
+    full = [d for d in directs if float(d["t"][-1]) >= duration - 1e-6]
+    if span < duration - 1e-6 and full:
+        med = np.concatenate([state_at(d, duration) for d in full])
+        f_mean, f_se = float(med.mean()), float(med.std(ddof=1) / math.sqrt(len(med)))
+        out = []
+        for name in cpi:
+            if name in runs and float(runs[name]["t"][-1]) >= duration - 1e-6 or (
+                    name in runs and runs[name]["end_state"]):
+                c = state_at(runs[name], duration)
+                c_mean, c_se = float(c.mean()), float(c.std(ddof=1) / math.sqrt(len(c)))
+                out.append(f"{name} {c_mean:.2f} +- {c_se:.2f} ({(c_mean - f_mean) / math.hypot(f_se, c_se):+.1f} s.e.)")
+        lines.append(f"At t = {duration:g}, against the {len(full)} direct ensemble(s) that got there ({len(med)} "
+                     f"realizations, median light height {f_mean:.2f} +- {f_se:.2f} d_p): " + "; ".join(out) + ".\n")
     plot(folder, case, t, directs, {n: runs[n] for n in cpi if n in runs})
     return summary, lines
 
