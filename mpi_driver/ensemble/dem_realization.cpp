@@ -173,11 +173,10 @@ LiftOutcome ColourLifter::lift(const Eigen::VectorXd& target, const LiftPayload&
     // input.bytes: the colours, then the moving flags (DemRealization::lift_input).
     const std::span<const std::uint8_t> bytes(input.bytes);
     const std::size_t n = input.reals.size();
-    EFDEM_EXPECTS(bytes.size() == n || bytes.size() == 2 * n);
-    const auto moving = prefer_moving_ && bytes.size() == 2 * n ? bytes.subspan(n)
-                                                                : std::span<const std::uint8_t>{};
+    EFDEM_EXPECTS(bytes.size() == 2 * n);
     coarse::LiftResult r =
-        coarse::lift_colours(target, input.reals, bytes.first(n), grid, rng, moving);
+        coarse::lift_colours(target, input.reals, bytes.first(n), grid, rng,
+                             prefer_moving_ ? bytes.subspan(n) : std::span<const std::uint8_t>{});
     LiftOutcome out;
     out.changed = static_cast<long>(r.n_changed);
     out.max_deviation = r.max_deviation;

@@ -46,20 +46,21 @@ Eigen::MatrixXd centred_steps(const Eigen::MatrixXd* steps, const std::vector<ch
     if (!steps || steps->rows() != n || steps->cols() != m) return {};
     Eigen::MatrixXd out = *steps;
     Eigen::VectorXd sum = Eigen::VectorXd::Zero(m);
+    std::vector<char> kept(static_cast<std::size_t>(n), 0);
     long finite = 0;
     for (Eigen::Index k = 0; k < n; ++k) {
         if (!moving[static_cast<std::size_t>(k)] || !out.row(k).allFinite()) {
             out.row(k).setZero();
             continue;
         }
+        kept[static_cast<std::size_t>(k)] = 1;
         sum += out.row(k).transpose();
         ++finite;
     }
     if (finite == 0) return {};
     const Eigen::VectorXd mean = sum / static_cast<double>(finite);
     for (Eigen::Index k = 0; k < n; ++k)
-        if (moving[static_cast<std::size_t>(k)] && steps->row(k).allFinite())
-            out.row(k) -= mean.transpose();
+        if (kept[static_cast<std::size_t>(k)]) out.row(k) -= mean.transpose();
     return out;
 }
 
@@ -88,11 +89,9 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
     std::vector<std::vector<std::uint8_t>> bytes, rest_flag;
     std::vector<Eigen::VectorXd> top_icdf, own_icdf;
     std::vector<std::size_t> out_reals, out_bytes;
-    std::vector<char> held_here;  // per local realization
     for (const auto& r : local) {
         const bool lifted = lifted_here(r->index());
         const bool held = lifted && hold && r->at_rest();
-        held_here.push_back(held ? 1 : 0);
         rest_flag.push_back({static_cast<std::uint8_t>(held ? 1 : 0)});
         if (!lifted) {
             // Dropped, or not among `only`: nothing sent, nothing changed.
@@ -213,7 +212,7 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
     const auto my_bytes = layout_.scatter_arrays(lifted_bytes, out_bytes);
     for (std::size_t j = 0; j < local.size(); ++j) {
         if (lifted_here(local[j]->index())) {
-            if (!held_here[j]) local[j]->apply_lift({my_reals[j], my_bytes[j]});
+            if (rest_flag[j][0] == 0) local[j]->apply_lift({my_reals[j], my_bytes[j]});
             local[j]->set_time(request.new_time);
         } else if (!only) {
             // A dropped realization's clock follows the jump too: a rank whose realizations were

@@ -72,7 +72,8 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.cpi = coarse::CpiSettings::from_params(cpi, s.observe.interval, s.is_cpi());
     const std::string lift = cpi.get_or_choice("lift", "mean", {"mean", "members", "own"});
     s.lift_members = lift != "mean";
-    if (s.lift_members && s.is_cpi() && !restricts_members(s.observable, s.observe.quantiles))
+    const bool own_states = restricts_members(s.observable, s.observe.quantiles);
+    if (s.lift_members && s.is_cpi() && !own_states)
         cpi.fail("lift",
                  "= " + lift +
                      " moves each realization from its own coarse state, and cpi.observable = " +
@@ -81,7 +82,6 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // A realization the gas no longer moves is in a state the DEM never leaves (U_s = 0.19: the
     // heavy spheres gather at the bottom and the bed defluidizes); a lift would move it on with
     // the others. hold leaves it where it is (EnsembleLifting), which needs its own coarse state.
-    const bool own_states = restricts_members(s.observable, s.observe.quantiles);
     const std::string at_rest =
         cpi.get_or_choice("at_rest", own_states ? "hold" : "lift", {"hold", "lift"});
     if (at_rest == "hold" && s.is_cpi() && !own_states)
