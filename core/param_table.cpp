@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "core/file_kind.hpp"
 #include "core/param_value.hpp"
 #include "core/scene_lexer.hpp"
 
@@ -56,10 +57,18 @@ ParamTable ParamTable::from_text(std::string_view text, std::string file,
 }
 
 std::string ParamTable::read_text_file(const std::filesystem::path& path) {
+    // Regular files only: a FIFO would block until someone writes to it, a device such as
+    // /dev/zero would be read until memory runs out.
+    if (const std::string what = not_a_regular_file(path); !what.empty())
+        throw InputError({path.string(), 0},
+                         what == "file not found" ? what : what + "; a scene is a regular file");
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0}, "file not found");
-    if (std::filesystem::is_directory(path, ec))
-        throw InputError({path.string(), 0}, "is a directory, not a file");
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec && size > kMaxSceneBytes)
+        throw InputError({path.string(), 0},
+                         fmt::format("is {} bytes long; a scene is a text file of at most {} "
+                                     "bytes (particle data are read from the files it names)",
+                                     size, kMaxSceneBytes));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError({path.string(), 0}, "cannot be opened for reading");
     std::ostringstream ss;

@@ -70,8 +70,12 @@ class ParamTable {
                                 std::filesystem::path base_dir = {});
     /// Reads and parses a file (InputError if it cannot be read).
     static ParamTable from_file(const std::filesystem::path& path);
-    /// Reads a whole file into a string; InputError naming the file if it cannot be read.
+    /// Reads a whole file into a string; InputError naming the file if it cannot be read, is
+    /// not a regular file (saying what it is) or is longer than kMaxSceneBytes.
     static std::string read_text_file(const std::filesystem::path& path);
+    /// A scene is a few kB of text; 16 MiB leaves room for any hand-made one and stops a
+    /// mistaken data file before it fills memory.
+    static constexpr std::uintmax_t kMaxSceneBytes = 16u << 20;
 
     /// Applies a command-line override "key=value"; it replaces any definition in the file.
     void add_override(std::string_view assignment);

@@ -90,6 +90,12 @@ class Effect {
     virtual double time_scale() const { return std::numeric_limits<double>::infinity(); }
     /// Which pair type sets time_scale() ("light-wall"), for messages.
     virtual std::string time_scale_label() const { return {}; }
+    /// Shortest relaxation time of a velocity-dependent force (drag), which an explicit step
+    /// must resolve, or +inf; relaxation_label() says what sets it, relaxation_remedy() which
+    /// key would lengthen it, for messages.
+    virtual double relaxation_time() const { return std::numeric_limits<double>::infinity(); }
+    virtual std::string relaxation_label() const { return {}; }
+    virtual std::string relaxation_remedy(double) const { return {}; }
     /// Potential energy stored by this effect (elastic contacts, gravity) [rho_s g d_p^4].
     virtual double potential_energy(const ForceContext&) const { return 0.0; }
     virtual void add_thermo(const ForceContext&, ThermoStats&) const {}

@@ -32,7 +32,9 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     const RunParameter& u_s = GasDrag::run_parameters().front();
     s.superficial_velocity = p.get<double>(std::string(u_s.key), u_s.bounds);
     s.phi_cap = p.get_or<double>("phi_cap", 0.70, Bounds::open(0.0, 1.0));
-    s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::at_least(0.1));
+    // Thicker than 10 d_p a slab averages over a large part of any bed (the demo bed is 15.5 d_p
+    // tall, the paper's 48) and the drag no longer sees its solid-fraction profile.
+    s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::closed(0.1, 10.0));
 
     static const char* const kPhysical[] = {"gas_viscosity", "particle_density",
                                             "particle_diameter", "gravity"};
@@ -71,7 +73,29 @@ GasDragSpec checked_spec(const EffectSetup& s) {
                 "is not 1 for every species, but gas_drag's drag law (Eq. 2) is "
                 "written for one particle size, the unit length d_p",
                 "1 for every species when gas_drag is listed in effects");
-    return GasDragSpec::from_params(s.scope);
+    GasDragSpec spec = GasDragSpec::from_params(s.scope);
+    // Above the terminal velocity of an isolated sphere of the heaviest species (rho / A,
+    // physics.md §3.3) the gas carries every particle to the lid: no bed is left to fluidize.
+    double rho_max = 0;
+    for (std::size_t k = 0; k < s.species.size(); ++k)
+        rho_max = std::max(rho_max, s.species[static_cast<SpeciesId>(k)].density);
+    const double terminal = rho_max / spec.A;
+    if (spec.superficial_velocity > terminal)
+        s.scope.fail("superficial_velocity",
+                     fmt::format("exceeds the terminal velocity rho/A = {:.4g} of an isolated "
+                                 "sphere of the heaviest species (A = {:.6g}): the gas would carry "
+                                 "every particle to the lid",
+                                 terminal, spec.A),
+                     fmt::format("[0, {:.4g}]", terminal));
+    // The 1D gas averages phi over horizontal slabs: at least two must fit below the lid.
+    if (s.domain.has_lid() && spec.slab_thickness > 0.5 * s.domain.lid_height)
+        s.scope.fail("slab_thickness",
+                     fmt::format("leaves fewer than two slabs below the lid at domain.lid = {:g}: "
+                                 "the 1D gas would see no solid-fraction profile",
+                                 s.domain.lid_height),
+                     fmt::format("[0.1, {:g}] (half of domain.lid; 1, one diameter, is usual)",
+                                 0.5 * s.domain.lid_height));
+    return spec;
 }
 
 /// The per-slab terms of Eq. (1), written once: the drag per unit volume c = A r(phi_c) and
@@ -109,6 +133,22 @@ GasDrag::GasDrag(const GasDragSpec& spec, const SpeciesTable& species) : spec_(s
         density_.push_back(species[static_cast<SpeciesId>(k)].density);
         species_names_.push_back(species[static_cast<SpeciesId>(k)].name);
     }
+}
+
+double GasDrag::relaxation_time() const {
+    const double rho_min = *std::min_element(density_.begin(), density_.end());
+    return rho_min * std::pow(1.0 - spec_.phi_cap, 2.65) / spec_.A;
+}
+
+std::string GasDrag::relaxation_label() const {
+    return fmt::format(
+        "drag relaxation time tau = rho (1 - phi_cap)^2.65 / A = {:.4g} of the lightest species "
+        "(gas_drag.A = {:g}, gas_drag.phi_cap = {:g})",
+        relaxation_time(), spec_.A, spec_.phi_cap);
+}
+
+std::string GasDrag::relaxation_remedy(double dt) const {
+    return fmt::format("gas_drag.A <= {:.4g}", spec_.A * relaxation_time() / dt);
 }
 
 Needs GasDrag::needs() const {

@@ -77,6 +77,12 @@ class GasDrag final : public Effect {
     Needs needs() const override;
     void add_forces(ForceContext& ctx) override;
     void describe(EffectReport& r) const override;
+    /// tau = rho_min (1 - phi_cap)^2.65 / A: the drag relaxation time of the lightest species
+    /// at the densest packing the law sees (physics.md §3.3), the shortest the drag imposes.
+    double relaxation_time() const override;
+    std::string relaxation_label() const override;
+    /// "gas_drag.A <= x": the A at which tau equals dt.
+    std::string relaxation_remedy(double dt) const override;
 
     const GasDragSpec& spec() const { return spec_; }
     /// The keys a run may change between steps (the registry row lists them): U_s, read by the

@@ -121,6 +121,42 @@ TEST_CASE("gas_drag's other inputs are checked", "[unit][gas]") {
         auto t = test::scene_table(std::string(kScene) + "gas_drag.phi_cap = 1\n");
         CHECK(input_error([&] { build(t); }).key() == "gas_drag.phi_cap");
     }
+    SECTION("U_s at most the terminal velocity of the heaviest species, rho_max / A") {
+        // A = 0.114939, rho_max = 2: 17.40 (physics.md §3.3); 17.5 blows every sphere to the lid.
+        auto ok = test::scene_table(std::string(kScene));
+        ok.add_override("gas_drag.superficial_velocity=17.4");
+        CHECK_NOTHROW(build(ok));
+        auto t = test::scene_table(std::string(kScene));
+        t.add_override("gas_drag.superficial_velocity=17.5");
+        const auto e = input_error([&] { build(t); });
+        CHECK(e.key() == "gas_drag.superficial_velocity");
+        CHECK_THAT(e.problem(), Catch::Contains("terminal velocity rho/A = 17.4"));
+        CHECK_THAT(e.allowed(), Catch::Contains("[0, 17.4"));
+    }
+    SECTION("slabs from 0.1 to 10 d_p, two of them below the lid") {
+        auto t = test::scene_table(std::string(kScene) + "gas_drag.slab_thickness = 1e300\n");
+        CHECK_THAT(input_error([&] { build(t); }).allowed(), Catch::Contains("[0.1, 10]"));
+        auto lid = test::scene_table(std::string(kScene) +
+                                     "domain.lid = 12\ngas_drag.slab_thickness = 7\n");
+        const auto e = input_error([&] { build(lid); });
+        CHECK(e.key() == "gas_drag.slab_thickness");
+        CHECK_THAT(e.allowed(), Catch::Contains("[0.1, 6]"));
+    }
+    SECTION("dt within the drag relaxation time tau = rho_min (1 - phi_cap)^2.65 / A") {
+        // tau = 0.3^2.65 / A = 0.04115 / A: at dt = 1e-4, A = 411.5 is the limit. Measured on the
+        // tiny test bed: A = 1000 (dt = 2.4 tau) runs, A = 1500 (3.7 tau) leaves the box.
+        // (U_s = 0: at such an A the gas would otherwise blow the bed away, refused first.)
+        auto ok = test::scene_table(std::string(kScene) + "gas_drag.A = 400\n");
+        ok.add_override("gas_drag.superficial_velocity=0");
+        CHECK_NOTHROW(build(ok));
+        auto t = test::scene_table(std::string(kScene) + "gas_drag.A = 3000\n");
+        t.add_override("gas_drag.superficial_velocity=0");
+        const auto e = input_error([&] { build(t); });
+        CHECK(e.key() == "dt");
+        CHECK_THAT(e.problem(), Catch::Contains("drag relaxation time tau"));
+        CHECK_THAT(e.problem(), Catch::Contains("gas_drag.A = 3000"));
+        CHECK_THAT(e.allowed(), Catch::Contains("dt <= 1.372e-05, or gas_drag.A <= 411.5"));
+    }
     SECTION("one particle size") {
         auto t = test::scene_table(std::string(kScene));
         t.add_override("species.diameter=1 1.5");

@@ -150,14 +150,15 @@ TEST_CASE("the registry lists the keys a run may change, with the bounds the sce
     CHECK(find_run_parameter("gas_drag.superficial_velocity").has_value());
     CHECK_FALSE(find_run_parameter("gas_drag.phi_cap").has_value());
     CHECK_FALSE(find_run_parameter("superficial_velocity").has_value());
-    // The same bounds as the scene key: 1000 is accepted, 1000.5 refused with them.
+    // The same bounds as the scene key: 1000 is accepted, 1000.5 refused with them (A = 1e-4
+    // puts the terminal velocity rho/A, the scene's own limit, far above both).
     auto ok = test::scene_table(kBase +
                                 "effects = gravity gas_drag\n"
-                                "gas_drag.A = 0.114939\ngas_drag.superficial_velocity = 1000\n");
+                                "gas_drag.A = 1e-4\ngas_drag.superficial_velocity = 1000\n");
     CHECK_NOTHROW(build(ok));
     auto bad = test::scene_table(kBase +
                                  "effects = gravity gas_drag\n"
-                                 "gas_drag.A = 0.114939\ngas_drag.superficial_velocity = 1000.5\n");
+                                 "gas_drag.A = 1e-4\ngas_drag.superficial_velocity = 1000.5\n");
     const InputError e = input_error([&] { build(bad); });
     CHECK_THAT(e.what(), Catch::Contains("in [0, 1000]"));
 }

@@ -27,7 +27,7 @@ check observe.interval "a multiple of 0.0001" observe.interval=1e-300
 check pair_contact.mu "[0, 10]" pair_contact.mu=1e308
 check pair_contact.restitution "[0.001, 1]" pair_contact.restitution=4.9e-324
 check pair_contact.kn "[1, 1000000000000]" pair_contact.kn=1e300
-check bed.settle.ke_threshold "(0, 1]" bed.settle.ke_threshold=1e20
+check bed.settle.ke_threshold "[1e-12, 1]" bed.settle.ke_threshold=1e20
 check gas_drag.superficial_velocity "[0, 1000]" gas_drag.superficial_velocity=1e9
 check dt "[1e-09, 1)" dt=1e-12
 check cpi.tolerance "(0, 1000000]" mode=cpi cpi.projection=adaptive cpi.tolerance=1e300
@@ -43,6 +43,30 @@ if [ $? -eq 0 ]; then echo "PASS: direct run with dt = 1.8e-4, observe.interval 
 else echo "FAIL: direct run with LAMMPS' dt refused: $out" | tail -1; failures=$((failures + 1)); fi
 # ... a cpi run does, and names a key it reads.
 check cpi.warmup "a multiple of 0.09" mode=cpi dt=1.8e-4 observe.interval=0.09 run.duration=90
+
+# Bounds from physics (each was accepted once, then failed at run time or did nothing useful).
+# The drag's relaxation time tau = rho (1 - phi_cap)^2.65 / A: A = 3000 blew up within 1,000 steps.
+check dt "dt <= 1.372e-05, or gas_drag.A <= 411.5" gas_drag.A=3000 gas_drag.superficial_velocity=0
+check gas_drag.superficial_velocity "[0, 17.4]" gas_drag.superficial_velocity=999
+check gas_drag.slab_thickness "[0.1, 10]" gas_drag.slab_thickness=1e300
+check bed.velocity_rms "[0, 10]" bed.velocity_rms=1e6
+check bed.settle.ke_threshold "[1e-12, 1]" bed.settle.ke_threshold=4.9e-324
+check watchdog.max_overlap "[0.0001, 1]" watchdog.max_overlap=1e-300
+
+# A scene must be a regular text file: a FIFO blocked --check for 630 s, /dev/zero was read
+# until memory ran out. Each is refused at once, saying what the path is.
+mkfifo "$work/scene_fifo.cfg"
+head -c 17000000 /dev/zero | tr '\0' '#' > "$work/huge.cfg"
+for case in "$work/scene_fifo.cfg:is a FIFO (named pipe), not a file" "/dev/zero:is a device, not a file" \
+            "$work:is a directory, not a file" "$work/huge.cfg:is 17000000 bytes long; a scene is a text file of at most 16777216 bytes"; do
+  path=${case%%:*}; what=${case#*:}
+  out=$(timeout 30 "$mpiexec" -n 1 "${launcher[@]}" "$efdem" --check "$path" 2>&1); code=$?
+  if [ $code -eq 2 ] && grep -qF "efdem: error: $path: $what" <<< "$out"; then
+    echo "PASS: scene $path refused: $what"
+  else
+    echo "FAIL: scene $path (exit $code): $out" | cut -c1-400; failures=$((failures + 1))
+  fi
+done
 
 [ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
 echo "PASS: value ranges"
