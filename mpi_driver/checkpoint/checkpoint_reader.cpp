@@ -1,5 +1,6 @@
 #include "mpi_driver/checkpoint/checkpoint_reader.hpp"
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -7,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/file_kind.hpp"
 #include "mpi_driver/output/h5_file.hpp"
 
 namespace efdem::mpi_driver {
@@ -23,9 +25,9 @@ constexpr const char* kPartialWrite =
 /// Runs `body` on the opened file; any HDF5 failure becomes an InputError naming the file.
 template <class T>
 T with_checkpoint(const std::filesystem::path& path, const std::function<T(const H5File&)>& body) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec))
-        refuse(path, "file not found (restart=FILE names no file)");
+    if (const std::string what = not_a_regular_file(path); !what.empty())
+        refuse(path, what == "file not found" ? "file not found (restart=FILE names no file)"
+                                              : what + " (restart=FILE names a checkpoint file)");
     try {
         const H5File f = H5File::open(path, false);
         return body(f);
@@ -132,6 +134,14 @@ std::vector<Vec3> vectors(const std::vector<double>& flat) {
     return out;
 }
 }  // namespace
+
+double read_checkpoint_time(const std::filesystem::path& path) {
+    return with_checkpoint<double>(path, [&](const H5File& f) {
+        const std::vector<double> times = f.read_doubles("/realizations/time");
+        if (times.empty()) refuse(path, "holds no realization");
+        return *std::max_element(times.begin(), times.end());
+    });
+}
 
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
     return with_checkpoint<CheckpointHeader>(path, [&](const H5File& f) {

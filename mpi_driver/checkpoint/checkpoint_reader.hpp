@@ -18,6 +18,10 @@ namespace efdem::mpi_driver {
 /// Root: the validated root-level state (format version, marker, header checksum).
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path);
 
+/// Root: the time the checkpoint's ensemble had reached (the latest realization clock; a
+/// realization dropped after a failure stopped earlier).
+double read_checkpoint_time(const std::filesystem::path& path);
+
 /// Realizations [first, first + count), each verified against its stored checksum.
 std::vector<RealizationState> read_checkpoint_realizations(const std::filesystem::path& path,
                                                            long first, int count);

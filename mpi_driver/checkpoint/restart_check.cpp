@@ -1,5 +1,8 @@
 #include "mpi_driver/checkpoint/restart_check.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -81,9 +84,13 @@ bool may_change_on_restart(const std::string& key) {
            key == "ensemble.at_rest";
 }
 
+bool shapes_the_run_file(const std::string& key) {
+    return key.rfind("observe.", 0) == 0;
+}
+
 std::string check_restart(const std::filesystem::path& path, const CheckpointHeader& h,
                           const std::string& parameters_now, long realizations_now,
-                          bool allow_physics_change) {
+                          bool allow_physics_change, double time_at_checkpoint) {
     const SourceLocation where{path.string(), 0};
     if (h.realizations != realizations_now)
         throw InputError(
@@ -100,6 +107,37 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
                                "{}; a restart continues the run that wrote the checkpoint, in its "
                                "mode (restart with mode = {})",
                                mode_then->second, mode_now->second, mode_then->second));
+    // Not physics either: the run file's grid. Its rows so far were sampled on it.
+    std::vector<std::string> grid;
+    for (const auto& [key, value] : now)
+        if (shapes_the_run_file(key))
+            if (const auto it = then.find(key); it != then.end() && it->second != value)
+                grid.push_back(fmt::format("{} = {} (checkpoint: {})", key, value, it->second));
+    if (!grid.empty()) {
+        std::string list;
+        for (std::size_t k = 0; k < grid.size(); ++k) list += (k ? "; " : "") + grid[k];
+        throw InputError(
+            where, fmt::format("a restart continues the run file, whose samples were made with "
+                               "the checkpoint's observe.* values, and this scene changes them: "
+                               "{}. Restart with the checkpoint's values (not even "
+                               "restart.allow_physics_change changes them)",
+                               list));
+    }
+    const auto duration = now.find("run.duration");
+    if (std::isfinite(time_at_checkpoint) && duration != now.end()) {
+        const double elapsed = time_at_checkpoint - h.driver.t_origin;
+        const double d = std::strtod(duration->second.c_str(), nullptr);
+        if (d <= elapsed + 1e-9 * std::max(1.0, std::abs(d)))
+            throw InputError(
+                where, fmt::format("run.duration = {}, but the run had already simulated {:.6g} "
+                                   "time units at this checkpoint (t = {:.6g}, from t = {:.6g}): "
+                                   "a restart runs on until t = {:.6g} + run.duration, so it would "
+                                   "have nothing to run (and would set the run's files back to "
+                                   "the checkpoint). Give a run.duration longer than {:.6g} to "
+                                   "continue the run",
+                                   duration->second, elapsed, time_at_checkpoint, h.driver.t_origin,
+                                   h.driver.t_origin, elapsed));
+    }
     std::vector<std::string> changes;
     for (const auto& [key, value] : now) {
         if (may_change_on_restart(key) || ignored_in(now, key)) continue;

@@ -51,7 +51,7 @@ Agreement load_restart(const MpiComm& mpi, const std::filesystem::path& path,
         out.header = read_checkpoint_header(path);
         const std::string warning =
             check_restart(path, out.header, parameters, static_cast<long>(mpi.size()) * per_rank,
-                          allow_physics_change);
+                          allow_physics_change, read_checkpoint_time(path));
         if (!warning.empty()) log::warn("{}", warning);
     });
     if (a.exit_code != kExitOk) return a;

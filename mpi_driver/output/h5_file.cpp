@@ -76,6 +76,21 @@ H5File H5File::open(const std::filesystem::path& path, bool writable) {
     return H5File(f, path.string());
 }
 
+H5File H5File::open_image(const std::string& bytes, const std::string& name) {
+    silence_hdf5();
+    const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    hid_t f = -1;
+    // The core driver reads from a copy of the image and never writes it back (backing store 0).
+    if (fapl >= 0 && H5Pset_fapl_core(fapl, 1 << 16, 0) >= 0 &&
+        H5Pset_file_image(fapl, const_cast<char*>(bytes.data()), bytes.size()) >= 0)
+        f = H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl);
+    if (fapl >= 0) H5Pclose(fapl);
+    if (f < 0)
+        throw RuntimeFailure(
+            fmt::format("cannot read {} as an HDF5 file ({} bytes)", name, bytes.size()));
+    return H5File(f, name);
+}
+
 H5File::~H5File() {
     if (file_ >= 0) H5Fclose(file_);
 }

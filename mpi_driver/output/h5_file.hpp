@@ -55,6 +55,9 @@ class H5File {
     static H5File create(const std::filesystem::path& path);
     /// Opens an existing file (serial driver); RuntimeFailure naming the file if it cannot.
     static H5File open(const std::filesystem::path& path, bool writable);
+    /// Opens an HDF5 file held in memory (read only; a checkpoint stores the run file whole),
+    /// `name` standing for it in messages; RuntimeFailure if `bytes` is not an HDF5 file.
+    static H5File open_image(const std::string& bytes, const std::string& name);
     ~H5File();
     H5File(H5File&& other) noexcept;
     H5File& operator=(H5File&&) = delete;

@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/io_error.hpp"
 #include "mpi_driver/output/run_file_schema.hpp"
+#include "mpi_driver/output/run_identity.hpp"
 
 #include <fmt/format.h>
 
@@ -73,6 +74,8 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
     file_.attribute("/", "format_version", kRunFileFormatVersion);
     file_.write_build_provenance();
     file_.attribute("/", "date", now_utc());
+    // Which run this is: a restart writes only into the run its checkpoint came from.
+    file_.attribute("/", "run_id", new_run_id());
     file_.attribute("/", "mode", p.mode);
     file_.attribute("/", "ranks", std::int64_t{p.ranks});
     file_.attribute("/", "realizations", std::int64_t{p.realizations});

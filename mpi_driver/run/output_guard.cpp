@@ -3,12 +3,19 @@
 #include <unistd.h>
 #include <algorithm>
 #include <cctype>
+#include <exception>
+#include <optional>
 #include <system_error>
 
 #include <fmt/format.h>
 
 #include "core/error.hpp"
 #include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
+#if EFDEM_HAVE_HDF5
+#include "mpi_driver/checkpoint/checkpoint_reader.hpp"
+#include "mpi_driver/output/h5_file.hpp"
+#include "mpi_driver/output/run_identity.hpp"
+#endif
 
 namespace efdem::mpi_driver {
 
@@ -86,7 +93,7 @@ std::string unwritable_directory(const std::filesystem::path& directory) {
     return {};
 }
 
-void check_output_is_free(const Params& root, const RunSettings& s, bool restarting) {
+void check_output_is_writable(const Params& root, const RunSettings& s) {
     const Params output = root.scope("output");
     if (const std::string why = unwritable_directory(s.output.directory); !why.empty())
         output.fail("directory", fmt::format("cannot be written to: {}", why),
@@ -96,6 +103,10 @@ void check_output_is_free(const Params& root, const RunSettings& s, bool restart
             root.scope("checkpoint")
                 .fail("directory", fmt::format("cannot be written to: {}", why),
                       "a directory this user can write");
+}
+
+void check_output_is_free(const Params& root, const RunSettings& s, bool restarting) {
+    const Params output = root.scope("output");
     if (restarting || s.output.overwrite) return;
     const auto files = existing_run_files(s);
     if (files.empty()) return;
@@ -108,6 +119,92 @@ void check_output_is_free(const Params& root, const RunSettings& s, bool restart
                 "run's files "
                 "and replace it; or continue it with restart=CHECKPOINT");
 }
+
+#if EFDEM_HAVE_HDF5
+namespace {
+/// The identity of the run whose run file a checkpoint stores (empty optional: it stores none,
+/// or the file cannot be read).
+std::optional<RunIdentity> checkpoint_run(const CheckpointHeader& header,
+                                          const std::filesystem::path& path) {
+    for (const auto& o : header.outputs)
+        if (o.name == ".h5") {
+            try {
+                return read_run_identity(
+                    H5File::open_image(o.bytes, path.string() + " (its copy of the run file)"));
+            } catch (const RuntimeFailure&) {
+                return std::nullopt;
+            }
+        }
+    return std::nullopt;
+}
+
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ec;
+    return std::filesystem::equivalent(a, b, ec);
+}
+}  // namespace
+
+void check_restart_target(const Params& root, const RunSettings& s,
+                          const std::filesystem::path& checkpoint) {
+    CheckpointHeader header;
+    try {
+        header = read_checkpoint_header(checkpoint);
+    } catch (const std::exception&) {
+        return;  // load_restart (or --check's check_restart) says precisely what is wrong
+    }
+    const Params output = root.scope("output");
+    const std::optional<RunIdentity> continued = checkpoint_run(header, checkpoint);
+    const std::string allowed =
+        "the output.directory and output.prefix of the run the checkpoint continues, or a "
+        "prefix with no files yet (the run is then continued there)";
+    // What is already under the prefix: its run file, else its newest checkpoint (the one a
+    // restart could write over or prune), else any other file of a run.
+    std::vector<std::filesystem::path> others;
+    std::filesystem::path witness;
+    for (const auto& f : existing_run_files(s)) {
+        if (same_file(f, checkpoint)) continue;
+        const std::string name = f.filename().string();
+        if (name == s.output.prefix + ".h5") witness = f;
+        others.push_back(f);
+    }
+    if (others.empty()) return;
+    if (witness.empty())
+        for (auto it = others.rbegin(); it != others.rend() && witness.empty(); ++it)
+            if (is_checkpoint_file_name(it->filename().string(), s.output.prefix)) witness = *it;
+    if (witness.empty())
+        output.fail("prefix",
+                    fmt::format("restart={}: {} exists without a run file beside it: a restart "
+                                "writes only into the run its checkpoint came from, and whose "
+                                "run this file is cannot be told (nothing was written)",
+                                checkpoint.string(), others.front().string()),
+                    allowed);
+    std::optional<RunIdentity> found;
+    std::string why;
+    try {
+        if (is_checkpoint_file_name(witness.filename().string(), s.output.prefix))
+            found = checkpoint_run(read_checkpoint_header(witness), witness);
+        else
+            found = read_run_identity(H5File::open(witness, false));
+    } catch (const std::exception& e) {
+        why = e.what();
+    }
+    if (found && continued && found->same_run(*continued)) return;
+    const std::string theirs =
+        found ? found->describe()
+              : fmt::format("a run that cannot be told ({})",
+                            why.empty() ? std::string("it stores no run file") : why);
+    const std::string ours =
+        continued ? continued->describe()
+                  : std::string("a run that cannot be told: the checkpoint stores no run file");
+    output.fail("prefix",
+                fmt::format("restart={} would write into another run: {} belongs to {}; the "
+                            "checkpoint continues {} (nothing was written)",
+                            checkpoint.string(), witness.string(), theirs, ours),
+                allowed);
+}
+#else
+void check_restart_target(const Params&, const RunSettings&, const std::filesystem::path&) {}
+#endif
 
 std::vector<std::filesystem::path> remove_earlier_run(const RunSettings& s) {
     const auto files = existing_run_files(s);

@@ -6,7 +6,10 @@
 /// an output.prefix under which an earlier run left files (its run file, CSV files, VTK series,
 /// thermo logs or checkpoints): exit 2, naming the file. output.overwrite = true replaces that
 /// run: its files are all deleted first, so that none of them is left mixed with the new run's.
-/// A restart (restart=FILE) continues its own run's files and is not refused.
+/// A restart (restart=FILE) writes only into the run its checkpoint came from: the run file
+/// under its output.prefix, if there is one, must be that run's (same run_id), and so must the
+/// newest checkpoint there; a prefix with none of a run's files is a fresh place to continue
+/// the run (its outputs are put back there from the checkpoint).
 
 #include <filesystem>
 #include <string>
@@ -27,10 +30,19 @@ std::vector<std::filesystem::path> existing_run_files(const RunSettings& setting
 /// directory); empty if it can.
 std::string unwritable_directory(const std::filesystem::path& directory);
 
-/// InputError (naming output.directory / output.prefix at their location in the scene) if a
-/// new run (not `restarting`) may not write its output: the directory cannot be written, or an
-/// earlier run's files are there and output.overwrite is false.
+/// InputError (naming output.directory or checkpoint.directory at its location in the scene)
+/// if the directory cannot be written to (or created).
+void check_output_is_writable(const Params& root, const RunSettings& settings);
+
+/// InputError (naming output.prefix) if a new run (not `restarting`) would write over an
+/// earlier run's files and output.overwrite is false.
 void check_output_is_free(const Params& root, const RunSettings& settings, bool restarting);
+
+/// InputError (naming output.prefix) if a restart from `checkpoint` would write into another
+/// run's files (see above), or into files whose run cannot be told. A checkpoint that cannot
+/// be read is left to the restart's own checks (their messages are the precise ones).
+void check_restart_target(const Params& root, const RunSettings& settings,
+                          const std::filesystem::path& checkpoint);
 
 /// A new run with output.overwrite = true: deletes the earlier run's files; returns them.
 std::vector<std::filesystem::path> remove_earlier_run(const RunSettings& settings);

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/shell_quote.hpp"
 #include "mpi_driver/output/progress.hpp"
 #include "mpi_driver/parallel/stop_signal.hpp"
 
@@ -30,11 +31,13 @@ int report_end(const RunSummary& summary, const RunSettings& s, const ParamTable
     } else if (summary.checkpoint.empty()) {
         log::notice("stopped by {}; nothing could be saved (no HDF5)", signal);
     } else {
-        std::string command = fmt::format("mpirun -n {} efdem {}", ranks, table.file());
-        for (const auto& o : table.overrides()) command += " " + o;
-        log::notice("stopped by {}: checkpoint {} (t = {:.6g}); continue with: {} restart={}",
-                    signal, summary.checkpoint, summary.checkpoint_time, command,
-                    summary.checkpoint);
+        // Every argument quoted for a POSIX shell: the line is meant to be pasted.
+        std::string command =
+            fmt::format("mpirun -n {} efdem {}", ranks, shell_quote(table.file()));
+        for (const auto& o : table.overrides()) command += fmt::format(" {}", shell_quote(o));
+        command += fmt::format(" {}", shell_quote(fmt::format("restart={}", summary.checkpoint)));
+        log::notice("stopped by {}: checkpoint {} (t = {:.6g}); continue with: {}", signal,
+                    summary.checkpoint, summary.checkpoint_time, command);
     }
     return kExitInterrupted;
 }

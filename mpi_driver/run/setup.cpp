@@ -57,12 +57,26 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
         [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
     // What a new run may not write over (the same check in --check); the root looks.
     if (mpi.is_root()) {
+        check_output_is_writable(root, settings);
+        // One run at a time under a prefix: the lock is taken before the output is looked at,
+        // so that no other run can create files between the look and this run's writing.
+        if (out.check) {
+            OutputLock::check_free(root, settings.output.directory, settings.output.prefix);
+        } else {
+            std::filesystem::create_directories(settings.output.directory);
+            out.lock.emplace(root, settings.output.directory, settings.output.prefix);
+        }
         check_output_is_free(root, settings, !options.restart.empty());
+        if (!options.restart.empty()) check_restart_target(root, settings, options.restart);
 #if EFDEM_HAVE_HDF5
-        if (out.check && !options.restart.empty())
-            check_restart(options.restart, read_checkpoint_header(options.restart),
-                          parameter_lines(*out.table), mpi.size() * settings.realizations_per_rank,
-                          settings.checkpoint.allow_physics_change);
+        if (out.check && !options.restart.empty()) {
+            const CheckpointHeader header = read_checkpoint_header(options.restart);  // first:
+            // its messages say what a file that is no checkpoint is
+            check_restart(options.restart, header, parameter_lines(*out.table),
+                          mpi.size() * settings.realizations_per_rank,
+                          settings.checkpoint.allow_physics_change,
+                          read_checkpoint_time(options.restart));
+        }
 #endif
     }
     if (!out.check) {

@@ -1,10 +1,11 @@
 #pragma once
 /// \file
 /// The set-up of a run, collective: every rank reads the same scene (scene_input.hpp), the run
-/// settings, and builds (and settles) its realizations' beds; the root checks that the output
-/// may be written (output_guard.hpp) and, with output.overwrite, deletes the earlier run's
-/// files. Each stage ends in one agreement (agree_on_failure), so every rank stops together and
-/// the root prints one message: exit code 2 for bad input, 3 for a failure.
+/// settings, and builds (and settles) its realizations' beds; the root takes the prefix's lock
+/// (output_lock.hpp), checks that the output may be written (output_guard.hpp) and, with
+/// output.overwrite, deletes the earlier run's files. Each stage ends in one agreement
+/// (agree_on_failure), so every rank stops together and the root prints one message: exit code 2
+/// for bad input, 3 for a failure.
 
 #include <chrono>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "mpi_driver/output/run_recorder.hpp"
 #include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/parallel/mpi_session.hpp"
+#include "mpi_driver/run/output_lock.hpp"
 #include "mpi_driver/run/run_options.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 
@@ -42,7 +44,8 @@ struct SetUp {
     std::optional<RunSettings> settings;
     std::vector<dem::System> systems;  ///< this rank's realizations' beds
     bool check = false;
-    int ranks = 1;  ///< the ranks the run is for (--ranks=N with --check)
+    int ranks = 1;                   ///< the ranks the run is for (--ranks=N with --check)
+    std::optional<OutputLock> lock;  ///< the root's, for the whole run (not with --check)
 };
 
 /// Collective: reads the scene of `options`, builds this rank's beds into `out` and records the

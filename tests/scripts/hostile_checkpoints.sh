@@ -50,6 +50,14 @@ PY
 }
 
 expect missing "$work/no_such_checkpoint.h5" "file not found"
+# Not a file: each says what the path is instead of "not found" (a FIFO would block the open).
+expect directory "$work" "checkpoint is a directory, not a file"
+mkfifo "$work/fifo.h5"
+expect fifo "$work/fifo.h5" "checkpoint is a FIFO (named pipe), not a file"
+ln -s "$work/loop_b.h5" "$work/loop_a.h5"; ln -s "$work/loop_a.h5" "$work/loop_b.h5"
+expect symlink_loop "$work/loop_a.h5" "checkpoint is a symbolic link that loops"
+ln -s "$work/gone.h5" "$work/dangling.h5"
+expect dangling "$work/dangling.h5" "is a symbolic link to '$work/gone.h5', which does not exist"
 head -c 5000 "$good" > "$work/truncated.h5"
 expect truncated "$work/truncated.h5" "truncated or corrupted"
 echo "not an HDF5 file" > "$work/text.h5"
@@ -66,6 +74,21 @@ expect wrong_scene "$good" "different physics: pair_contact.kn = 300000 (checkpo
 expect wrong_count "$good" "holds 2 realizations but this run has 4" ensemble.realizations_per_rank=2
 expect other_bed "$good" "checkpoint does not fit the scene: realization 0: the checkpoint has 256 particles, the scene builds 200" \
   "bed.count=100 100" restart.allow_physics_change=true
+# The run file's grid never changes on a restart, not even with allow_physics_change (its rows
+# so far were sampled on it: another interval ended "incomplete", other quantiles in exit 3).
+expect other_interval "$good" "observe.interval = 0.5 (checkpoint: 0.25)" observe.interval=0.5 \
+  restart.allow_physics_change=true
+expect other_quantiles "$good" "observe.quantiles = 9 (checkpoint: 19)" observe.quantiles=9 \
+  restart.allow_physics_change=true
+# A run.duration that ends at or before the checkpoint (t = 1) has nothing to run; it used to end
+# with exit 0, status "incomplete", and the run's files set back to the checkpoint.
+expect too_short "$good" "run.duration = 1, but the run had already simulated 1 time units" run.duration=1
+timeout 120 "$mpiexec" -n 2 "$@" "$efdem" --check "$scene" "${common[@]}" output.prefix=hostile \
+  restart="$good" run.duration=0.5 > "$work/check_short.log" 2>&1
+code=$?
+[ $code -eq 2 ] && grep -q "run.duration = 0.5, but the run had already simulated" "$work/check_short.log" \
+  && echo "PASS: --check refuses a run.duration that ends before the checkpoint" \
+  || { cat "$work/check_short.log"; echo "FAIL: --check, short duration: exit $code"; failures=$((failures + 1)); }
 
 # The same physics change is accepted when asked for.
 timeout 120 "$mpiexec" -n 2 "$@" "$efdem" "$scene" "${common[@]}" output.prefix=allowed restart="$good" \

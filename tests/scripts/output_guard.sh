@@ -79,6 +79,73 @@ else
   grep -v "^t = " "$work/cont2.log"; ls "$work/cont"; fail "restart output files (exit $code)"
 fi
 
+# 5. A restart writes only into the run its checkpoint came from (it used to truncate and rewrite
+#    any run named by its output.prefix, exit 0). "other" is a completed run of another seed.
+efd "$efdem" "$scene" mode=direct run.duration=1 seed=9 output.directory="$work/cont" output.prefix=other \
+  > "$work/other.log" 2>&1 || { cat "$work/other.log"; fail "the other run failed"; }
+other_before=$(cd "$work/cont" && sha256sum other* | sort)
+for target in "output.prefix=other" "output.prefix=other output.directory=$work/cont/"; do
+  # shellcheck disable=SC2086
+  timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=2 \
+    output.directory="$work/cont" $target restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/into_other.log" 2>&1
+  code=$?
+  if [ $code -eq 2 ] && grep -q "key 'output.prefix' = 'other': restart=$work/cont/efdem_ckpt_00000004.h5 would write into another run: $work/cont/other.h5 belongs to run_id [0-9a-f]\{32\}, .*, seed 9, .*; the checkpoint continues run_id [0-9a-f]\{32\}, .*seed 11" "$work/into_other.log" \
+     && [ "$(cd "$work/cont" && sha256sum other* | sort)" = "$other_before" ]; then
+    echo "PASS: a restart into another run ($target, 2 ranks) is refused (exit 2, naming both runs); that run's files are unchanged"
+  else
+    cat "$work/into_other.log"; fail "restart into another run ($target): exit $code"
+  fi
+done
+efd "$efdem" --check "$scene" mode=direct run.duration=2 output.directory="$work/cont" output.prefix=other \
+  restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/check_other.log" 2>&1
+code=$?
+[ $code -eq 2 ] && grep -q "would write into another run" "$work/check_other.log" \
+  && echo "PASS: --check refuses a restart into another run" || { cat "$work/check_other.log"; fail "--check, restart into another run: exit $code"; }
+# Files of a run without its run file: whose they are cannot be told, so they are not touched.
+mkdir -p "$work/orphan"; cp "$work/cont/other_mean_icdf.csv" "$work/orphan/efdem_mean_icdf.csv"
+efd "$efdem" "$scene" mode=direct run.duration=2 output.directory="$work/orphan" \
+  restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/orphan.log" 2>&1
+code=$?
+[ $code -eq 2 ] && grep -q "efdem_mean_icdf.csv exists without a run file beside it" "$work/orphan.log" \
+  && cmp -s "$work/orphan/efdem_mean_icdf.csv" "$work/cont/other_mean_icdf.csv" \
+  && echo "PASS: a restart into files of a run without a run file is refused" || { cat "$work/orphan.log"; fail "orphan files: exit $code"; }
+
+# 6. One run at a time under a prefix: of two restarts into one run, the second is refused (exit 2)
+#    while the first runs (it used to fail with exit 3 inside HDF5), and the first is unharmed.
+setsid "$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 \
+  output.directory="$work/cont" restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/first_restart.log" 2>&1 &
+job=$!
+for _ in $(seq 1200); do grep -q "^t = " "$work/first_restart.log" && break; sleep 0.05; done
+efd "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/cont" \
+  restart="$work/cont/efdem_ckpt_00000004.h5" > "$work/second_restart.log" 2>&1
+code=$?
+if [ $code -eq 2 ] && grep -q "another efdem run is writing under this prefix now (pid [0-9]* on .* holds the lock $work/cont/efdem.lock)" "$work/second_restart.log"; then
+  echo "PASS: a second restart into a running run is refused (exit 2, naming the lock's holder)"
+else
+  cat "$work/second_restart.log"; fail "second restart: exit $code"
+fi
+kill -TERM $(ps -o pid=,comm= -s $job | awk '$2 == "efdem" {print $1}'); wait $job; code=$?
+[ $code -eq 4 ] && [ ! -e "$work/cont/efdem.lock" ] \
+  && echo "PASS: the first restart went on and stopped normally (exit 4); its lock file is gone" \
+  || { grep -v "^t = " "$work/first_restart.log"; fail "the first restart: exit $code"; }
+
+# 7. The restart command printed after a stop is quoted for a POSIX shell: pasted, it passes an
+#    override with a space and $(...) exactly (efdem's own quotes kept), and runs nothing.
+odd="$work/with space/\$(touch $work/pasted_ran)"
+setsid "$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 \
+  "output.directory=\"$odd\"" > "$work/odd.log" 2>&1 &
+job=$!
+for _ in $(seq 1200); do grep -q "^t = " "$work/odd.log" && break; sleep 0.05; done
+kill -TERM $(ps -o pid=,comm= -s $job | awk '$2 == "efdem" {print $1}'); wait $job
+line=$(grep -o "continue with: .*" "$work/odd.log"); line=${line#continue with: }
+args=$(mpirun() { printf '%s\n' "$@"; }; eval "$line")
+if [ -n "$line" ] && grep -qxF "output.directory=\"$odd\"" <<< "$args" && [ ! -e "$work/pasted_ran" ] \
+   && grep -qxF "restart=$odd/$(cd "$odd" && ls efdem_ckpt_*.h5 | tail -1)" <<< "$args"; then
+  echo "PASS: the printed restart command keeps 'output.directory=\"$odd\"' one word and runs nothing"
+else
+  echo "line: $line"; echo "args: $args"; fail "the printed restart command"
+fi
+
 # 4. end_status marks.
 [ "$(status_of "$out/efdem.h5")" = "completed" ] && echo "PASS: end_status completed" || fail "end_status of a completed run"
 setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 output.directory="$work/killed" > "$work/killed.log" 2>&1 &
