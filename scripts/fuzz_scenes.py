@@ -259,11 +259,34 @@ def m_long(rng, lines):
     return set_value(lines, i, long_key, value), f"{len(long_key)}-character key"
 
 
+# Values at and beyond the bounds that physics sets (docs/scene_reference.md): each of the
+# outside ones was once accepted by --check and then failed at run time or did nothing useful
+# (the drag's relaxation time, the terminal velocity, a slab bigger than the box, settling that
+# can never end, a watchdog that trips on a bed at rest).
+PHYSICS_EDGES = {
+    "gas_drag.A": ["3e3", "411", "412", "1500", "1e6"],
+    "gas_drag.superficial_velocity": ["999", "17.4", "17.5", "8.7"],
+    "gas_drag.slab_thickness": ["1e300", "10", "10.5", "0.1"],
+    "bed.velocity_rms": ["1e6", "10", "10.1"],
+    "bed.settle.ke_threshold": ["4.9e-324", "1e-12", "9e-13"],
+    "watchdog.max_overlap": ["1e-300", "1e-4", "9e-5"],
+}
+
+
+def m_physics_edge(rng, lines):
+    key = rng.choice(sorted(PHYSICS_EDGES))
+    value = rng.choice(PHYSICS_EDGES[key])
+    for i, k, _ in value_positions(lines):
+        if k == key:
+            return set_value(lines, i, key, value), f"physics edge {key} = {value}"
+    return lines + [f"{key} = {value}".encode()], f"physics edge {key} = {value} (added)"
+
+
 MUTATIONS = [
     m_delete_line, m_missing_required, m_duplicate_line, m_random_bytes, m_extreme_number,
     m_non_finite, m_scale_number, m_scale_number, m_unit_mistake, m_unit_mistake,
     m_word_for_number, m_number_for_word,
-    m_unknown_key, m_truncate_line, m_swap_values, m_empty_value, m_long,
+    m_unknown_key, m_truncate_line, m_swap_values, m_empty_value, m_long, m_physics_edge,
 ]
 
 

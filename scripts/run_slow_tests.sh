@@ -18,9 +18,12 @@ echo "== efdem_physics_tests [.slow]"
 echo "== efdem_unit_tests [.slow]"
 "$EFDEM_BUILD_DIR/tests/efdem_unit_tests" "[.slow]" --durations yes || status=1
 if [ "${EFDEM_SKIP_FUZZ:-0}" != "1" ]; then
-    echo "== scene fuzzer"
+    # A new master seed every run (the clock), printed so that a failure can be replayed with
+    # EFDEM_FUZZ_SEED=S (and --replay K); the default tier keeps seed 1.
+    fuzz_seed=${EFDEM_FUZZ_SEED:-$(date +%s)}
+    echo "== scene fuzzer, seed $fuzz_seed (replay: EFDEM_FUZZ_SEED=$fuzz_seed)"
     python3 "$src/scripts/fuzz_scenes.py" --efdem "$EFDEM_BUILD_DIR/mpi_driver/efdem" \
-        --cases "${EFDEM_FUZZ_CASES:-1000}" --seed "${EFDEM_FUZZ_SEED:-1}" --jobs "${EFDEM_FUZZ_JOBS:-2}" \
+        --cases "${EFDEM_FUZZ_CASES:-1000}" --seed "$fuzz_seed" --jobs "${EFDEM_FUZZ_JOBS:-2}" \
         --failures "$EFDEM_BUILD_DIR/fuzz-failures" || status=1
 fi
 exit $status
