@@ -209,7 +209,13 @@ std::filesystem::path CheckpointWriter::write(long sequence,
     if (!layout_.is_root()) return final_path;
     if (settings_.debug_delay > 0)  // test hook: a window in which the job can be killed mid-write
         std::this_thread::sleep_for(std::chrono::duration<double>(settings_.debug_delay));
-    write_header(tmp, sequence, *header);
+    try {
+        write_header(tmp, sequence, *header);
+    } catch (const std::exception&) {
+        std::error_code ignored;
+        std::filesystem::remove(tmp, ignored);  // a checkpoint that can never be whole
+        throw;
+    }
     std::error_code ec;
     std::filesystem::rename(tmp, final_path, ec);
     if (ec)

@@ -8,6 +8,7 @@
 #include "core/contracts.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/parallel/stop_signal.hpp"
 
 namespace efdem::mpi_driver {
@@ -70,10 +71,16 @@ std::string EnsembleStepper::where_saved() const {
         last_checkpoint_.string(), last_checkpoint_time_);
 }
 
-void EnsembleStepper::fail(const std::string& message, long realization) const {
-    // Used where the ranks cannot agree first (keeping or restoring states, checkpoints).
-    layout_.mpi().abort(fmt::format("{}; {}", naming(realization, message), where_saved()),
-                        kExitRuntimeFailure);
+void EnsembleStepper::agree_on_stage(const std::string& local_failure, long realization) const {
+    const std::string mine =
+        local_failure.empty()
+            ? std::string()
+            : fmt::format("{}; {}", naming(realization, local_failure), where_saved());
+    const Agreement agreed =
+        agree_on_failure(layout_.mpi().comm(), mine.empty() ? kExitOk : kExitRuntimeFailure, mine);
+    if (agreed.exit_code == kExitOk) return;
+    if (layout_.is_root()) log::error("{}", agreed.message);
+    throw RunFailed(agreed.message);
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
@@ -340,11 +347,13 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
 
 EnsembleSnapshot EnsembleStepper::snapshot(const char* when) const {
     EnsembleSnapshot s;
+    std::string failure;
     try {
         s.realizations = EnsembleSnapshots::save_realizations(local_);
     } catch (const std::exception& e) {
-        fail(std::string("keeping the state ") + when + ": " + e.what(), local_.front()->index());
+        failure = std::string("keeping the state ") + when + ": " + e.what();
     }
+    agree_on_stage(failure, local_.front()->index());
     s.time = time();
     s.stepper = saved_state();
     s.last_sample = sampler_.last();
@@ -354,11 +363,13 @@ EnsembleSnapshot EnsembleStepper::snapshot(const char* when) const {
 
 void EnsembleStepper::return_to(const EnsembleSnapshot& s, const char* when, bool keep_membership) {
     at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
+    std::string failure;
     try {
         EnsembleSnapshots::restore_realizations(local_, s.realizations);
     } catch (const std::exception& e) {
-        fail(std::string("going back to ") + when + ": " + e.what(), local_.front()->index());
+        failure = std::string("going back to ") + when + ": " + e.what();
     }
+    agree_on_stage(failure, local_.front()->index());
     // The discarded work was done: it stays in the cost.
     const double micro = micro_time_, steps = particle_steps_;
     StepperState now;

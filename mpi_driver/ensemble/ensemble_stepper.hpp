@@ -267,14 +267,18 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     void do_rebuild(bool top_half);
     void do_set_parameter(double value);
 
-    /// Every rank: the snapshot of everything now (a failure to save ends the job).
+    /// Every rank: the snapshot of everything now (a failure to save on any rank ends the run
+    /// on every rank together: RunFailed, and the root marks the run file).
     EnsembleSnapshot snapshot(const char* when) const;
     /// Every rank: back to `s` (realizations and the stepper's state). The cost counters keep
     /// counting the discarded work; `keep_membership`: who is in the ensemble and the failures
     /// survived stay as they are now (a rebuild decides them).
     void return_to(const EnsembleSnapshot& s, const char* when, bool keep_membership);
     std::string where_saved() const;
-    [[noreturn]] void fail(const std::string& message, long realization) const;
+    /// Collective, after a stage every rank ran on its own (no collective inside): if it failed
+    /// on any rank (`local_failure` non-empty there), every rank throws RunFailed with the
+    /// lowest failing rank's message, naming the realization and the newest checkpoint.
+    void agree_on_stage(const std::string& local_failure, long realization) const;
 
     const EnsembleLayout& layout_;
     Realizations local_;

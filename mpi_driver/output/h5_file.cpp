@@ -99,9 +99,27 @@ H5File::H5File(H5File&& other) noexcept : file_(other.file_), path_(std::move(ot
     other.file_ = -1;
 }
 
+namespace {
+/// The HDF5 error stack does not always carry the system's reason (a write the library
+/// buffered fails later, without errno): a full file system is then said from its free space.
+std::string with_disk_state(std::string why, const std::string& path) {
+    if (why.find("no space left") != std::string::npos) return why;
+    std::error_code ec;
+    const auto space = std::filesystem::space(std::filesystem::path(path).parent_path().empty()
+                                                  ? std::filesystem::path(".")
+                                                  : std::filesystem::path(path).parent_path(),
+                                              ec);
+    if (ec || space.available >= (1u << 20)) return why;
+    return fmt::format(
+        "{}{}no space left: {} bytes free on its file system (the disk or the "
+        "quota is full)",
+        why, why.empty() ? "" : "; ", space.available);
+}
+}  // namespace
+
 void H5File::check(herr_t status, const std::string& what) const {
     if (status < 0) {
-        const std::string why = hdf5_error_reason();
+        const std::string why = with_disk_state(hdf5_error_reason(), path_);
         throw RuntimeFailure(
             fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
     }
@@ -109,7 +127,7 @@ void H5File::check(herr_t status, const std::string& what) const {
 
 hid_t H5File::check_id(hid_t id, const std::string& what) const {
     if (id < 0) {
-        const std::string why = hdf5_error_reason();
+        const std::string why = with_disk_state(hdf5_error_reason(), path_);
         throw RuntimeFailure(
             fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
     }

@@ -2,9 +2,12 @@
 /// \file
 /// RecorderList: forwards every record to several recorders (HDF5 and CSV).
 
+#include <exception>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "mpi_driver/output/run_recorder.hpp"
 
 namespace efdem::mpi_driver {
@@ -31,8 +34,19 @@ class RecorderList final : public RunRecorder {
     void steady_outcome(const coarse::SteadyRunOutcome& outcome) override {
         for (auto& r : recorders_) r->steady_outcome(outcome);
     }
+    /// Every recorder gets its end even when an earlier one fails (a full disk may refuse a CSV
+    /// line and still take the run file's end status, written first from its reserve); then
+    /// RuntimeFailure naming what could not be finished.
     void finish(const RunSummary& summary) override {
-        for (auto& r : recorders_) r->finish(summary);
+        std::string failures;
+        for (auto& r : recorders_) {
+            try {
+                r->finish(summary);
+            } catch (const std::exception& e) {
+                failures += (failures.empty() ? "" : "; ") + std::string(e.what());
+            }
+        }
+        if (!failures.empty()) throw RuntimeFailure(failures);
     }
     std::vector<std::filesystem::path> files() const override {
         std::vector<std::filesystem::path> out;

@@ -1,6 +1,7 @@
 #include "mpi_driver/parallel/mpi_session.hpp"
 
 #include <cstdlib>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -14,8 +15,25 @@ MpiComm::MpiComm(MPI_Comm comm) : comm_(comm) {
     MPI_Comm_size(comm_, &size_);
 }
 
+namespace {
+std::function<void(const std::string&)>& last_words() {
+    static std::function<void(const std::string&)> words;
+    return words;
+}
+}  // namespace
+
+void MpiComm::set_last_words(std::function<void(const std::string&)> words) {
+    last_words() = std::move(words);
+}
+
 void MpiComm::abort(const std::string& message, int exit_code) const {
     log::rank_error("{}", message);
+    if (auto words = std::exchange(last_words(), nullptr)) {  // once, even if it aborts again
+        try {
+            words(message);
+        } catch (...) {
+        }
+    }
     MPI_Abort(comm_, exit_code);
     std::exit(exit_code);  // not reached
 }

@@ -10,6 +10,7 @@
 
 #include <mpi.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -23,8 +24,13 @@ class MpiComm {
     int rank() const { return rank_; }
     int size() const { return size_; }
     bool is_root() const { return rank_ == 0; }
-    /// Prints `message` (naming this rank) and aborts every rank with `exit_code`.
+    /// Prints `message` (naming this rank), runs this process's last words (set_last_words;
+    /// once) and aborts every rank with `exit_code`.
     [[noreturn]] void abort(const std::string& message, int exit_code) const;
+    /// What this process does before it aborts, given the abort's message: the root marks its
+    /// run file failed and frees its reserve. Empty function: nothing. A failure inside it is
+    /// ignored (the abort goes on).
+    static void set_last_words(std::function<void(const std::string&)> words);
 
   private:
     MPI_Comm comm_;

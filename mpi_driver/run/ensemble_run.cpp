@@ -68,10 +68,10 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     std::unique_ptr<RecorderList> recorders;
     std::vector<std::unique_ptr<Realization>> local;
     const bool resume = restart != nullptr;
+    std::vector<std::unique_ptr<RunRecorder>> owned;  // until the list takes them
     try {
         if (mpi.is_root()) {
             if (resume) restore_outputs(restart->header, s.output.directory, s.output.prefix);
-            std::vector<std::unique_ptr<RunRecorder>> owned;
 #if EFDEM_HAVE_HDF5
             owned.push_back(std::make_unique<Hdf5Recorder>(s.output.directory, s.output.prefix,
                                                            prov, observables.primary->dimension(),
@@ -90,6 +90,14 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
             local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species,
                                                              s.observe.other, out, resume, bed));
     } catch (const std::exception& e) {
+        // The run file may exist already (a CSV header on a nearly full disk): it says so.
+        RunSummary failed;
+        failed.end_status = std::string("failed: ") + e.what();
+        try {
+            if (recorders) recorders->finish(failed);  // the list holds them all
+            for (auto& r : owned) r->finish(failed);   // else those made before the failure
+        } catch (const std::exception&) {
+        }
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
     if (resume) {
@@ -157,6 +165,30 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         }
         return stepper.finish_code();
     }
+    // How the run file is marked when the run fails here: the end status and the counters so
+    // far (finish() frees the run file's reserve first). Empty string: every output finished;
+    // else what could not be.
+    const auto mark_failed = [&](const std::string& why) -> std::string {
+        RunSummary failed;
+        failed.end_status = "failed: " + why;
+        failed.simulated_time = stepper.time() - t0;
+        failed.dem_time = stepper.micro_time();
+        failed.particle_steps = stepper.particle_steps();
+        failed.wall_seconds = progress.elapsed_seconds();
+        wall.fill(failed);
+        try {
+            recorders->finish(failed);
+        } catch (const std::exception& e) {
+            return e.what();
+        }
+        return {};
+    };
+    // An abort on the root (a failure the ranks cannot agree on first, e.g. inside a
+    // collective checkpoint write) marks the run file too, on its way out.
+    MpiComm::set_last_words([&](const std::string& why) { mark_failed(why); });
+    struct Silence {
+        ~Silence() { MpiComm::set_last_words(nullptr); }
+    } silence_at_return;
     RunSummary summary;
     try {
         summary = s.is_steady() ? run_steady(stepper, s, recorders.get(), progress)
@@ -166,29 +198,21 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         wall.fill(summary);
         recorders->finish(summary);
     } catch (const RunFailed& e) {
-        summary.end_status = std::string("failed: ") + e.what();
-        summary.simulated_time = stepper.time() - t0;
-        summary.dem_time = stepper.micro_time();
-        summary.particle_steps = stepper.particle_steps();
-        summary.wall_seconds = progress.elapsed_seconds();
-        wall.fill(summary);
-        try {
-            recorders->finish(summary);
-        } catch (const std::exception& again) {
-            log::error("the run file could not be marked failed: {}", again.what());
-        }
-        log::error("the run failed; its files in {} are marked 'failed'",
-                   s.output.directory.string());
+        const std::string unfinished = mark_failed(e.what());
+        if (unfinished.empty())
+            log::error("the run failed; its files in {} are marked 'failed'",
+                       s.output.directory.string());
+        else
+            log::error(
+                "the run failed; not every output file could be finished ({}); the "
+                "others are marked 'failed'",
+                unfinished);
         return kExitRuntimeFailure;
     } catch (const std::exception& e) {
-        // A failure on the root (e.g. its run file on a full disk): mark the run file if it can
-        // be (finish() frees its reserve first), then end every rank.
-        summary.end_status = std::string("failed: ") + e.what();
-        wall.fill(summary);
-        try {
-            recorders->finish(summary);
-        } catch (const std::exception&) {
-        }
+        // A failure on the root alone (e.g. its run file on a full disk): mark the run file if
+        // it can be, then end every rank (the last words would mark it again: silenced).
+        mark_failed(e.what());
+        MpiComm::set_last_words(nullptr);
         mpi.abort(e.what(), kExitRuntimeFailure);
     }
     return report_end(summary, s, table, mpi.size());

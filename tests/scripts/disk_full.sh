@@ -67,5 +67,27 @@ PY
   then echo "PASS: $kind: exit 3: $msg"
   else echo "FAIL: $kind: files left behind"; failures=$((failures + 1)); fi
 done
+# A disk filled by another process during a checkpoint write (after the space check passed; the
+# write is held open by debug.checkpoint_delay): the run used to abort with the run file still
+# "running", its 1 MiB reserve left behind and, in cpi mode, no reason given.
+for mode in direct cpi; do
+  out="$work/filled-$mode"; mount_small "$out" 3000k || { echo "FAIL: mount"; exit 1; }
+  timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=$mode run.duration=6 \
+    output.directory="$out" checkpoint.interval=1 debug.checkpoint_delay=3 > "$work/filled-$mode.log" 2>&1 &
+  job=$!
+  for _ in $(seq 1200); do compgen -G "$out/*.tmp" > /dev/null && break; sleep 0.05; done
+  sleep 0.5; fallocate -l 100M "$out/filler" 2>/dev/null || dd if=/dev/zero of="$out/filler" bs=64k 2>/dev/null
+  wait $job; code=$?
+  status=$(/usr/bin/python3 -c "import h5py, sys; print(h5py.File(sys.argv[1], 'r').attrs['end_status'])" "$out/efdem.h5")
+  if [ $code -eq 3 ] && [[ $status == "failed: writing checkpoint 1: "*"no space left"* ]] \
+     && [ ! -e "$out/efdem.h5.reserve" ] && ! compgen -G "$out/*.tmp" > /dev/null \
+     && grep -q "error: writing checkpoint 1: .*no space left" "$work/filled-$mode.log"; then
+    echo "PASS: $mode, disk filled during a checkpoint: exit 3, run file '$(cut -c1-90 <<< "$status")...', reserve and partial checkpoint gone"
+  else
+    grep -v "^t = " "$work/filled-$mode.log" | head; ls "$out"; echo "FAIL: $mode, disk filled during a checkpoint: exit $code, status $status"
+    failures=$((failures + 1))
+  fi
+done
+
 [ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
 echo "PASS: full disks end the run cleanly"
