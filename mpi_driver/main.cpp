@@ -21,7 +21,11 @@ using namespace efdem::mpi_driver;
 namespace {
 /// The root prints the agreed message of a failed stage; every rank returns its exit code.
 int failed(const MpiSession& mpi, const Agreement& agreed) {
-    if (mpi.is_root()) log::error("{}", agreed.message);
+    if (!mpi.is_root()) return agreed.exit_code;
+    if (agreed.exit_code == kExitInterrupted)  // a stop asked for, not an error
+        log::notice("{}", agreed.message);
+    else
+        log::error("{}", agreed.message);
     return agreed.exit_code;
 }
 }  // namespace

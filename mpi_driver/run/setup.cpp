@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/parallel/scene_input.hpp"
+#include "mpi_driver/parallel/stop_signal.hpp"
 #include "mpi_driver/run/output_guard.hpp"
 #include "mpi_driver/run/settling_progress.hpp"
 #if EFDEM_HAVE_HDF5
@@ -21,6 +23,18 @@
 namespace efdem::mpi_driver {
 
 namespace {
+
+/// A stop signal while the beds are being settled: before the run exists there is nothing to
+/// checkpoint, so set-up ends at once (at the next half time unit of settling) with exit 4.
+class SettlingStopped : public std::runtime_error {
+  public:
+    SettlingStopped(int signal, const dem::SettlingProgress& p)
+        : std::runtime_error(fmt::format(
+              "stopped by {} during set-up, while settling realization {} ({} stage, t = {:.4g}): "
+              "the run had not started, so there is nothing to checkpoint; run the same command "
+              "again to start it",
+              signal_name(signal), p.realization, dem::to_string(p.stage), p.time)) {}
+};
 
 /// Every rank: reads the scene and builds its beds; throws what a bad scene or a failing build
 /// throws (the caller turns it into the agreement).
@@ -35,8 +49,14 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
     // Settling a paper-size bed takes minutes: the root says how its own realizations go (the
     // other ranks settle theirs at the same time).
     SettlingProgressLine settling_line(5.0);
+    // Every rank looks for a stop signal after each half time unit of settling.
     const dem::SettlingReport settling =
-        mpi.is_root() ? settling_line.report() : dem::SettlingReport{};
+        [line = mpi.is_root() ? settling_line.report()
+                              : dem::SettlingReport{}](const dem::SettlingProgress& p) {
+            if (line) line(p);
+            if (const int signal = stop_signal_received(); signal != 0)
+                throw SettlingStopped(signal, p);
+        };
     // A restart replaces every particle state by the checkpoint's (positions, velocities,
     // species, neighbours, contact history, clock, random streams; a dropped realization is
     // never advanced again), so its beds are built but not settled: settling them would only
@@ -123,6 +143,9 @@ Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wa
     const SetupWall::Clock::time_point settling_start = SetupWall::Clock::now();
     try {
         read_and_build(mpi, options, out);
+    } catch (const SettlingStopped& e) {
+        code = kExitInterrupted;
+        message = e.what();
     } catch (const InputError& e) {
         code = kExitInputError;
         message = e.what();
