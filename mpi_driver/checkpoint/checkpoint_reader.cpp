@@ -186,6 +186,12 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         h.driver.fell_back = integers[3] != 0;
         // Before format 3 checkpoints were only written after the warm-up.
         h.driver.warmed_up = h.format_version < 3 || integers[4] != 0;
+        if (f.exists("/driver/warmup_done")) {  // written since the warm-up has safe points
+            const auto done = f.read_doubles("/driver/warmup_done");
+            if (done.size() != 1 || !(done[0] >= 0))
+                refuse(path, "has a malformed /driver/warmup_done");
+            h.driver.warmup_done = done[0];
+        }
         const auto lifting = f.read_integers("/driver/lifting");
         if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
             refuse(path, "has a malformed /driver/lifting dataset");

@@ -351,6 +351,8 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
                                              h.driver.without_progress, h.driver.fell_back ? 1 : 0,
                                              h.driver.warmed_up ? 1 : 0};
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
+    const std::vector<double> warmup_done{h.driver.warmup_done};
+    f.write("/driver/warmup_done", std::span<const double>(warmup_done), {1});
     std::vector<std::int64_t> lifting;
     for (const auto& st : s.lifting)
         for (std::uint64_t w : st) lifting.push_back(to_stored(w));

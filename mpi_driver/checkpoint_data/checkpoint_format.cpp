@@ -104,6 +104,9 @@ std::uint64_t CheckpointHeader::checksum() const {
         h = fnv1a_array(integrator_layout, h);
         h = hash_text(integrator_layout_text, h);
     }
+    // Only where a piece of the warm-up is done (checkpoints inside it): the checksums of every
+    // other checkpoint, and of those written before the field existed, stay as they were.
+    if (driver.warmup_done != 0) h = hash_value(driver.warmup_done, h);
     if (format_version >= 3) {
         h = hash_value(driver.warmed_up ? 1L : 0L, h);
         h = fnv1a_array(s.active, h);

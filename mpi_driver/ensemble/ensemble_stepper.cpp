@@ -461,6 +461,10 @@ void EnsembleStepper::restore_state(const StepperState& s) {
     failures_.restore(s);
     sampler_.restore(s);
     lifting_.restore(s);
+    // The test-only injected failure happens once per run: a state that has survived a failure
+    // (a restart after a replace, say) must not see it again. Never reset: going back to a state
+    // kept before it does not undo it.
+    injected_fired_ = injected_fired_ || (settings_.failure.realization >= 0 && s.failures > 0);
 }
 
 }  // namespace efdem::mpi_driver

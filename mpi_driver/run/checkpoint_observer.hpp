@@ -2,7 +2,9 @@
 /// \file
 /// CheckpointObserver: the checkpoint cadence of a cpi run: a whole-ensemble checkpoint every
 /// `interval` coarse steps, written between two steps (nothing of a burst is pending there),
-/// with the run loop's state so that a restart continues the run exactly.
+/// with the run loop's state so that a restart continues the run exactly; inside a warm-up by
+/// time, every `interval` pieces of one burst length (so that a job shorter than its warm-up
+/// still progresses from one requeue to the next).
 
 #include "coarse/equation_free/projective/projective_run.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
@@ -21,6 +23,7 @@ class CheckpointObserver final : public coarse::ProjectiveRunObserver {
     EnsembleStepper& stepper_;
     long interval_;
     long last_;
+    long warmup_pieces_ = 0;  ///< warm-up pieces seen by this process
 };
 
 }  // namespace efdem::mpi_driver

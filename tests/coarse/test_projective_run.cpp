@@ -328,6 +328,42 @@ ResumedPair run_and_resume(long at) {
 }
 }  // namespace
 
+TEST_CASE("a warm-up by time has safe points; a run resumed inside it equals the whole run",
+          "[unit][coarse][run]") {
+    // Warm-up 7 in pieces of one burst (2): 2, 4, 6, 7, with a safe point after 2, 4 and 6.
+    auto toy = slow_toy();
+    ProjectiveRun run(fixed_settings(7.0), toy, variable("x"));
+    struct Inside final : ProjectiveRunObserver {
+        const test::LinearToyStepper* stepper = nullptr;
+        std::vector<double> done;  ///< warmup_done at each safe point inside the warm-up
+        std::optional<test::LinearToyStepper> copy;
+        std::optional<ProjectiveRunState> state;
+        void between_steps(const ProjectiveRun& r) override {
+            if (r.state().warmed_up || r.state().warmup_done == 0) return;
+            done.push_back(r.state().warmup_done);
+            if (r.state().warmup_done == 4.0) {
+                copy.emplace(*stepper);
+                state = r.state();
+            }
+        }
+    } seen;
+    seen.stepper = &toy;
+    run.add_observer(seen);
+    const ProjectiveRunOutcome whole = run.run(100.0);
+    CHECK(seen.done == std::vector<double>{2.0, 4.0, 6.0});
+    REQUIRE(seen.copy);
+    CHECK(seen.copy->time() == 4.0);
+    ProjectiveRun resumed(fixed_settings(7.0), *seen.copy, variable("x"));
+    Recorder<test::LinearToyStepper> again;
+    again.stepper = &*seen.copy;
+    resumed.add_observer(again);
+    const ProjectiveRunOutcome rest = resumed.run(100.0, seen.state);
+    CHECK(again.warmups == 1);  // the rest of the warm-up, then the steps
+    CHECK(rest.coarse_steps == whole.coarse_steps);
+    CHECK(seen.copy->time() == toy.time());
+    CHECK(seen.copy->state() == toy.state());  // bit for bit
+}
+
 TEST_CASE("a resumed run equals the uninterrupted one bit for bit", "[unit][coarse][run]") {
     const ResumedPair r = run_and_resume(4);
     CHECK(r.kept->coarse_steps == 4);

@@ -26,7 +26,16 @@ run ddrop mode=direct run.duration=4 ensemble.on_failure=drop checkpoint.interva
 run dre mode=direct run.duration=4 ensemble.on_failure=drop "${fail[@]}" restart="$work/ddrop_ckpt_00000008.h5"
 run cref mode=cpi run.duration=12
 run cdrop mode=cpi run.duration=12 ensemble.on_failure=drop debug.fail_realization=1 debug.fail_time=4
-run crep mode=cpi run.duration=12 ensemble.on_failure=replace debug.fail_realization=1 debug.fail_time=4
+run crep mode=cpi run.duration=12 ensemble.on_failure=replace debug.fail_realization=1 debug.fail_time=4 \
+  checkpoint.interval=1 checkpoint.keep=100
+# The injected failure happens once per run: a restart from a checkpoint written after the
+# replacement must not see it again (it did: the rebuilt realization failed a second time).
+newest=$(ls "$work"/crep_ckpt_*.h5 | tail -1)
+run crep_re mode=cpi run.duration=12 ensemble.on_failure=replace debug.fail_realization=1 debug.fail_time=4 \
+  restart="$newest"
+/usr/bin/python3 "$here/compare_runs.py" "$work/crep.h5" "$work/crep_re.h5" \
+  || { echo "FAIL: the restart after the replacement ($newest) differs from the uninterrupted run"; exit 1; }
+echo "PASS: a restart from $(basename "$newest"), written after the replacement, equals the uninterrupted run (the injected failure does not fire again)"
 /usr/bin/python3 "$here/compare_runs.py" "$work/ddrop.h5" "$work/dre.h5" \
   || { echo "FAIL: the restart after the drop differs from the uninterrupted run"; exit 1; }
 echo "PASS: a restart from a checkpoint written after the drop equals the uninterrupted run"

@@ -145,7 +145,18 @@ void ProjectiveRun::warm_up() {
     const double room = std::max(0.0, t_end_ - burst - t0);
     BurstSamples w;
     if (!settings_.warmup_until_steady) {
-        stepper_.run(std::min(settings_.warmup, t_end_ - t0), w);
+        // In pieces of one burst length (whole samples: a burst is), each followed by a safe
+        // point; a resumed run runs only what is left. The same samples as one piece.
+        const double total = std::min(settings_.warmup, t_end_ - state_.t_origin);
+        const double tol = time_tolerance(t_end_);
+        while (state_.warmup_done < total - tol) {
+            const double piece = std::min(burst, total - state_.warmup_done);
+            w = {};
+            stepper_.run(piece, w);
+            state_.warmup_done += piece;
+            if (state_.warmup_done < total - tol)
+                for (auto* o : observers_) o->between_steps(*this);
+        }
         log::info("warm-up: {:.4g} time units of direct simulation before the first coarse step",
                   settings_.warmup);
         return;

@@ -58,8 +58,13 @@ struct ProjectiveRunState {
     long without_progress = 0;  ///< consecutive steps without a jump
     bool fell_back = false;     ///< the primary coarse variable failed; the fallback is in use
     /// The warm-up is done (false in a state saved before or during it: a run resumed from
-    /// there does the warm-up from the start).
+    /// there does the rest of the warm-up).
     bool warmed_up = false;
+    /// Warm-up time simulated so far (cpi.warmup by time: it runs in pieces of one burst
+    /// length, with a safe point after each, where a run can be checkpointed and stopped; a run
+    /// resumed there runs only the rest). 0 with warmup_until = steady, whose drift test needs
+    /// the samples of its last burst: a stop in it goes back to its start.
+    double warmup_done = 0;
     /// The integrator's own state (ProjectiveIntegrator::save_state(); nullopt for the
     /// single-step integrators).
     IntegratorState integrator;
@@ -87,8 +92,8 @@ class ProjectiveRunObserver {
     /// After the warm-up of a new run (not called on a resumed run or without warm-up).
     virtual void warmup_done(const ProjectiveRun& run) { (void)run; }
     /// Before every coarse step, where nothing of a burst is pending: checkpoints go here. Also
-    /// called once before the warm-up (state().warmed_up false), where a run that must stop can
-    /// go back to.
+    /// called before the warm-up and between its pieces (state().warmed_up false), where a run
+    /// that must stop can go back to.
     virtual void between_steps(const ProjectiveRun& run) { (void)run; }
     /// After every coarse step (run.state().coarse_steps already counts it).
     virtual void step_done(const ProjectiveRun& run, const ProjectiveStepRecord& record) {
