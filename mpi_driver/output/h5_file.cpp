@@ -49,6 +49,22 @@ std::string hdf5_error_reason() {
     return reason;
 }
 
+/// The HDF5 error stack does not always carry the system's reason (a write the library
+/// buffered fails later, without errno): a full file system is then said from its free space.
+std::string with_disk_state(std::string why, const std::string& path) {
+    if (why.find("no space left") != std::string::npos) return why;
+    std::error_code ec;
+    const auto space = std::filesystem::space(std::filesystem::path(path).parent_path().empty()
+                                                  ? std::filesystem::path(".")
+                                                  : std::filesystem::path(path).parent_path(),
+                                              ec);
+    if (ec || space.available >= (1u << 20)) return why;
+    return fmt::format(
+        "{}{}no space left: {} bytes free on its file system (the disk or the "
+        "quota is full)",
+        why, why.empty() ? "" : "; ", space.available);
+}
+
 hid_t string_type() {
     const hid_t t = H5Tcopy(H5T_C_S1);
     H5Tset_size(t, H5T_VARIABLE);
@@ -62,7 +78,11 @@ hid_t string_type() {
 H5File H5File::create(const std::filesystem::path& path) {
     silence_hdf5();
     const hid_t f = H5Fcreate(path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    if (f < 0) throw RuntimeFailure(fmt::format("cannot create the HDF5 file {}", path.string()));
+    if (f < 0) {
+        const std::string why = with_disk_state(hdf5_error_reason(), path.string());
+        throw RuntimeFailure(fmt::format("cannot create the HDF5 file {}{}{}", path.string(),
+                                         why.empty() ? "" : ": ", why));
+    }
     return H5File(f, path.string());
 }
 
@@ -98,24 +118,6 @@ H5File::~H5File() {
 H5File::H5File(H5File&& other) noexcept : file_(other.file_), path_(std::move(other.path_)) {
     other.file_ = -1;
 }
-
-namespace {
-/// The HDF5 error stack does not always carry the system's reason (a write the library
-/// buffered fails later, without errno): a full file system is then said from its free space.
-std::string with_disk_state(std::string why, const std::string& path) {
-    if (why.find("no space left") != std::string::npos) return why;
-    std::error_code ec;
-    const auto space = std::filesystem::space(std::filesystem::path(path).parent_path().empty()
-                                                  ? std::filesystem::path(".")
-                                                  : std::filesystem::path(path).parent_path(),
-                                              ec);
-    if (ec || space.available >= (1u << 20)) return why;
-    return fmt::format(
-        "{}{}no space left: {} bytes free on its file system (the disk or the "
-        "quota is full)",
-        why, why.empty() ? "" : "; ", space.available);
-}
-}  // namespace
 
 void H5File::check(herr_t status, const std::string& what) const {
     if (status < 0) {

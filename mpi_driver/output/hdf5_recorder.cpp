@@ -38,6 +38,20 @@ std::filesystem::path make_reserve(const std::filesystem::path& run_file) {
     return p;
 }
 
+/// The run file, created (a new run) or opened (a restart); if that fails, the reserve is
+/// released and a run file this run created is not left behind half made.
+H5File open_or_release(const std::filesystem::path& path, const std::filesystem::path& reserve,
+                       bool resume) {
+    try {
+        return resume ? H5File::open(path, true) : H5File::create(path);
+    } catch (const std::exception&) {
+        std::error_code ignored;
+        std::filesystem::remove(reserve, ignored);
+        if (!resume) std::filesystem::remove(path, ignored);
+        throw;
+    }
+}
+
 std::string now_utc() {
     const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
     std::tm tm{};
@@ -55,12 +69,29 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
                            const RunProvenance& p, Eigen::Index coarse_dimension, bool resume)
     : path_(directory / (prefix + ".h5")),
       reserve_(make_reserve(path_)),
-      file_(resume ? H5File::open(path_, true) : H5File::create(path_)),
+      file_(open_or_release(path_, reserve_, resume)),
       realizations_(p.realizations),
       m_(p.p_grid.size()),
       dim_(coarse_dimension),
       species_(p.species_names.size()),
       slabs_(static_cast<std::size_t>(p.profile_slabs)) {
+    // On a disk with room for the reserve but little more the first writes fail: the run file
+    // must not be left unreadable or 'running', nor the reserve behind.
+    try {
+        start(p, resume);
+    } catch (const std::exception& e) {
+        std::error_code ignored;
+        std::filesystem::remove(reserve_, ignored);
+        try {
+            file_.attribute("/", "end_status", std::string("failed: ") + e.what());
+            file_.flush();
+        } catch (const std::exception&) {
+        }
+        throw;
+    }
+}
+
+void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
     if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
         file_.attribute("/", "ranks", std::int64_t{p.ranks});
         file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});

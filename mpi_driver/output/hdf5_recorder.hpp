@@ -40,6 +40,9 @@ class Hdf5Recorder final : public RunRecorder {
     std::vector<std::filesystem::path> files() const override { return {path_}; }
 
   private:
+    /// The run file's start: its metadata and axes (a new run), or the attributes of this
+    /// part of a restarted one.
+    void start(const RunProvenance& p, bool resume);
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
     /// Writes `name`'s units, description and dimension scales (run_file_schema.hpp).
     void document(const std::string& name);

@@ -67,6 +67,34 @@ PY
   then echo "PASS: $kind: exit 3: $msg"
   else echo "FAIL: $kind: files left behind"; failures=$((failures + 1)); fi
 done
+# A disk with room for the 1 MiB reserve and a few pages more (1 MiB + k x 4 KiB free): the run
+# fails while it creates its outputs (the run file's metadata, the CSV sidecar, the first CSV
+# header) or at its first sample. Whatever fails, the run ends with exit 3 and "no space left",
+# its run file is absent or readable and says "failed: ...", and the reserve is gone. (Before:
+# the run file was left "running" after a CSV header failed, or unreadable, and the reserve
+# stayed.) tmpfs allocates whole pages, so these k cover each of those places on this scene.
+nearly="$work/nearly"; mount_small "$nearly" 2000k || { echo "FAIL: mount"; exit 1; }
+places=""
+for k in 1 2 3 4 5 6 7 8; do
+  rm -rf "${nearly:?}"/*
+  avail=$(df -B1 --output=avail "$nearly" | tail -1)
+  fallocate -l $((avail - 1048576 - k * 4096)) "$nearly/filler"
+  timeout 120 "$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=1 \
+    output.directory="$nearly/out" > "$work/nearly-$k.log" 2>&1
+  code=$?
+  if [ $code -eq 3 ] && grep -qi "error:.*no space left" "$work/nearly-$k.log" && [ ! -e "$nearly/out/efdem.h5.reserve" ] \
+     && { [ ! -e "$nearly/out/efdem.h5" ] || /usr/bin/python3 -c "
+import h5py, sys
+s = h5py.File(sys.argv[1], 'r').attrs['end_status']
+assert s.startswith('failed:') and 'no space left' in s.lower(), s" "$nearly/out/efdem.h5"; }; then
+    places="$places $(grep -o -m1 "cannot write the CSV [a-z]*\|cannot create the HDF5 file\|HDF5 error in [^:]*: [a-z]*\|reserve" "$work/nearly-$k.log" | sed 's|/[^ ]*/||; s/ /_/g')"
+  else
+    grep -v "^t = " "$work/nearly-$k.log" | head -5; ls "$nearly/out"
+    echo "FAIL: 1 MiB + $k pages free: exit $code"; failures=$((failures + 1))
+  fi
+done
+echo "PASS: nearly full disks (1 MiB + 1..8 pages): exit 3, run file absent or marked failed, no reserve left; failed at:$places"
+
 # A disk filled by another process during a checkpoint write (after the space check passed; the
 # write is held open by debug.checkpoint_delay): the run used to abort with the run file still
 # "running", its 1 MiB reserve left behind and, in cpi mode, no reason given.
