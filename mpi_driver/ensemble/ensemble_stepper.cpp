@@ -255,7 +255,7 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
             }
             try {
                 r->advance(settings_.steps_per_sample);
-                if (!injected_fired_ && r->index() == inject.realization &&
+                if (!injected_fired_ && !inject.keep_stage && r->index() == inject.realization &&
                     r->time() >= inject.time) {
                     injected_fired_ = true;
                     throw RuntimeFailure("injected failure (debug.fail_realization)", r->index());
@@ -349,6 +349,11 @@ EnsembleSnapshot EnsembleStepper::snapshot(const char* when) const {
     EnsembleSnapshot s;
     std::string failure;
     try {
+        const InjectedFailure& inject = settings_.failure;
+        if (inject.keep_stage)
+            for (const auto& r : local_)
+                if (r->index() == inject.realization && r->time() >= inject.time)
+                    throw std::runtime_error("injected failure (debug.fail_stage = keep)");
         s.realizations = EnsembleSnapshots::save_realizations(local_);
     } catch (const std::exception& e) {
         failure = std::string("keeping the state ") + when + ": " + e.what();

@@ -201,6 +201,8 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.injected_failure.realization =
         debug.get_or<long>("fail_realization", -1, Bounds::closed(-1, 1e9));
     s.injected_failure.time = debug.get_or<double>("fail_time", 0.0, Bounds::closed(0.0, 1e9));
+    s.injected_failure.keep_stage =
+        debug.get_or_choice("fail_stage", "sample", {"sample", "keep"}) == "keep";
 
     const Params ensemble = root.scope("ensemble");
     const std::string action =

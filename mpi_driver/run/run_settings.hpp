@@ -47,6 +47,7 @@
 /// | checkpoint.*, restart.*        | checkpoint_data/checkpoint_settings.hpp             |         |
 /// | debug.fail_realization         | test only: this realization fails ...               | -1      |
 /// | debug.fail_time                | ... at the first sample at or after this time       | 0       |
+/// | debug.fail_stage               | ... in its DEM steps (sample) or keeping states (keep) | sample |
 // clang-format on
 
 #include <cstdint>

@@ -36,6 +36,20 @@ run crep_re mode=cpi run.duration=12 ensemble.on_failure=replace debug.fail_real
 /usr/bin/python3 "$here/compare_runs.py" "$work/crep.h5" "$work/crep_re.h5" \
   || { echo "FAIL: the restart after the replacement ($newest) differs from the uninterrupted run"; exit 1; }
 echo "PASS: a restart from $(basename "$newest"), written after the replacement, equals the uninterrupted run (the injected failure does not fire again)"
+# A failure on a non-root rank while the ensemble keeps its state (a local step
+# of a stage every rank runs): the ranks agree, every rank exits 3 and the root marks the run
+# file. (It was an MPI_Abort from that rank: the run file stayed 'running'.)
+timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" ensemble.realizations_per_rank=2 mode=cpi \
+  run.duration=12 output.directory="$work" output.prefix=keepfail debug.fail_realization=2 debug.fail_time=4 \
+  debug.fail_stage=keep > "$work/keepfail.log" 2>&1
+code=$?
+status=$(/usr/bin/python3 -c "import h5py, sys; print(h5py.File(sys.argv[1], 'r').attrs['end_status'])" "$work/keepfail.h5")
+if [ $code -eq 3 ] && [[ $status == "failed: "*"realization 2: keeping the state "*": injected failure (debug.fail_stage = keep);"* ]] \
+   && ! grep -q "MPI_ABORT" "$work/keepfail.log"; then
+  echo "PASS: a failure keeping the state on rank 1 ends every rank (exit 3, no abort); run file: $(cut -c1-100 <<< "$status")..."
+else
+  grep -v "^t = " "$work/keepfail.log"; echo "FAIL: keep-stage failure: exit $code, status '$status'"; exit 1
+fi
 /usr/bin/python3 "$here/compare_runs.py" "$work/ddrop.h5" "$work/dre.h5" \
   || { echo "FAIL: the restart after the drop differs from the uninterrupted run"; exit 1; }
 echo "PASS: a restart from a checkpoint written after the drop equals the uninterrupted run"
