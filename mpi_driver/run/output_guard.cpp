@@ -161,8 +161,12 @@ void check_restart_target(const Params& root, const RunSettings& s,
     // restart could write over or prune), else any other file of a run.
     std::vector<std::filesystem::path> others;
     std::filesystem::path witness;
+    bool checkpoint_is_here = false;  // the checkpoint is one of this prefix's own files
     for (const auto& f : existing_run_files(s)) {
-        if (same_file(f, checkpoint)) continue;
+        if (same_file(f, checkpoint)) {
+            checkpoint_is_here = true;
+            continue;
+        }
         const std::string name = f.filename().string();
         if (name == s.output.prefix + ".h5") witness = f;
         others.push_back(f);
@@ -189,6 +193,10 @@ void check_restart_target(const Params& root, const RunSettings& s,
         why = e.what();
     }
     if (found && continued && found->same_run(*continued)) return;
+    // A run file that cannot be read (a job killed while writing it) beside the checkpoint
+    // being restarted from, under the same prefix: that is this run's own folder, and the
+    // restart puts the run file back from the checkpoint.
+    if (!found && checkpoint_is_here && continued) return;
     const std::string theirs =
         found ? found->describe()
               : fmt::format("a run that cannot be told ({})",

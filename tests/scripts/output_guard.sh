@@ -110,6 +110,18 @@ code=$?
   && cmp -s "$work/orphan/efdem_mean_icdf.csv" "$work/cont/other_mean_icdf.csv" \
   && echo "PASS: a restart into files of a run without a run file is refused" || { cat "$work/orphan.log"; fail "orphan files: exit $code"; }
 
+# A run file cut short (a job killed while writing it) beside its own checkpoint: the restart
+# is this run's, and puts the run file back from the checkpoint.
+efd "$efdem" "$scene" mode=direct run.duration=2 checkpoint.interval=4 output.directory="$work/cut" > "$work/cut.log" 2>&1 \
+  || { cat "$work/cut.log"; fail "the run to cut failed"; }
+head -c 3000 "$work/cut/efdem.h5" > "$work/cut.h5" && mv "$work/cut.h5" "$work/cut/efdem.h5"
+efd "$efdem" "$scene" mode=direct run.duration=2 output.directory="$work/cut" restart="$work/cut/efdem_ckpt_00000004.h5" \
+  > "$work/cut-restart.log" 2>&1
+code=$?
+[ $code -eq 0 ] && [ "$(status_of "$work/cut/efdem.h5")" = "completed" ] \
+  && echo "PASS: a restart beside its own checkpoint goes on when the run file was cut short (the file is put back)" \
+  || { cat "$work/cut-restart.log"; fail "restart over a cut run file: exit $code"; }
+
 # 6. One run at a time under a prefix: of two restarts into one run, the second is refused (exit 2)
 #    while the first runs (it used to fail with exit 3 inside HDF5), and the first is unharmed.
 setsid "$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$scene" mode=direct run.duration=1000 \
