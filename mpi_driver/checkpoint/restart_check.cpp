@@ -61,6 +61,14 @@ bool as_before_the_key(const std::string& key, const std::string& value) {
     return false;
 }
 
+/// The first `most` of `items` joined with "; ", and how many more there are.
+std::string joined(const std::vector<std::string>& items, std::size_t most) {
+    std::string list;
+    for (std::size_t k = 0; k < items.size() && k < most; ++k) list += (k ? "; " : "") + items[k];
+    if (items.size() > most) list += fmt::format("; and {} more", items.size() - most);
+    return list;
+}
+
 /// What a checkpoint that does not list `key` was written with ("" when the key is not one of
 /// kAddedKeys or any value does).
 std::string value_before_the_key(const std::string& key) {
@@ -114,14 +122,12 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
             if (const auto it = then.find(key); it != then.end() && it->second != value)
                 grid.push_back(fmt::format("{} = {} (checkpoint: {})", key, value, it->second));
     if (!grid.empty()) {
-        std::string list;
-        for (std::size_t k = 0; k < grid.size(); ++k) list += (k ? "; " : "") + grid[k];
         throw InputError(
             where, fmt::format("a restart continues the run file, whose samples were made with "
                                "the checkpoint's observe.* values, and this scene changes them: "
                                "{}. Restart with the checkpoint's values (not even "
                                "restart.allow_physics_change changes them)",
-                               list));
+                               joined(grid, grid.size())));
     }
     const auto duration = now.find("run.duration");
     if (std::isfinite(time_at_checkpoint) && duration != now.end()) {
@@ -158,9 +164,7 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
         if (!may_change_on_restart(key) && !ignored_in(now, key) && !now.contains(key))
             changes.push_back(fmt::format("{} missing (checkpoint: {})", key, value));
     if (changes.empty()) return {};
-    std::string list;
-    for (std::size_t k = 0; k < changes.size() && k < 8; ++k) list += (k ? "; " : "") + changes[k];
-    if (changes.size() > 8) list += fmt::format("; and {} more", changes.size() - 8);
+    const std::string list = joined(changes, 8);
     if (!allow_physics_change)
         throw InputError(
             where, fmt::format("checkpoint was written by a scene with different physics: {}. "

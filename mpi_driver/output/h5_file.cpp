@@ -20,9 +20,11 @@ void silence_hdf5() {
     (void)done;
 }
 
-/// Why the last HDF5 call failed, from its error stack: the system's reason where the library
-/// gives one (e.g. "No space left on device"), else its innermost description.
-std::string hdf5_error_reason() {
+/// Why the last HDF5 call on the file `path` failed, from its error stack: the system's reason
+/// where the library gives one (e.g. "No space left on device"), else its innermost
+/// description. The stack does not always carry the system's reason (a write the library
+/// buffered fails later, without errno): a full file system is then said from its free space.
+std::string hdf5_error_reason(const std::string& path) {
     struct Found {
         std::string innermost, system;
     } found;
@@ -45,24 +47,14 @@ std::string hdf5_error_reason() {
     std::string reason = !found.system.empty() ? found.system : found.innermost;
     if (reason.find("No space left") != std::string::npos ||
         reason.find("quota") != std::string::npos)
-        reason += " (no space left: the disk or the quota is full)";
-    return reason;
-}
-
-/// The HDF5 error stack does not always carry the system's reason (a write the library
-/// buffered fails later, without errno): a full file system is then said from its free space.
-std::string with_disk_state(std::string why, const std::string& path) {
-    if (why.find("no space left") != std::string::npos) return why;
+        return reason + " (no space left: the disk or the quota is full)";
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
     std::error_code ec;
-    const auto space = std::filesystem::space(std::filesystem::path(path).parent_path().empty()
-                                                  ? std::filesystem::path(".")
-                                                  : std::filesystem::path(path).parent_path(),
-                                              ec);
-    if (ec || space.available >= (1u << 20)) return why;
+    const auto space = std::filesystem::space(parent.empty() ? "." : parent, ec);
+    if (ec || space.available >= (1u << 20)) return reason;
     return fmt::format(
-        "{}{}no space left: {} bytes free on its file system (the disk or the "
-        "quota is full)",
-        why, why.empty() ? "" : "; ", space.available);
+        "{}{}no space left: {} bytes free on its file system (the disk or the quota is full)",
+        reason, reason.empty() ? "" : "; ", space.available);
 }
 
 hid_t string_type() {
@@ -79,7 +71,7 @@ H5File H5File::create(const std::filesystem::path& path) {
     silence_hdf5();
     const hid_t f = H5Fcreate(path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (f < 0) {
-        const std::string why = with_disk_state(hdf5_error_reason(), path.string());
+        const std::string why = hdf5_error_reason(path.string());
         throw RuntimeFailure(fmt::format("cannot create the HDF5 file {}{}{}", path.string(),
                                          why.empty() ? "" : ": ", why));
     }
@@ -121,7 +113,7 @@ H5File::H5File(H5File&& other) noexcept : file_(other.file_), path_(std::move(ot
 
 void H5File::check(herr_t status, const std::string& what) const {
     if (status < 0) {
-        const std::string why = with_disk_state(hdf5_error_reason(), path_);
+        const std::string why = hdf5_error_reason(path_);
         throw RuntimeFailure(
             fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
     }
@@ -129,7 +121,7 @@ void H5File::check(herr_t status, const std::string& what) const {
 
 hid_t H5File::check_id(hid_t id, const std::string& what) const {
     if (id < 0) {
-        const std::string why = with_disk_state(hdf5_error_reason(), path_);
+        const std::string why = hdf5_error_reason(path_);
         throw RuntimeFailure(
             fmt::format("HDF5 error in {}: {}{}{}", path_, what, why.empty() ? "" : ": ", why));
     }

@@ -145,13 +145,7 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
 }  // namespace
 
 void check_restart_target(const Params& root, const RunSettings& s,
-                          const std::filesystem::path& checkpoint) {
-    CheckpointHeader header;
-    try {
-        header = read_checkpoint_header(checkpoint);
-    } catch (const std::exception&) {
-        return;  // load_restart (or --check's check_restart) says precisely what is wrong
-    }
+                          const std::filesystem::path& checkpoint, const CheckpointHeader& header) {
     const Params output = root.scope("output");
     const std::optional<RunIdentity> continued = checkpoint_run(header, checkpoint);
     const std::string allowed =
@@ -210,8 +204,6 @@ void check_restart_target(const Params& root, const RunSettings& s,
                             checkpoint.string(), witness.string(), theirs, ours),
                 allowed);
 }
-#else
-void check_restart_target(const Params&, const RunSettings&, const std::filesystem::path&) {}
 #endif
 
 std::vector<std::filesystem::path> remove_earlier_run(const RunSettings& s) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/param_table.hpp"
+#include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 #include "mpi_driver/run/run_settings.hpp"
 
 namespace efdem::mpi_driver {
@@ -38,11 +39,12 @@ void check_output_is_writable(const Params& root, const RunSettings& settings);
 /// earlier run's files and output.overwrite is false.
 void check_output_is_free(const Params& root, const RunSettings& settings, bool restarting);
 
-/// InputError (naming output.prefix) if a restart from `checkpoint` would write into another
-/// run's files (see above), or into files whose run cannot be told. A checkpoint that cannot
-/// be read is left to the restart's own checks (their messages are the precise ones).
+#if EFDEM_HAVE_HDF5
+/// InputError (naming output.prefix) if a restart from `checkpoint` (whose header is `header`)
+/// would write into another run's files (see above), or into files whose run cannot be told.
 void check_restart_target(const Params& root, const RunSettings& settings,
-                          const std::filesystem::path& checkpoint);
+                          const std::filesystem::path& checkpoint, const CheckpointHeader& header);
+#endif
 
 /// A new run with output.overwrite = true: deletes the earlier run's files; returns them.
 std::vector<std::filesystem::path> remove_earlier_run(const RunSettings& settings);

@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -87,15 +88,22 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
             out.lock.emplace(root, settings.output.directory, settings.output.prefix);
         }
         check_output_is_free(root, settings, !options.restart.empty());
-        if (!options.restart.empty()) check_restart_target(root, settings, options.restart);
 #if EFDEM_HAVE_HDF5
-        if (out.check && !options.restart.empty()) {
-            const CheckpointHeader header = read_checkpoint_header(options.restart);  // first:
-            // its messages say what a file that is no checkpoint is
-            check_restart(options.restart, header, parameter_lines(*out.table),
-                          mpi.size() * settings.realizations_per_rank,
-                          settings.checkpoint.allow_physics_change,
-                          read_checkpoint_time(options.restart));
+        if (!options.restart.empty()) {
+            // Read once here. A checkpoint that cannot be read: --check says why now; a run
+            // leaves it to load_restart, which says the same collectively.
+            std::optional<CheckpointHeader> header;
+            try {
+                header = read_checkpoint_header(options.restart);
+            } catch (const std::exception&) {
+                if (out.check) throw;
+            }
+            if (header) check_restart_target(root, settings, options.restart, *header);
+            if (header && out.check)
+                check_restart(options.restart, *header, parameter_lines(*out.table),
+                              mpi.size() * settings.realizations_per_rank,
+                              settings.checkpoint.allow_physics_change,
+                              read_checkpoint_time(options.restart));
         }
 #endif
     }

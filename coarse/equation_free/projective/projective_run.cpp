@@ -141,6 +141,7 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
 
 void ProjectiveRun::warm_up() {
     const double t0 = stepper_.time(), burst = settings_.burst();
+    const double tol = time_tolerance(t_end_);
     // Room for one burst after the warm-up.
     const double room = std::max(0.0, t_end_ - burst - t0);
     BurstSamples w;
@@ -148,7 +149,6 @@ void ProjectiveRun::warm_up() {
         // In pieces of one burst length (whole samples: a burst is), each followed by a safe
         // point; a resumed run runs only what is left. The same samples as one piece.
         const double total = std::min(settings_.warmup, t_end_ - state_.t_origin);
-        const double tol = time_tolerance(t_end_);
         while (state_.warmup_done < total - tol) {
             const double piece = std::min(burst, total - state_.warmup_done);
             w = {};
@@ -168,7 +168,6 @@ void ProjectiveRun::warm_up() {
     // derivation, see cpi_settings.hpp), i.e. cpi.tolerance per burst.
     const double window = settings_.window();
     const double t_limit = std::min(t0 + settings_.warmup + settings_.warmup_max, t0 + room);
-    const double tol = time_tolerance(t_end_);
     while (true) {
         const PhaseDrift d =
             phase_drift(w, stepper_.time() - burst - tol, settings_.warmup_drift_rate);
