@@ -63,9 +63,17 @@ void DemRealization::apply_lift(const LiftPayload& lifted) {
     still_samples_ = 0;  // other masses: its balance is judged again
 }
 
-void DemRealization::advance(long steps) {
-    system_.run(steps);
+bool DemRealization::advance_unless_stopped(long steps, const StopCheck& stop) {
+    if (!stop) {
+        system_.run(steps);
+    } else {
+        for (long done = 0; done < steps; done += kStopCheckSteps) {
+            if (stop()) return false;
+            system_.run(std::min(kStopCheckSteps, steps - done));
+        }
+    }
     still_samples_ = still() ? still_samples_ + 1 : 0;
+    return true;
 }
 
 bool DemRealization::still() const {

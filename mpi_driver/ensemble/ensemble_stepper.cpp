@@ -238,9 +238,20 @@ void EnsembleStepper::serve() {
 long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {
     const InjectedFailure& inject = settings_.failure;
     const bool can_redo = has_resume_point();
+    // A stop signal need not wait for the end of a sample (a paper-size bed's takes seconds,
+    // more than mpirun's grace between its SIGTERM and SIGKILL) where there is a state to go back
+    // to: the resume point (cpi), or, when a checkpoint can be written (direct), the sample's
+    // start kept here.
+    const bool keep_sample_start = !can_redo && can_checkpoint();
+    Realization::StopCheck stop;
+    if (can_redo || keep_sample_start) stop = [] { return stop_signal_received() != 0; };
+    std::vector<RealizationState> sample_start;
     std::vector<RealizationFailure> failed;
     for (long s = 0; s < samples; ++s) {
-        long paused = 0;  // particles of this rank's realizations at rest, not advanced
+        // (A copy that fails here, out of memory, ends the job as a failed lift's apply does.)
+        if (keep_sample_start) sample_start = EnsembleSnapshots::save_realizations(local_);
+        long paused = 0;   // particles of this rank's realizations at rest, not advanced
+        bool cut = false;  // this rank stopped inside the sample on a stop signal
         for (auto& r : local_) {
             if (!failures_.is_active(r->index())) {
                 // Dropped after a failure: not advanced, but its clock keeps time.
@@ -253,8 +264,12 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
                 paused += r->particles();
                 continue;
             }
+            if (cut) continue;  // the sample is given up: its state is not used
             try {
-                r->advance(settings_.steps_per_sample);
+                if (!r->advance_unless_stopped(settings_.steps_per_sample, stop)) {
+                    cut = true;
+                    continue;
+                }
                 if (!injected_fired_ && !inject.keep_stage && r->index() == inject.realization &&
                     r->time() >= inject.time) {
                     injected_fired_ = true;
@@ -264,8 +279,18 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
                 failed.push_back({r->index(), e.what()});
             }
         }
-        const int signal = failures_.agree(local_, failed, stop_signal_received(), can_redo, sink_);
+        const FailureAgreement::Agreed agreed =
+            failures_.agree(local_, failed, stop_signal_received(), cut, can_redo, sink_);
+        const int signal = agreed.signal;
         failed.clear();
+        if (agreed.cut && !failures_.pending()) {
+            // Stopped inside the sample somewhere: no rank uses it, and the counters stay those
+            // of its start. Direct: back to that start (the checkpoint's state); cpi: the
+            // checkpoint is the resume point's.
+            if (keep_sample_start) go_back_to_sample_start(sample_start);
+            interrupted_ = signal;
+            return s;
+        }
         micro_time_ += static_cast<double>(settings_.steps_per_sample) * local_.front()->dt();
         if (settings_.pause_at_rest)  // what was computed: the paused particles left out
             MPI_Allreduce(MPI_IN_PLACE, &paused, 1, MPI_LONG, MPI_SUM, layout_.mpi().comm());
@@ -289,7 +314,7 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
                 failed.push_back({r->index(), e.what()});
             }
         }
-        failures_.agree(local_, failed, 0, can_redo, sink_);
+        failures_.agree(local_, failed, 0, false, can_redo, sink_);
         failed.clear();
         if (failures_.pending()) return s + 1;
         if (signal != 0) {
@@ -298,6 +323,17 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
         }
     }
     return samples;
+}
+
+void EnsembleStepper::go_back_to_sample_start(const std::vector<RealizationState>& start) {
+    std::string failure;
+    try {
+        EnsembleSnapshots::restore_realizations(local_, start);
+    } catch (const std::exception& e) {
+        failure =
+            std::string("going back to the start of a sample cut by a stop signal: ") + e.what();
+    }
+    agree_on_stage(failure, local_.front()->index());
 }
 
 void EnsembleStepper::note_rest(const SampleRecord& rec) {

@@ -248,8 +248,11 @@ class EnsembleStepper final : public coarse::CoarseStepper {
 
     // What every rank does for a command (the root after broadcasting it, the others in
     // serve()).
-    /// Returns the samples taken (fewer than `samples` when a stop was agreed).
+    /// Returns the samples taken (fewer than `samples` when a stop was agreed; a sample in which
+    /// a rank stopped on the signal is not taken).
     long do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    /// Every rank, direct: the realizations back to `start` after a sample cut by a stop.
+    void go_back_to_sample_start(const std::vector<RealizationState>& start);
     /// Root: at_rest_since_ from a new sample.
     void note_rest(const SampleRecord& rec);
     /// lift() and lift_apart() on the root: the command to the other ranks, then do_lift().

@@ -49,13 +49,15 @@ void FailureAgreement::restore(const StepperState& s) {
     failures_ = s.failures;
 }
 
-int FailureAgreement::agree(const Realizations& local, const std::vector<RealizationFailure>& mine,
-                            int signal, bool can_redo, SampleSink* sink) {
-    int here[2] = {signal, static_cast<int>(mine.size())};
-    int global[2] = {0, 0};
-    MPI_Allreduce(here, global, 2, MPI_INT, MPI_MAX, layout_.mpi().comm());
+FailureAgreement::Agreed FailureAgreement::agree(const Realizations& local,
+                                                 const std::vector<RealizationFailure>& mine,
+                                                 int signal, bool cut, bool can_redo,
+                                                 SampleSink* sink) {
+    int here[3] = {signal, static_cast<int>(mine.size()), cut ? 1 : 0};
+    int global[3] = {0, 0, 0};
+    MPI_Allreduce(here, global, 3, MPI_INT, MPI_MAX, layout_.mpi().comm());
     if (global[1] > 0) on_failures(local, mine, can_redo, sink);
-    return global[0];
+    return {global[0], global[2] != 0};
 }
 
 std::vector<std::string> FailureAgreement::gather_messages(

@@ -3,10 +3,10 @@
 /// FailureAgreement: who is in the ensemble, and the ranks' agreement on failures and stop
 /// signals after every sample (one job of the EnsembleStepper).
 ///
-/// agree() is one MPI_Allreduce of (stop signal, failures on this rank): every rank learns at
-/// the same sample that a signal arrived somewhere or that a realization failed, so no rank
-/// waits in a collective the others left. On failures a second MPI_Allreduce tells every rank
-/// which realizations failed, and the policy (failure_policy.hpp) decides, the same on every
+/// agree() is one MPI_Allreduce of (stop signal, failures on this rank, sample cut short): every
+/// rank learns at the same sample that a signal arrived somewhere or that a realization failed, so
+/// no rank waits in a collective the others left. On failures a second MPI_Allreduce tells every
+/// rank which realizations failed, and the policy (failure_policy.hpp) decides, the same on every
 /// rank:
 ///
 /// * abort, or more failures than the policy survives: every failing rank prints its failures
@@ -46,13 +46,19 @@ class FailureAgreement {
     FailureAgreement(const EnsembleLayout& layout, const FailurePolicy& policy,
                      std::function<std::string()> where_saved);
 
+    /// What the ranks agreed on after a sample.
+    struct Agreed {
+        int signal = 0;    ///< the stop signal (the largest received; 0: none)
+        bool cut = false;  ///< some rank stopped inside the sample: nobody may use it
+    };
     /// Collective, every rank after every sample. `mine`: this rank's failures; `signal`: the
-    /// stop signal this rank received (0: none). Returns the agreed signal (the largest).
-    /// `can_redo`: a resume point exists (cpi), so failures wait for a rebuild (pending()); else
-    /// they are dropped now. `sink` (root, may be null): where a survived failure is recorded.
-    /// Throws RunFailed on every rank when the run cannot survive the failures.
-    int agree(const Realizations& local, const std::vector<RealizationFailure>& mine, int signal,
-              bool can_redo, SampleSink* sink);
+    /// stop signal this rank received (0: none); `cut`: this rank's realizations stopped inside
+    /// the sample on it. `can_redo`: a resume point exists (cpi), so failures wait for a rebuild
+    /// (pending()); else they are dropped now. `sink` (root, may be null): where a survived
+    /// failure is recorded. Throws RunFailed on every rank when the run cannot survive the
+    /// failures.
+    Agreed agree(const Realizations& local, const std::vector<RealizationFailure>& mine, int signal,
+                 bool cut, bool can_redo, SampleSink* sink);
 
     /// Every rank: failures agreed on that await a rebuild.
     bool pending() const { return !pending_.empty(); }

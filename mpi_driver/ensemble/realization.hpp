@@ -8,6 +8,7 @@
 /// LiftPayloads between ranks without knowing which.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -58,8 +59,15 @@ class Realization {
     virtual void set_time(double t) = 0;
     virtual double dt() const = 0;
     virtual long particles() const = 0;
+    /// Asked between chunks of a sample's micro steps; true stops the sample there.
+    using StopCheck = std::function<bool()>;
     /// Advances `steps` micro steps; throws RuntimeFailure on a numerical failure.
-    virtual void advance(long steps) = 0;
+    void advance(long steps) { advance_unless_stopped(steps, {}); }
+    /// The same, asking `stop` (may be empty: never) every few steps, so that a stop signal need
+    /// not wait for the end of a long sample (docs/reliability.md, "Stop signals"). Returns false
+    /// when `stop` cut the steps short: the realization then stands inside the sample, and the
+    /// caller restores a saved state. A model may also ignore `stop` and always return true.
+    virtual bool advance_unless_stopped(long steps, const StopCheck& stop) = 0;
     virtual Observation observe(const coarse::ProbabilityGrid& grid, bool top_half) const = 0;
     /// What the root needs to lift this realization.
     virtual LiftPayload lift_input() const = 0;

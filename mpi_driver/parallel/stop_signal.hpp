@@ -3,9 +3,11 @@
 /// Stop signals: SIGTERM, SIGINT and SIGUSR1 (what Slurm sends at the time limit, Ctrl-C, and
 /// `sbatch --signal=B:USR1@...` forwarded by mpirun) ask the run to stop at its next safe point.
 ///
-/// The handler only records the signal (async-signal-safe); the ensemble agrees on it at every
-/// sample (EnsembleStepper: one MPI_Allreduce), so a signal that reaches one rank stops them
-/// all at the same sample, where the run writes a checkpoint and ends with kExitInterrupted.
+/// The handler only records the signal (async-signal-safe); a realization looks for it every
+/// few DEM steps and gives its sample up (Realization::advance_unless_stopped), and the ensemble
+/// agrees on it at every sample (EnsembleStepper: one MPI_Allreduce), so a signal that reaches
+/// one rank stops them all at the same sample, where the run writes a checkpoint and ends with
+/// kExitInterrupted.
 /// A second signal ends the process at once (exit 128 + signal number), without a checkpoint:
 /// the checkpoints already on disk are untouched (their writing is crash-safe). A repeat within
 /// 2 s of the first counts as the same request delivered twice (Slurm signals every process of

@@ -1,5 +1,6 @@
 // Checkpoint pieces that need no file: a realization's saved state put into a freshly built
-// realization continues bit for bit; checksums see one changed bit; which scene keys a restart
+// realization continues bit for bit, and so does one put back after a sample cut by a stop;
+// checksums see one changed bit; which scene keys a restart
 // may change; checkpoint file names. (Whole-program restart tests: tests/scripts/restart_*.sh.)
 #include <catch2/catch.hpp>
 
@@ -60,6 +61,30 @@ TEST_CASE("a saved realization restored into a fresh one continues bit for bit",
     CHECK(same_bits(a.x, b.x));
     CHECK(same_bits(a.v, b.v));
     CHECK(same_bits(a.omega, b.omega));
+    CHECK(a.checksum() == b.checksum());
+}
+
+TEST_CASE("a sample cut by a stop goes back to its start and is then run bit for bit as uncut",
+          "[mpi][checkpoint]") {
+    // What a stop signal inside a sample does in a direct run (EnsembleStepper::do_run): the
+    // realization asks every kStopCheckSteps steps, stops, and is put back to the sample's start.
+    DemRealization uncut = build(1), cut = build(1);
+    uncut.advance(3000);
+    cut.advance(3000);
+    const RealizationState start = cut.save_state();
+    long asked = 0;
+    const bool whole = cut.advance_unless_stopped(5000, [&asked] { return ++asked > 3; });
+    CHECK_FALSE(whole);
+    CHECK(asked == 4);  // asked before each chunk: three ran, the fourth was refused
+    CHECK(cut.save_state().step == start.step + 3 * DemRealization::kStopCheckSteps);
+    cut.restore_state(start);
+    // Asked all through and never stopping: the same steps as one uninterrupted call.
+    CHECK(cut.advance_unless_stopped(5000, [] { return false; }));
+    uncut.advance(5000);
+    const RealizationState a = uncut.save_state(), b = cut.save_state();
+    CHECK(a.step == b.step);
+    CHECK(same_bits(a.x, b.x));
+    CHECK(same_bits(a.v, b.v));
     CHECK(a.checksum() == b.checksum());
 }
 

@@ -439,9 +439,9 @@ TEST_CASE("a failure on one rank is agreed by every rank: drop (direct) takes it
     ListSink sink;
     FailureAgreement agreement(layout, policy(FailurePolicy::Action::drop),
                                [] { return std::string("no checkpoint"); });
-    CHECK(agreement.agree(local, {}, 0, false, &sink) == 0);  // nothing to agree on
+    CHECK(agreement.agree(local, {}, 0, false, false, &sink).signal == 0);  // nothing to agree on
     CHECK(agreement.active_count() == kR);
-    const int signal = agreement.agree(local, last_fails(local), 0, false, &sink);
+    const int signal = agreement.agree(local, last_fails(local), 0, false, false, &sink).signal;
     CHECK(signal == 0);
     // Every rank, not only the failing one, knows it now.
     CHECK(agreement.active_count() == kR - 1);
@@ -466,7 +466,7 @@ TEST_CASE("a failure under ensemble.on_failure = abort ends the run on every ran
                                [] { return std::string("no checkpoint"); });
     std::string what;
     try {
-        agreement.agree(local, last_fails(local), 0, true, nullptr);
+        agreement.agree(local, last_fails(local), 0, false, true, nullptr);
     } catch (const RunFailed& e) {
         what = e.what();
     }
@@ -482,8 +482,15 @@ TEST_CASE("a stop signal received by one rank is agreed by every rank",
     Realizations local = toys(layout, spread_start);
     FailureAgreement agreement(layout, policy(FailurePolicy::Action::abort),
                                [] { return std::string(); });
-    const int mine = world.rank() == world.size() - 1 ? 15 : 0;  // SIGTERM on the last rank
-    CHECK(agreement.agree(local, {}, mine, true, nullptr) == 15);
+    const bool last = world.rank() == world.size() - 1;
+    const int mine = last ? 15 : 0;  // SIGTERM on the last rank
+    const FailureAgreement::Agreed whole = agreement.agree(local, {}, mine, false, true, nullptr);
+    CHECK(whole.signal == 15);
+    CHECK(!whole.cut);  // every rank finished the sample: it may be used
+    // The last rank stopped inside the next sample: no rank may use that one.
+    const FailureAgreement::Agreed cut = agreement.agree(local, {}, mine, last, true, nullptr);
+    CHECK(cut.signal == 15);
+    CHECK(cut.cut);
     CHECK(agreement.active_count() == kR);
 }
 
@@ -499,7 +506,7 @@ TEST_CASE("replace: the failed realization is rebuilt from its donor with the do
     ListSink sink;
     FailureAgreement agreement(layout, policy(FailurePolicy::Action::replace),
                                [] { return std::string(); });
-    agreement.agree(local, last_fails(local), 0, true, &sink);
+    agreement.agree(local, last_fails(local), 0, false, true, &sink);
     REQUIRE(agreement.pending());  // cpi: waits for the rebuild, on every rank
     EnsembleSnapshots::restore_realizations(local, at_resume);
     const FailureAgreement::Rebuild plan = agreement.plan_rebuild(true);
@@ -545,7 +552,7 @@ TEST_CASE("drop in cpi: the failed realization leaves the ensemble at the rebuil
     Realizations local = toys(layout, spread_start);
     FailureAgreement agreement(layout, policy(FailurePolicy::Action::drop),
                                [] { return std::string(); });
-    agreement.agree(local, last_fails(local), 0, true, nullptr);
+    agreement.agree(local, last_fails(local), 0, false, true, nullptr);
     REQUIRE(agreement.pending());
     CHECK(agreement.active_count() == kR);  // until the rebuild
     const FailureAgreement::Rebuild plan = agreement.plan_rebuild(true);

@@ -20,12 +20,13 @@ class ToyRealization final : public mpi_driver::Realization {
     void set_time(double t) override { t_ = t; }
     double dt() const override { return h_; }
     long particles() const override { return 1; }
-    void advance(long steps) override {
+    bool advance_unless_stopped(long steps, const StopCheck&) override {
         for (long s = 0; s < steps; ++s) {
             if (!at_rest_) x_ += h_ * (a_ * x_);  // at rest: a state the toy does not leave
             t_ += h_;
         }
         steps_ += steps;
+        return true;  // a toy sample is short: it never stops inside one
     }
     mpi_driver::Observation observe(const coarse::ProbabilityGrid&, bool) const override {
         mpi_driver::Observation o;
