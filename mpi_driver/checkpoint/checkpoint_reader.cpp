@@ -37,6 +37,30 @@ T with_checkpoint(const std::filesystem::path& path, const std::function<T(const
     }
 }
 
+/// A warm-up until steady's last samples (checkpoint_format.hpp).
+coarse::BurstSamples read_warmup_tail(const H5File& f, const std::filesystem::path& path) {
+    const std::string g = "/driver/warmup_tail/";
+    coarse::BurstSamples tail;
+    tail.t = f.read_doubles(g + "t");
+    auto series = [&](const char* name) {
+        std::vector<Eigen::VectorXd> rows;
+        if (!f.exists(g + name)) return rows;
+        const std::vector<double> all = f.read_doubles(g + name);
+        const std::size_t n = tail.t.size();
+        if (n == 0 || all.size() % n != 0)
+            refuse(path, fmt::format("has a malformed {}{} dataset ({} values for {} samples)", g,
+                                     name, all.size(), n));
+        const auto r = static_cast<Eigen::Index>(all.size() / n);
+        for (std::size_t i = 0; i < n; ++i)
+            rows.emplace_back(
+                Eigen::Map<const Eigen::VectorXd>(all.data() + i * static_cast<std::size_t>(r), r));
+        return rows;
+    };
+    tail.member_phase = series("phase");
+    tail.member_expansion = series("expansion");
+    return tail;
+}
+
 /// The multistep integrator's state from its named fields (format 4; checkpoint_format.hpp).
 coarse::MultistepState read_integrator_state(const H5File& f, const std::filesystem::path& path) {
     const std::string g = "/driver/integrator/";
@@ -192,6 +216,7 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
                 refuse(path, "has a malformed /driver/warmup_done");
             h.driver.warmup_done = done[0];
         }
+        if (f.exists("/driver/warmup_tail")) h.driver.warmup_tail = read_warmup_tail(f, path);
         const auto lifting = f.read_integers("/driver/lifting");
         if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
             refuse(path, "has a malformed /driver/lifting dataset");

@@ -18,6 +18,28 @@
 namespace efdem::mpi_driver {
 
 namespace {
+/// A warm-up until steady's last samples (only at a safe point inside one): /driver/warmup_tail/
+/// t (n) and phase, expansion (n x R; each only where the samples have it).
+void write_warmup_tail(H5File& f, const coarse::BurstSamples& tail) {
+    if (tail.t.empty()) return;
+    const std::string g = "/driver/warmup_tail/";
+    f.create_group(g);
+    f.write(g + "t", std::span<const double>(tail.t), {tail.t.size()});
+    auto series = [&](const char* name, const std::vector<Eigen::VectorXd>& rows) {
+        if (rows.empty()) return;
+        EFDEM_ASSERT(rows.size() == tail.t.size());
+        const auto r = static_cast<std::size_t>(rows.front().size());
+        std::vector<double> all;
+        for (const Eigen::VectorXd& v : rows) {
+            EFDEM_ASSERT(static_cast<std::size_t>(v.size()) == r);
+            all.insert(all.end(), v.data(), v.data() + r);
+        }
+        f.write(g + name, std::span<const double>(all), {rows.size(), r});
+    };
+    series("phase", tail.member_phase);
+    series("expansion", tail.member_expansion);
+}
+
 /// The multistep integrator's state as named fields under /driver/integrator (format 4;
 /// checkpoint_format.hpp lists them); nothing for an integrator without a state.
 void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
@@ -353,6 +375,7 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
     const std::vector<double> warmup_done{h.driver.warmup_done};
     f.write("/driver/warmup_done", std::span<const double>(warmup_done), {1});
+    write_warmup_tail(f, h.driver.warmup_tail);
     std::vector<std::int64_t> lifting;
     for (const auto& st : s.lifting)
         for (std::uint64_t w : st) lifting.push_back(to_stored(w));

@@ -107,6 +107,16 @@ std::uint64_t CheckpointHeader::checksum() const {
     // Only where a piece of the warm-up is done (checkpoints inside it): the checksums of every
     // other checkpoint, and of those written before the field existed, stay as they were.
     if (driver.warmup_done != 0) h = hash_value(driver.warmup_done, h);
+    // Likewise the samples a warm-up until steady needs (only at safe points inside one).
+    const coarse::BurstSamples& tail = driver.warmup_tail;
+    if (!tail.t.empty()) {
+        h = hash_value(static_cast<std::uint64_t>(tail.t.size()), h);
+        for (double t : tail.t) h = hash_value(t, h);
+        for (const auto* series : {&tail.member_phase, &tail.member_expansion}) {
+            h = hash_value(static_cast<std::uint64_t>(series->size()), h);
+            for (const Eigen::VectorXd& v : *series) h = hash_vector(v, h);
+        }
+    }
     if (format_version >= 3) {
         h = hash_value(driver.warmed_up ? 1L : 0L, h);
         h = fnv1a_array(s.active, h);

@@ -12,6 +12,9 @@
 ///   /driver/integers        samples_taken, coarse_steps, without_progress, fell_back,
 ///                           warmed_up (format 3; earlier formats: 4 values, warmed up)
 ///   /driver/warmup_done     warm-up time simulated so far (absent in older files: 0)
+///   /driver/warmup_tail/    only at a safe point inside a warm-up until steady: the samples its
+///                           next drift test reads, t (n) and phase, expansion (n x R, each
+///                           where the samples have it)
 ///   /driver/lifting         R x 4: each realization's lifting random stream (xoshiro state)
 ///   /driver/observable, /driver/recorded   warm starts of the coarse observables
 ///   /driver/integrator/     the multistep integrator's state by name (format 4; absent for the

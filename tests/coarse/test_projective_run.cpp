@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <tuple>
 
 #include <Eigen/Core>
 
@@ -546,6 +547,74 @@ TEST_CASE("the warm-up of an adaptive run ends when the phase signal stops drift
             CHECK(w.t == Approx(1.0));
         }
     }
+}
+
+TEST_CASE("a warm-up until steady has safe points; a run resumed inside it equals the whole run",
+          "[unit][coarse][run]") {
+    // The toy of the test above with cpi.warmup = 7 and bursts of 6: pieces 0-6 and 6-7 (a safe
+    // point at 6), then the drift test at 7 finds the transient (exact drift 1.5 e^-3.5 = 0.045
+    // per time unit against 0.05 / 6 allowed): a safe point at 7 before the next window. A run
+    // resumed there must judge the drift from the same samples (the tail of the last burst
+    // length, kept in the state) and so end its warm-up, and the whole run, as the uninterrupted
+    // one, bit for bit.
+    Eigen::VectorXd k = Eigen::VectorXd::Constant(5, 0.005);
+    k[0] = 0.5;
+    ParamTable table = ParamTable::from_text(
+        "cpi.projection = adaptive\ncpi.tolerance = 0.05\ncpi.healing = 2\n"
+        "cpi.window = 4\ncpi.warmup = 7\ncpi.warmup_until = steady\n",
+        "scene.cfg", "/scenes");
+    const CpiSettings s = CpiSettings::from_params(table.root().scope("cpi"), 0.1);
+    struct Inside final : ProjectiveRunObserver {
+        const test::OuEnsembleStepper* stepper = nullptr;
+        std::vector<double> done;  ///< warmup_done at each safe point inside the warm-up
+        std::optional<test::OuEnsembleStepper> copy;
+        std::optional<ProjectiveRunState> state;
+        double warmed_at = -1;
+        void between_steps(const ProjectiveRun& r) override {
+            if (r.state().warmed_up || r.state().warmup_done == 0) return;
+            done.push_back(r.state().warmup_done);
+            if (std::abs(r.state().warmup_done - 7.0) < 1e-9) {
+                copy.emplace(*stepper);
+                state = r.state();
+            }
+        }
+        void warmup_done(const ProjectiveRun&) override { warmed_at = stepper->time(); }
+    };
+    test::OuEnsembleStepper toy(k, 0.005, 8, 0.1, Eigen::VectorXd::Constant(5, 3.0), 2);
+    ProjectiveRun run(s, toy, variable("ou"));
+    Inside seen;
+    seen.stepper = &toy;
+    run.add_observer(seen);
+    const ProjectiveRunOutcome whole = run.run(60.0);
+    REQUIRE(seen.done.size() >= 2);
+    CHECK(seen.done[0] == Approx(6.0));
+    CHECK(seen.done[1] == Approx(7.0));
+    REQUIRE(seen.state);
+    // The samples of the last burst length (6 time units at 0.1: 1.0 < t <= 7.0, and t = 1.0
+    // itself within the time tolerance), with one phase signal per member.
+    CHECK(seen.state->warmup_tail.t.size() == 61);
+    CHECK(seen.state->warmup_tail.member_phase.size() == 61);
+    CHECK(seen.warmed_at > 7.0);  // the warm-up went on after the safe point
+
+    const auto resume = [&](ProjectiveRunState state) {
+        test::OuEnsembleStepper copy = *seen.copy;
+        ProjectiveRun resumed(s, copy, variable("ou"));
+        Inside again;
+        again.stepper = &copy;
+        resumed.add_observer(again);
+        const ProjectiveRunOutcome rest = resumed.run(60.0, state);
+        return std::tuple{rest, again.warmed_at, copy};
+    };
+    const auto [rest, warmed_at, end] = resume(*seen.state);
+    CHECK(warmed_at == seen.warmed_at);
+    CHECK(rest.coarse_steps == whole.coarse_steps);
+    CHECK(end.time() == toy.time());
+    CHECK(end.mean() == toy.mean());  // bit for bit
+    // Without the kept samples the drift test at 7 has none to read: the warm-up would end
+    // there, and the run would differ.
+    ProjectiveRunState bare = *seen.state;
+    bare.warmup_tail = {};
+    CHECK(std::get<1>(resume(bare)) != seen.warmed_at);
 }
 
 TEST_CASE("a burst that ends the run up to round-off leaves no jump", "[unit][coarse][run]") {

@@ -7,7 +7,8 @@
 # realizations on 2 ranks; and a run from settled beds ("settled"), whose restart builds its beds
 # without settling them (the checkpoint replaces every particle state); and a cpi run restarted
 # from a checkpoint written inside its warm-up ("warmup": a job shorter than its warm-up used to
-# start it again from the beginning at every requeue).
+# start it again from the beginning at every requeue), also inside the drift loop of a warm-up
+# until steady, whose checkpoint holds the samples its next drift test reads ("warmsteady").
 # Compared: the run HDF5 file (compare_runs.py) and the CSV files (byte for byte: the wall time is in the sidecar, not compared).
 #   restart_equality.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 set -euo pipefail
@@ -38,6 +39,7 @@ for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi
             "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
             "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.accuracy=4,cpi.dt_min=0.5,run.duration=24" \
             "warmup 1 00000000 1,2 mode=cpi,cpi.warmup=4,run.duration=12" \
+            "warmsteady 1 00000000 1,2 mode=cpi,cpi.projection=adaptive,cpi.tolerance=0.06,cpi.dt_min=0.5,cpi.warmup=1.5,run.duration=12" \
             "settled 4 00000008 2 mode=direct,bed.settle=true,bed.settle.ke_threshold=1e-3,bed.settle.max_time=20"; do
   read -r mode every from nps overrides <<< "$spec"
   IFS=, read -r -a extra <<< "$overrides"
@@ -57,6 +59,16 @@ import h5py, sys
 f = h5py.File(sys.argv[1], 'r')
 assert f['/driver/warmup_done'][0] == 3.0 and f['/driver/integers'][4] == 0, 'not 3 units into the warm-up'
 assert abs(f['/realizations/time'][0] - 3.0) < 1e-9" "$ckpt" || { echo "FAIL: $ckpt is not inside the warm-up"; exit 1; }
+  fi
+  if [ "$mode" = warmsteady ]; then  # the warm-up until steady ran on in windows of 1 to t = 7.5
+    /usr/bin/python3 -c "
+import h5py, sys
+f = h5py.File(sys.argv[1], 'r')
+assert f['/driver/warmup_done'][0] == 6.5 and f['/driver/integers'][4] == 0, 'not 6.5 units into the warm-up'
+t = f['/driver/warmup_tail/t'][()]
+assert abs(t[0] - 5.0) < 1e-9 and abs(t[-1] - 6.5) < 1e-9, t  # the samples of the last burst length
+assert f['/driver/warmup_tail/expansion'].shape == (len(t), 4)" "$ckpt" \
+      || { echo "FAIL: $ckpt is not inside the drift loop of the warm-up"; exit 1; }
   fi
   if [ "$mode" = pooled ]; then  # the budget is in the checkpoint, and jumps follow the restart
     /usr/bin/python3 -c "import h5py, sys; h5py.File(sys.argv[1], 'r')['/driver/integrator/budget/sigma']" "$ckpt" \

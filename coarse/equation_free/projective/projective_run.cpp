@@ -140,7 +140,8 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
 }
 
 void ProjectiveRun::warm_up() {
-    const double t0 = stepper_.time(), burst = settings_.burst();
+    // The warm-up starts the run: t_origin (also in a run resumed inside it).
+    const double t0 = state_.t_origin, burst = settings_.burst();
     const double tol = time_tolerance(t_end_);
     // Room for one burst after the warm-up.
     const double room = std::max(0.0, t_end_ - burst - t0);
@@ -161,11 +162,22 @@ void ProjectiveRun::warm_up() {
                   settings_.warmup);
         return;
     }
+    // Until steady: `length` first, in pieces of one burst; then one window at a time while
+    // the phase signal's drift over the last burst length is beyond its noise and faster than
+    // warmup_drift_rate = steady_drift_rate(cpi.tolerance, burst) (adaptive; a derivation, see
+    // cpi_settings.hpp), i.e. cpi.tolerance per burst. A safe point before every piece but the
+    // first keeps the samples the next drift test reads (ProjectiveRunState::warmup_tail).
     const double length = std::min(std::max(settings_.warmup, burst), room);
-    if (length > 0) stepper_.run(length, w);
-    // On until the phase signal's drift over the last burst length is within its noise, or
-    // slower than warmup_drift_rate = steady_drift_rate(cpi.tolerance, burst) (adaptive; a
-    // derivation, see cpi_settings.hpp), i.e. cpi.tolerance per burst.
+    w = std::move(state_.warmup_tail);  // a resumed run: the samples it had
+    state_.warmup_tail = {};
+    // Resumed at a safe point of the drift loop: it is the one before the next window.
+    bool at_safe_point = state_.warmup_done > 0 && state_.warmup_done >= length - tol;
+    while (state_.warmup_done < length - tol) {
+        const double piece = std::min(burst, length - state_.warmup_done);
+        stepper_.run(piece, w);
+        state_.warmup_done += piece;
+        if (state_.warmup_done < length - tol) warmup_safe_point(w, burst);
+    }
     const double window = settings_.window();
     const double t_limit = std::min(t0 + settings_.warmup + settings_.warmup_max, t0 + room);
     while (true) {
@@ -195,8 +207,28 @@ void ProjectiveRun::warm_up() {
                 stepper_.time() - t0, d.message);
             return;
         }
+        if (!at_safe_point) warmup_safe_point(w, burst);
+        at_safe_point = false;
         stepper_.run(window, w);
+        state_.warmup_done += window;
     }
+}
+
+void ProjectiveRun::warmup_safe_point(const BurstSamples& w, double burst) {
+    // The samples of the last burst length (and a tolerance), as the drift test selects them.
+    const double from = stepper_.time() - burst - time_tolerance(t_end_);
+    std::size_t first = 0;
+    while (first < w.t.size() && w.t[first] < from) ++first;
+    BurstSamples& tail = state_.warmup_tail;
+    tail = {};
+    const auto keep = [first](const auto& all, auto& kept) {
+        if (!all.empty()) kept.assign(all.begin() + static_cast<std::ptrdiff_t>(first), all.end());
+    };
+    keep(w.t, tail.t);
+    keep(w.member_phase, tail.member_phase);
+    keep(w.member_expansion, tail.member_expansion);
+    for (auto* o : observers_) o->between_steps(*this);
+    tail = {};
 }
 
 double planned_micro_time(double t_now, double t_end, double burst, double dt) {

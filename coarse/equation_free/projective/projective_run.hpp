@@ -6,7 +6,8 @@
 ///
 /// * warm-up: `warmup` of direct simulation before the first coarse step (a new run only), or,
 ///   with warmup_until_steady, on until the phase signal (the bed's centre of mass) no longer
-///   drifts beyond its noise (phase_drift.hpp) — the fast transient is judged from the run;
+///   drifts beyond its noise (phase_drift.hpp) — the fast transient is judged from the run; in
+///   pieces with safe points between them (ProjectiveRunState::warmup_done, warmup_tail);
 /// * the step loop: one ProjectiveIntegrator::step after another until the end time;
 /// * the end-of-run rule: the integrators shorten their last jumps so that the run ends at
 ///   t_end exactly; a rest shorter than one burst ends the run early, with a log line;
@@ -60,11 +61,16 @@ struct ProjectiveRunState {
     /// The warm-up is done (false in a state saved before or during it: a run resumed from
     /// there does the rest of the warm-up).
     bool warmed_up = false;
-    /// Warm-up time simulated so far (cpi.warmup by time: it runs in pieces of one burst
-    /// length, with a safe point after each, where a run can be checkpointed and stopped; a run
-    /// resumed there runs only the rest). 0 with warmup_until = steady, whose drift test needs
-    /// the samples of its last burst: a stop in it goes back to its start.
+    /// Warm-up time simulated so far. The warm-up runs in pieces (of one burst length; with
+    /// warmup_until = steady, then of one window while it drifts), with a safe point before
+    /// each piece but the first, where a run can be checkpointed and stopped; a run resumed
+    /// there runs only the rest.
     double warmup_done = 0;
+    /// warmup_until = steady, at a safe point inside the warm-up: the samples of the last burst
+    /// length (times and the members' phase and expansion signals; the other fields empty),
+    /// which its next drift test reads, so that a resumed run judges the drift exactly as the
+    /// uninterrupted one. Empty everywhere else.
+    BurstSamples warmup_tail;
     /// The integrator's own state (ProjectiveIntegrator::save_state(); nullopt for the
     /// single-step integrators).
     IntegratorState integrator;
@@ -146,6 +152,9 @@ class ProjectiveRun {
     /// cpi.warmup of direct simulation; with warmup_until_steady on in windows until the phase
     /// signal no longer drifts (at most warmup_max longer; always leaving one burst of the run).
     void warm_up();
+    /// A safe point inside a warm-up until steady: the observers see the state with the
+    /// samples the next drift test reads (`w`'s last burst length) in warmup_tail.
+    void warmup_safe_point(const BurstSamples& w, double burst);
 
     CpiSettings settings_;
     CoarseStepper& stepper_;
