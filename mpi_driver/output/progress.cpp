@@ -29,9 +29,11 @@ void Progress::update(double t_sim, double particle_steps, const std::string& ex
                                  ? std::clamp(particle_steps / expected_particle_steps_, 0.0, 1.0)
                                  : done;
     const double eta = work_done > 0 ? wall * (1 - work_done) / work_done : 0.0;
-    log::info("t = {:9.3f} / {:g} ({:5.1f} %)  {:.3g} particle-steps/s  elapsed {}  ETA {}{}{}",
+    log::info("t = {:9.3f} / {:g} ({:5.1f} %)  {:.3g} particle-steps/s  elapsed {}  ETA {}{}{}{}{}",
               t_sim, t_end_, 100 * done, rate, format_duration(wall),
-              work_done > 0 ? format_duration(eta) : "-", extra.empty() ? "" : "  ", extra);
+              work_done > 0 ? format_duration(eta) : "-", extra.empty() ? "" : "  ", extra,
+              checkpoint_.empty() ? "" : "  ", checkpoint_);
+    checkpoint_.clear();
 }
 
 std::string format_duration(double s) {

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <string>
+#include <utility>
 
 namespace efdem::mpi_driver {
 
@@ -21,6 +22,12 @@ class Progress {
     /// the simulated time left.
     void set_expected_particle_steps(double total) { expected_particle_steps_ = total; }
     double elapsed_seconds() const;
+    /// A checkpoint was written (`what`: "checkpoint FILE (t = ...)"): said at the end of the
+    /// next progress line, not on a line of its own, so that a job's log holds no more
+    /// checkpoint lines than progress lines (checkpoint.interval = 1 in a direct run would
+    /// otherwise print one per sample). A later checkpoint replaces one not said yet: the line
+    /// names the newest.
+    void note_checkpoint(std::string what) { checkpoint_ = std::move(what); }
 
   private:
     using Clock = std::chrono::steady_clock;
@@ -28,6 +35,7 @@ class Progress {
     double expected_particle_steps_ = 0.0;
     Clock::time_point start_ = Clock::now();
     Clock::time_point last_ = Clock::time_point::min();
+    std::string checkpoint_;  ///< the newest checkpoint not yet said (empty: none)
 };
 
 /// "1h02m", "3m20s", "12s".

@@ -8,6 +8,7 @@
 
 #include "coarse/equation_free/projective/projective_run.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/output/progress.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -15,12 +16,14 @@ class CheckpointObserver final : public coarse::ProjectiveRunObserver {
   public:
     /// `interval` > 0 coarse steps; `last`: the coarse step the newest checkpoint was written
     /// after (that of the checkpoint a restarted run resumed from, so it is not written again).
-    CheckpointObserver(EnsembleStepper& stepper, long interval, long last)
-        : stepper_(stepper), interval_(interval), last_(last) {}
+    /// Each checkpoint is said on the next progress line (Progress::note_checkpoint).
+    CheckpointObserver(EnsembleStepper& stepper, Progress& progress, long interval, long last)
+        : stepper_(stepper), progress_(progress), interval_(interval), last_(last) {}
     void between_steps(const coarse::ProjectiveRun& run) override;
 
   private:
     EnsembleStepper& stepper_;
+    Progress& progress_;
     long interval_;
     long last_;
     long warmup_pieces_ = 0;  ///< warm-up pieces seen by this process

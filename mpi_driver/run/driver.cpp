@@ -79,7 +79,8 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
             if (stepper.interrupted()) break;
             if (every > 0 && done % every == 0 && done < total) {
                 const auto path = stepper.checkpoint(done, state);
-                log::info("checkpoint {} (t = {:.6g})", path.string(), stepper.time());
+                progress.note_checkpoint(
+                    fmt::format("checkpoint {} (t = {:.6g})", path.string(), stepper.time()));
             }
         }
     } catch (const RunInterrupted&) {
@@ -132,7 +133,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
     ProgressObserver progress_line(stepper, progress);
     std::optional<CheckpointObserver> checkpoints;
     if (control.checkpoint_interval > 0)
-        checkpoints.emplace(stepper, control.checkpoint_interval,
+        checkpoints.emplace(stepper, progress, control.checkpoint_interval,
                             control.resume ? control.resume->coarse_steps : 0);
     if (checkpoints) run.add_observer(*checkpoints);
     run.add_observer(report);
