@@ -3,6 +3,11 @@
 
     /usr/bin/python3 scripts/scene_reference.py --efdem build/mpi_driver/efdem            # check
     /usr/bin/python3 scripts/scene_reference.py --efdem build/mpi_driver/efdem --keys     # the keys, TSV
+    /usr/bin/python3 scripts/scene_reference.py --write-meanings   # after editing a meaning
+
+The page's meanings also reach `efdem --list-keys` (its fourth column): the first sentence of
+each, without markdown, is compiled in from mpi_driver/run/key_meanings.inc, which
+--write-meanings writes from the page; the check fails while that file is not what it would write.
 
 The keys: `efdem --list-keys` (every key a scene's set-up reads, with what it accepts and its
 default, from the code's own declarations: core/param_table.hpp KeyDeclaration) on a matrix of
@@ -84,8 +89,8 @@ def list_keys(efdem):
             r = subprocess.run(cmd, capture_output=True, text=True)
             if r.returncode != 0:
                 sys.exit(f"scene_reference.py: {' '.join(cmd)} failed ({r.returncode}):\n{r.stderr}{r.stdout}")
-            for line in r.stdout.splitlines():
-                key, expected, default = line.split("\t")
+            for line in r.stdout.splitlines()[1:]:  # under the header line
+                key, expected, default, _meaning = line.split("\t")
                 entry = keys.setdefault(key, {"expected": set(), "defaults": set()})
                 entry["expected"].add(expected)
                 entry["defaults"].add(default)
@@ -107,6 +112,28 @@ def page_rows(path):
     return rows
 
 
+MEANINGS = os.path.join(ROOT, "mpi_driver", "run", "key_meanings.inc")
+
+
+def short_meaning(text):
+    """The first sentence of a page meaning, without markdown: what --list-keys shows."""
+    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", text).replace("`", "").replace("**", "")
+    ends = [m.start() for m in re.finditer(r"\.(\s|$)", text) if not re.search(r"(i\.e|e\.g|cf)$", text[:m.start()])]
+    first = (text[:ends[0]] if ends else text).strip()
+    if len(first) > 150:  # a line a terminal shows: cut at a word
+        first = first[:147].rsplit(" ", 1)[0] + "..."
+    return first
+
+
+def meanings_file(rows):
+    lines = ["// Written by scripts/scene_reference.py --write-meanings from docs/scene_reference.md (the",
+             "// first sentence of each key's meaning): edit the page, then run it. Read by listings.cpp."]
+    for key in sorted(rows):
+        text = short_meaning(rows[key]["meaning"]).replace("\\", "\\\\").replace('"', '\\"')
+        lines.append(f'{{"{key}", "{text}"}},')
+    return "\n".join(lines) + "\n"
+
+
 def source_literals():
     names = {}
     for folder in ("core", "dem", "coarse", "mpi_driver"):
@@ -125,7 +152,14 @@ def main():
     ap.add_argument("--efdem", default=os.path.join(ROOT, "build", "mpi_driver", "efdem"))
     ap.add_argument("--page", default=PAGE)
     ap.add_argument("--keys", action="store_true", help="print the keys the code reads (TSV) and stop")
+    ap.add_argument("--write-meanings", action="store_true",
+                    help=f"write {os.path.relpath(MEANINGS, ROOT)} from the page and stop")
     a = ap.parse_args()
+    if a.write_meanings:
+        with open(MEANINGS, "w", encoding="utf-8") as f:
+            f.write(meanings_file(page_rows(a.page)))
+        print(f"scene_reference.py: wrote {os.path.relpath(MEANINGS, ROOT)}")
+        return 0
     keys = list_keys(a.efdem)
     if a.keys:
         for k, v in keys.items():
@@ -165,6 +199,10 @@ def main():
     for k, row in rows.items():
         if k not in keys and k.split(".")[-1] not in literals:
             errors.append(f"{os.path.relpath(a.page, ROOT)}:{row['line']}: `{k}` is documented but nothing reads it")
+    with open(MEANINGS, encoding="utf-8") as f:
+        if f.read() != meanings_file(rows):
+            errors.append(f"{os.path.relpath(MEANINGS, ROOT)} is not the page's meanings: run "
+                          "/usr/bin/python3 scripts/scene_reference.py --write-meanings and rebuild")
     if errors:
         print("scene_reference.py: docs/scene_reference.md does not match the code:\n  " + "\n  ".join(errors))
         return 1

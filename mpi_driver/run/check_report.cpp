@@ -9,6 +9,7 @@
 
 #include "core/version.hpp"
 #include "dem/scene.hpp"
+#include "mpi_driver/run/ensemble_size.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -17,9 +18,9 @@ std::string check_report(const ParamTable& table, const RunSettings& settings,
     std::string out;
     auto line = [&out](const std::string& s) { out += s + "\n"; };
     line(fmt::format("efdem {} ({}) --check {}", version(), git_hash(), table.file()));
-    line(fmt::format("mode: {}; ensemble: R = {} ranks x {} per rank = {} realizations; seed {}",
-                     settings.mode_name(), n_ranks, settings.realizations_per_rank,
-                     n_ranks * settings.realizations_per_rank, settings.seed));
+    line(fmt::format("mode: {}; ensemble: R = {}{}; seed {}", settings.mode_name(),
+                     ensemble_size(n_ranks, settings.realizations_per_rank),
+                     n_ranks == 1 ? " (--check --ranks=N: as run on N ranks)" : "", settings.seed));
     const auto& p = sys.particles();
     std::map<int, long> per_species;
     for (auto s : p.species()) ++per_species[s];

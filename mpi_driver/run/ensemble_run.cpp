@@ -20,6 +20,7 @@
 #include "mpi_driver/parallel/ensemble_layout.hpp"
 #include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/run/driver.hpp"
+#include "mpi_driver/run/ensemble_size.hpp"
 #include "mpi_driver/run/run_end.hpp"
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_provenance.hpp"
@@ -108,11 +109,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         }
         log::info("restarted from {} at t = {:.6g}", restart->path.string(), local.front()->time());
     }
-    log::info(
-        "efdem {}: {} run of {} on {} ranks x {} = {} realizations ({} particles each), output "
-        "{}/{}.*",
-        version(), prov.mode, table.file(), mpi.size(), s.realizations_per_rank, prov.realizations,
-        local.front()->particles(), s.output.directory.string(), s.output.prefix);
+    log::info("efdem {}: {} run of {} on {} ({} particles each), output {}/{}.*", version(),
+              prov.mode, table.file(), ensemble_size(mpi.size(), s.realizations_per_rank),
+              local.front()->particles(), s.output.directory.string(), s.output.prefix);
 
     StepperSettings ss;
     ss.sample_interval = s.observe.interval;

@@ -1,6 +1,8 @@
 #include "mpi_driver/run/listings.hpp"
 
+#include <map>
 #include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -44,9 +46,17 @@ bool print_listing(RunOptions::Action action) {
 }
 
 void print_keys(const ParamTable& table) {
-    std::string out;
-    for (const auto& d : table.declarations())
-        out += fmt::format("{}\t{}\t{}\n", d.key, d.expected, d.required ? "required" : d.fallback);
+    // The first sentence of each key's meaning in docs/scene_reference.md.
+    static const std::map<std::string_view, std::string_view> meanings = {
+#include "mpi_driver/run/key_meanings.inc"
+    };
+    std::string out = "key\tallowed\tdefault\tmeaning\n";
+    for (const auto& d : table.declarations()) {
+        const auto m = meanings.find(d.key);
+        out +=
+            fmt::format("{}\t{}\t{}\t{}\n", d.key, d.expected, d.required ? "required" : d.fallback,
+                        m == meanings.end() ? std::string_view() : m->second);
+    }
     log::output(out);
 }
 

@@ -66,7 +66,11 @@ std::string RunOptions::usage() {
     return R"(efdem - equation-free (coarse projective) computation on MPI ensembles of DEM runs
 
 usage:
-  mpirun -np P efdem SCENE [key=value ...]    run the scene (direct or cpi mode)
+  mpirun -np P efdem SCENE [key=value ...]    run the scene in its mode (key `mode`): direct (every
+                                              realization simulated throughout), cpi (coarse
+                                              projective integration), steady (the coarse steady
+                                              state by Newton-GMRES and its eigenvalues) or
+                                              continuation (the steady state along a parameter)
   mpirun -np P efdem SCENE restart=FILE [...] continue from a checkpoint
   efdem --check SCENE [key=value ...]         read the scene, build one realization, report the
                                               active effects and everything derived from the
@@ -74,8 +78,9 @@ usage:
   efdem --check --ranks=N SCENE [...]         as --check, for a run on N ranks (what a batch
                                               script checks before it launches N)
   efdem --list-keys SCENE [key=value ...]     as --check, then every key the scene's set-up read
-                                              (tab-separated: key, what it accepts, default or
-                                              'required'); all keys: docs/scene_reference.md
+                                              (tab-separated, with a header: key, what it
+                                              accepts, default or 'required', meaning); all
+                                              keys: docs/scene_reference.md
   efdem --list-effects                        the effects a scene can list, with a summary
   efdem --version                             version, git hash, build
   efdem --help                                this text
@@ -84,7 +89,9 @@ key=value arguments override the scene file (e.g. seed=7 output.directory=runs/a
 restart=FILE continues the run saved in the checkpoint FILE (checkpoint.interval = N writes
 one every N coarse steps, or N samples in direct mode); the scene must have the same physics
 unless restart.allow_physics_change=true.
-Exit codes: 0 success, 2 input error (nothing was computed), 3 failure while running.
+Exit codes: 0 success, 2 input error (nothing was computed), 3 failure while running,
+4 stopped by a signal (SIGTERM, SIGINT, SIGUSR1) with a checkpoint to continue from (the
+message names it and the restart= command).
 Documentation: README.md, docs/ (effects in docs/effects/).
 )";
 }

@@ -61,3 +61,13 @@ TEST_CASE("values: what is allowed, and how a value is shown", "[unit][params]")
           "gravity pair_contact");
     CHECK(show_param_value(std::vector<double>{1.5, 2}) == "1.5 2");
 }
+
+TEST_CASE("a computed bound is shown as a user would write it", "[unit][params]") {
+    // pair_contact.kt's lower bound is 1e-6 x kn: for kn = 2e5 the double is 0.19999999999999998,
+    // which the allowed text used to show; 15 significant digits show 0.2 (a double has 15-17,
+    // so every bound a user types, e.g. 1e-09 or 1000000, reads as typed).
+    CHECK(param_value_expected<double>(Bounds::closed(1e-6 * 2e5, 2e5)) ==
+          "a finite real number in [0.2, 200000]");
+    CHECK(param_value_expected<double>(Bounds::at_least(1e-09)) == "a finite real number >= 1e-09");
+    CHECK(param_value_expected<double>(Bounds::positive()) == "a finite real number > 0");
+}
