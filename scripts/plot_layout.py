@@ -40,12 +40,27 @@ def _overlaps(a, b):
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
+def line_pixels(ax, step=3.0):
+    """Window points every `step` pixels along the lines drawn in `ax` (curves, reference lines),
+    for labels to keep off them."""
+    out = []
+    for line in ax.get_lines():
+        xy = line.get_transform().transform(np.asarray(line.get_xydata(), dtype=float))
+        xy = xy[np.all(np.isfinite(xy), axis=1)]
+        if line.get_linestyle() in ("None", "none", "", " ") or len(xy) < 2:
+            continue
+        for a, b in zip(xy[:-1], xy[1:]):
+            n = max(1, int(np.hypot(*(b - a)) / step))
+            out.extend(a + (b - a) * f for f in np.linspace(0, 1, n + 1))
+    return out
+
+
 def place_labels(ax, xs, ys, texts, fontsize=7, marker_px=5.0):
     """Labels the points (xs, ys) of `ax` with `texts`, each where its box overlaps no other label,
     no point (a square of 2 marker_px around each) and stays inside the axes: the nearest free
     position of a ring of candidates around its point, farther rings until one is free, joined to
-    its point by a thin line when it is not beside it. Call after the layout is final. Returns
-    the annotations."""
+    its point by a thin line when it is not beside it; it keeps off the lines drawn (line_pixels)
+    too. Call after the layout is final. Returns the annotations."""
     fig = ax.figure
     renderer = fig.canvas.get_renderer()
     to_px = fig.dpi / 72.0
@@ -53,6 +68,7 @@ def place_labels(ax, xs, ys, texts, fontsize=7, marker_px=5.0):
     frame = ax.get_window_extent(renderer)
     frame = (frame.x0, frame.y0, frame.x1, frame.y1)
     taken = [(x - marker_px, y - marker_px, x + marker_px, y + marker_px) for x, y in pts]
+    taken += [(x - 1, y - 1, x + 1, y + 1) for x, y in line_pixels(ax)]
     out = []
     # Crowded points first: they have the fewest free places.
     order = np.argsort([-sum(np.hypot(*(p - q)) < 40 for q in pts) for p in pts], kind="stable")
