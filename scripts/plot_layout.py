@@ -55,7 +55,7 @@ def line_pixels(ax, step=3.0):
     return out
 
 
-def place_labels(ax, xs, ys, texts, fontsize=7, marker_px=5.0):
+def place_labels(ax, xs, ys, texts, fontsize=7, marker_px=5.0, avoid=()):
     """Labels the points (xs, ys) of `ax` with `texts`, each where its box overlaps no other label,
     no point (a square of 2 marker_px around each) and stays inside the axes: the nearest free
     position of a ring of candidates around its point, farther rings until one is free, joined to
@@ -69,6 +69,9 @@ def place_labels(ax, xs, ys, texts, fontsize=7, marker_px=5.0):
     frame = (frame.x0, frame.y0, frame.x1, frame.y1)
     taken = [(x - marker_px, y - marker_px, x + marker_px, y + marker_px) for x, y in pts]
     taken += [(x - 1, y - 1, x + 1, y + 1) for x, y in line_pixels(ax)]
+    if len(avoid):  # other markers (data coordinates) that carry no label
+        taken += [(x - marker_px, y - marker_px, x + marker_px, y + marker_px)
+                  for x, y in ax.transData.transform(np.asarray(avoid, dtype=float))]
     out = []
     # Crowded points first: they have the fewest free places.
     order = np.argsort([-sum(np.hypot(*(p - q)) < 40 for q in pts) for p in pts], kind="stable")
