@@ -63,6 +63,8 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
+import plot_layout  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
 sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
@@ -263,21 +265,55 @@ def analyse(args):
     with open(os.path.join(args.results, "analysis.json"), "w") as f:
         json.dump({"runs": rows, "noise_floors": floors}, f, indent=1)
     if rows:
-        fig, axes = plt.subplots(1, len(args.bed.speeds), figsize=(11, 4.2), sharey=True)
-        for ax, u in zip(np.atleast_1d(axes), args.bed.speeds):
-            for row in (r for r in rows if r["u"] == u):
-                colour = "C0" if row["run"].startswith("adaptive") else "C3"
-                ax.plot(row["speedup_dem"], row["ratio"], "o", color=colour)
-                ax.plot(row["speedup_wall"], row["ratio"], "s", mfc="none", color=colour)
-                ax.annotate(row["run"].replace("adaptive_", ""), (row["speedup_dem"], row["ratio"]), fontsize=8,
-                            xytext=(4, 4), textcoords="offset points")
-            ax.axhline(1.0, color="k", lw=0.8, ls="--")
-            ax.set_title(f"{args.bed.label.split(' (')[0]}, U_s = {u:g}, R = {args.realizations}")
-            ax.set_xlabel("speed-up over a direct ensemble [-] (filled: DEM time, open: wall time)")
-        np.atleast_1d(axes)[0].set_ylabel("error / empirical noise floor [-]")
-        fig.tight_layout()
-        fig.savefig(os.path.join(args.results, "error_vs_speedup.png"), dpi=120)
+        plot_error_vs_speedup(args, rows)
     print("\n".join(report))
+
+
+def run_codes(args, shown):
+    """Legend lines: what each plotted run code means, from runs() itself, per U_s where the
+    settings differ between them."""
+    shared = base(args.bed.speeds[0], args.bed, args.realizations, args.np)
+    shared = ", ".join(f"{k} = {v}" for k, v in shared.items() if k.startswith("cpi."))
+    lines = [f"run codes (every CPI run: {shared} unless named; tol: cpi.tolerance in d_p):"]
+    for code in dict.fromkeys(name for u in args.bed.speeds for name, *_ in runs(u, args.bed)):
+        if code not in shown:
+            continue
+        per_u = {u: next(((seed, extra) for name, _, seed, extra in runs(u, args.bed) if name == code), None)
+                 for u in args.bed.speeds}
+        settings = {u: f"seed {v[0]}, " + ", ".join(f"{k} = {x}" for k, x in v[1].items()) for u, v in per_u.items() if v}
+        if len(set(settings.values())) == 1:
+            lines.append(f"{code.replace('adaptive_', '')}: {next(iter(settings.values()))}")
+        else:
+            lines += [f"{code.replace('adaptive_', '')} (U_s = {u:g}): {text}" for u, text in settings.items()]
+    return [plot_layout.text_entry(line) for line in lines]
+
+
+def plot_error_vs_speedup(args, rows):
+    fig, axes = plt.subplots(1, len(args.bed.speeds), figsize=(11, 8), sharey=True)
+    axes = np.atleast_1d(axes)
+    for ax, u in zip(axes, args.bed.speeds):
+        mine = [r for r in rows if r["u"] == u]
+        for row in mine:
+            colour = "C0" if row["run"].startswith("adaptive") else "C3"
+            ax.plot(row["speedup_dem"], row["ratio"], "o", color=colour)
+            ax.plot(row["speedup_wall"], row["ratio"], "s", mfc="none", color=colour)
+        ax.axhline(1.0, color="k", lw=0.8, ls="--")
+        ax.set_title(f"{args.bed.label.split(' (')[0]}, U_s = {u:g}, R = {args.realizations}")
+        ax.set_xlabel("speed-up over a direct ensemble [-]")
+    axes[0].set_ylabel("error / empirical noise floor [-]")
+    handles = [Line2D([], [], color="C0", marker="o", ls="none", label="adaptive CPI, speed-up in DEM time"),
+               Line2D([], [], color="C0", marker="s", mfc="none", ls="none", label="adaptive CPI, speed-up in wall time"),
+               Line2D([], [], color="C3", marker="o", ls="none", label="fixed-DT CPI, speed-up in DEM time"),
+               Line2D([], [], color="C3", marker="s", mfc="none", ls="none", label="fixed-DT CPI, speed-up in wall time"),
+               Line2D([], [], color="k", lw=0.8, ls="--", label="error = noise floor (as good as a direct ensemble)")]
+    plot_layout.legend_beside(fig, handles + run_codes(args, {r["run"] for r in rows}), side="bottom")
+    for ax, u in zip(axes, args.bed.speeds):
+        mine = [r for r in rows if r["u"] == u]
+        # Both markers of a run are avoided; the label goes to the DEM-time (filled) one.
+        plot_layout.place_labels(ax, [r["speedup_dem"] for r in mine], [r["ratio"] for r in mine],
+                                 [r["run"].replace("adaptive_", "") for r in mine], fontsize=8,
+                                 avoid=[(r["speedup_wall"], r["ratio"]) for r in mine])
+    fig.savefig(os.path.join(args.results, "error_vs_speedup.png"), dpi=120)
 
 
 def main():

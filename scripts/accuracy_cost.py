@@ -28,6 +28,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import accuracy_metrics as am  # noqa: E402
+import plot_layout  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
 # The scenes of the study are checked in; the study only overrides keys. Full study: the demo bed
 # (the paper's model, 1,000 spheres in 7.5 x 7.5: 1/12 of the particles). --quick: the tiny bed
@@ -156,52 +158,68 @@ def analyse(run, ref):
                 ideal=run["simulated_time"] / max(run["dem_time"], 1e-12), R=R)
 
 
-def plots(args, rows, refs, loaded):
+def run_codes(quick, names):
+    """Legend lines that say what each run code in `names` means: its settings, from the study's
+    own list (study_runs), after a line with the settings every CPI run shares."""
+    _, base = SCENES[quick]
+    shared = ", ".join(f"{k} = {base[k]}" for k in ("cpi.warmup", "cpi.healing", "cpi.window"))
+    lines = [f"run codes (every CPI run: {shared} unless named):"]
+    for name, us, mode, R, overrides in study_runs(quick):
+        if name in names:
+            settings = ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in overrides.items())
+            lines.append(f"{name}: {mode}, U_s = {us}, R = {R}" + (f", {settings}" if settings else ""))
+    return [plot_layout.text_entry(line) for line in lines]
+
+
+def finish(fig, ax, handles, rows, x, y, path, quick):
+    """The legend and the run codes beside the axes, each point labelled with its code where the
+    label covers no other, and the figure written."""
+    plot_layout.legend_beside(fig, handles + run_codes(quick, {r["name"] for r in rows}), side="right")
+    plot_layout.place_labels(ax, [r[x] for r in rows], [r[y] for r in rows], [r["name"] for r in rows], fontsize=6)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def plots(args, rows, refs):
     out = args.out
     # 1. error vs wall time, Pareto front labelled
-    fig, ax = plt.subplots(figsize=(8, 5.5), dpi=120)
+    fig, ax = plt.subplots(figsize=(12, 5.5), dpi=120)
     pts = [(r["wall"], r["error"]) for r in rows]
     front = set(am.pareto_front(pts))
     for i, r in enumerate(rows):
         ax.scatter(r["wall"], r["error"], c="C3" if i in front else "C0", s=30, zorder=3)
-        ax.annotate(r["name"], (r["wall"], r["error"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
     fr = sorted(front, key=lambda i: pts[i][0])
-    ax.plot([pts[i][0] for i in fr], [pts[i][1] for i in fr], "C3-", lw=1, label="Pareto front")
-    for us, ref in refs.items():
-        ax.axvline(ref["wall_seconds"], color="grey", ls=":", lw=1)
-        ax.annotate(f"direct R={int(ref['realizations'])} (U_s={us})", (ref["wall_seconds"], ax.get_ylim()[1]),
-                    fontsize=6, rotation=90, va="top")
+    ax.plot([pts[i][0] for i in fr], [pts[i][1] for i in fr], "C3-", lw=1)
+    handles = [Line2D([], [], color="C3", marker="o", lw=1, label="CPI run on the Pareto front"),
+               Line2D([], [], color="C0", marker="o", ls="none", label="CPI run off the front")]
+    for (us, ref), ls in zip(refs.items(), (":", "-.")):
+        ax.axvline(ref["wall_seconds"], color="grey", ls=ls, lw=1)
+        handles.append(Line2D([], [], color="grey", ls=ls, lw=1,
+                              label=f"wall time of the direct reference, U_s = {us} (R = {int(ref['realizations'])})"))
     ax.set_xlabel("wall time of the run [s] (2 cores)")
     ax.set_ylabel("RMS error of the mean ICDF vs direct [$d_p$]")
     ax.set_title("Accuracy against cost")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "error_vs_wall_time.png"))
-    plt.close(fig)
+    finish(fig, ax, handles, rows, "wall", "error", os.path.join(out, "error_vs_wall_time.png"), args.quick)
     # 2. speed-up vs DT, colour = error
     dt_rows = [r for r in rows if r["name"].startswith(("DT", "U041"))]
     if dt_rows:
-        fig, ax = plt.subplots(figsize=(7, 5), dpi=120)
+        fig, ax = plt.subplots(figsize=(11, 5), dpi=120)
         sc = ax.scatter([r["dt"] for r in dt_rows], [r["speedup"] for r in dt_rows],
-                        c=[r["error"] for r in dt_rows], cmap="viridis", s=60, label="wall time")
+                        c=[r["error"] for r in dt_rows], cmap="viridis", s=60, label="wall-time speed-up (colour: error)")
         # The DEM-time ("ideal") speed-up: what the method buys, whatever the machine's load.
         ax.scatter([r["dt"] for r in dt_rows], [r["ideal"] for r in dt_rows], facecolors="none",
-                   edgecolors="k", s=60, label="DEM time (ideal)")
-        for r in dt_rows:
-            ax.annotate(r["name"], (r["dt"], r["speedup"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+                   edgecolors="k", s=60, label="DEM-time speed-up (ideal)")
         fig.colorbar(sc, ax=ax, label="RMS error [$d_p$]")
         ax.set_xlabel(r"projective step DT [$\sqrt{d_p/g}$]")
         ax.set_ylabel("speed-up vs direct (equal R)")
-        ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "speedup_vs_dt.png"))
-        plt.close(fig)
+        finish(fig, ax, ax.get_legend_handles_labels()[0], dt_rows, "dt", "speedup",
+               os.path.join(out, "speedup_vs_dt.png"), args.quick)
     # 3. error vs R with the 1/sqrt(R) noise floor
     r_rows = [r for r in rows if r["name"].startswith("R") or r["name"] in ("DT80", "DT12")]
     if r_rows:
-        fig, ax = plt.subplots(figsize=(7, 5), dpi=120)
+        fig, ax = plt.subplots(figsize=(9, 5), dpi=120)
         Rs = np.array([r["R"] for r in r_rows])
         ax.loglog(Rs, [r["error"] for r in r_rows], "o", label="measured RMS error")
         ax.loglog(Rs, [r["noise_floor"] for r in r_rows], "s", mfc="none", label="standard error of a mean of R")
@@ -210,27 +228,26 @@ def plots(args, rows, refs, loaded):
         ax.set_xlabel("realizations R")
         ax.set_ylabel("RMS error [$d_p$]")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
-        fig.tight_layout()
+        plot_layout.legend_beside(fig, ax.get_legend_handles_labels()[0], side="right")
         fig.savefig(os.path.join(out, "error_vs_realizations.png"))
         plt.close(fig)
     # 4. predicted noise amplification vs measured error
     pr = [r for r in rows if math.isfinite(r["predicted"]) and r["dt"] > 0]
     if pr:
-        fig, ax = plt.subplots(figsize=(6, 5), dpi=120)
-        ax.scatter([r["predicted"] for r in pr], [r["error"] for r in pr])
-        for r in pr:
-            ax.annotate(r["name"], (r["predicted"], r["error"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        fig, ax = plt.subplots(figsize=(10, 5), dpi=120)
+        ax.scatter([r["predicted"] for r in pr], [r["error"] for r in pr], label="CPI run")
         lim = max(max(r["predicted"] for r in pr), max(r["error"] for r in pr)) * 1.1
         ax.plot([0, lim], [0, lim], "k:", lw=1, label="measured = predicted")
         ax.set_xlabel(r"predicted projection noise $DT/W\,\sqrt{12/n}\,\sigma_R$ [$d_p$]")
         ax.set_ylabel("measured RMS error [$d_p$]")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "predicted_vs_measured.png"))
-        plt.close(fig)
-    # 5. ICDF trajectories: the reference and two CPI runs, with bands
+        finish(fig, ax, ax.get_legend_handles_labels()[0], pr, "predicted", "error",
+               os.path.join(out, "predicted_vs_measured.png"), args.quick)
+
+
+def icdf_plot(args, rows):
+    """ICDF trajectories: the reference and a CPI run, with their 95 % intervals."""
+    out = args.out
     import plot_icdf
     # The reference and the paper-like step (DT = 4 x burst), or the largest DT of a quick study.
     main_run = next((r["name"] for r in rows if r["name"] in ("DT80", "DT12")), rows[0]["name"])
@@ -270,7 +287,8 @@ def main(argv=None):
         a = analyse(run, refs[us])
         rows.append(dict(name=name, us=us, wall=float(run["wall_seconds"]), particle_steps=float(run["particle_steps"]),
                          steps=run.get("steps", 0), repairs=run.get("repairs", 0), **a))
-    plots(args, rows, refs, loaded)
+    plots(args, rows, refs)
+    icdf_plot(args, rows)
     with open(os.path.join(args.out, "accuracy_cost.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()

@@ -6,11 +6,14 @@ same times, and what the CPI run cost, each number labelled with what it is.
 
 * Agreement, over the sample times both runs recorded (CPI records its bursts only) and every
   node of the light-particle ICDF: the RMS difference of the two ensemble means; the share of CPI
-  points inside the direct ensemble's 95 % band of its mean at the same time (mean +- 1.96
-  sqrt(var / R)); and the share within 1.96 standard errors of the difference of the two means
-  (both ensembles' noise; about 95 % if CPI were exact). With independent seeds and equal
-  spreads, an exact CPI would lie inside the direct band for only about 83 % of the points (the
-  difference of two such means has sqrt(2) times the standard error of one).
+  points inside the direct ensemble's 95 % Student-t interval of its mean at the same time
+  (mean +- t(0.975, R - 1) sqrt(var / R), scripts/ensemble_bands.py); and the share inside Welch's
+  95 % Student-t interval of the difference of the two means (both ensembles' noise,
+  Welch-Satterthwaite degrees of freedom; about 95 % if CPI were exact). With independent seeds
+  and equal spreads, an exact CPI would lie inside the direct interval for fewer of the points
+  (the difference of two such means has sqrt(1 + R_direct / R_cpi) times the standard error of
+  one): the summary prints that share for the two R (R = 4 and 4: 89 %). A run of one
+  realization has no interval: the summary says so instead of a share.
   Beside them the noise floor of this comparison: the RMS difference two exact, independent
   ensembles of these sizes would show, sqrt(mean(se_direct^2 + se_cpi^2)) from the two
   ensembles' own spreads, and CPI's RMS difference as a multiple of it.
@@ -27,10 +30,10 @@ import sys
 
 import numpy as np
 
+import ensemble_bands
 import run_files
 
 NEEDED = ["p", "samples/time", "samples/mean", "samples/variance"]
-Z95 = 1.959964  # two-sided 95 % quantile of the normal distribution
 
 
 def load(path, mode):
@@ -41,6 +44,7 @@ def load(path, mode):
             raise run_files.UsageError(f"{path}: a {got} run; expected the {mode} run here "
                                        "(arguments: DIRECT.h5 CPI.h5)")
         run = {k: f[k][:] for k in NEEDED}
+        run["realizations_used"] = run_files.realizations_per_sample(f)
         for k in ("realizations", "simulated_time", "dem_time", "wall_seconds", "particle_steps"):
             if k not in f.attrs:
                 raise run_files.UsageError(f"{path}: no '{k}' attribute (end_status "
@@ -69,23 +73,37 @@ def agreement(d, c):
     if len(common) == 0:
         raise run_files.UsageError("the two runs share no sample time (other observe.interval or time spans)")
     md, mc = d["samples/mean"][i_d], c["samples/mean"][i_c]
-    se_d = np.sqrt(d["samples/variance"][i_d] / d["realizations"])
-    se_c = np.sqrt(c["samples/variance"][i_c] / c["realizations"])
+    # The realizations in each mean at each common time, as a column against the nodes.
+    n_d, n_c = d["realizations_used"][i_d][:, None], c["realizations_used"][i_c][:, None]
+    var_d, var_c = d["samples/variance"][i_d], c["samples/variance"][i_c]  # unbiased (R - 1) variances
+    se_d, se_c = np.sqrt(var_d / n_d), np.sqrt(var_c / n_c)
     diff = mc - md
     ok = np.isfinite(diff)  # a mean is NaN only where no realization was left
     if not ok.any():
         raise run_files.UsageError("no finite ensemble mean at the common sample times")
     floor = np.sqrt(se_d ** 2 + se_c ** 2)  # RMS difference of two exact independent ensembles
-    inside_direct = np.abs(diff) <= Z95 * se_d
-    inside_difference = np.abs(diff) <= Z95 * floor
+    band_d = ensemble_bands.half_width(var_d, n_d)  # NaN where the direct run has one realization
+    band_diff = ensemble_bands.welch_half_width(var_d, n_d, var_c, n_c)
     return {
         "times": len(common), "t_first": float(common[0]), "t_last": float(common[-1]),
         "points": int(ok.sum()),
         "rms": float(np.sqrt(np.mean(diff[ok] ** 2))),
         "floor": float(np.sqrt(np.mean(floor[ok] ** 2))),
-        "inside_direct_band": float(np.mean(inside_direct[ok])),
-        "inside_difference_band": float(np.mean(inside_difference[ok])),
+        "inside_direct_band": share_inside(diff[ok], band_d[ok]),
+        "inside_difference_band": share_inside(diff[ok], band_diff[ok]),
+        "exact_inside_direct_band": ensemble_bands.exact_coverage_of_other_band(d["realizations"], c["realizations"]),
     }
+
+
+def share_inside(diff, half):
+    """The share of the differences inside +- half, or NaN where no point has an interval
+    (one realization)."""
+    has = np.isfinite(half)
+    return float(np.mean(np.abs(diff[has]) <= half[has])) if has.any() else float("nan")
+
+
+def percent(share, none):
+    return f"{100 * share:.0f} %" if np.isfinite(share) else none
 
 
 def ratio(a, b):
@@ -124,10 +142,12 @@ def summary(d, c):
     lines.append(f"  noise floor of this comparison (RMS difference of two exact independent ensembles of these "
                  f"sizes, from their own spread): {a['floor']:.3f} d_p; CPI's difference is "
                  f"{ratio(a['rms'], a['floor']):.2f}x the floor")
-    lines.append(f"  CPI inside the direct ensemble's 95 % band of its mean: {100 * a['inside_direct_band']:.0f} % "
-                 "of points (an exact CPI with independent seeds and equal spread: about 83 %)")
-    lines.append(f"  CPI within 1.96 standard errors of the difference of the two means: "
-                 f"{100 * a['inside_difference_band']:.0f} % (an exact CPI: about 95 %)")
+    no_band = "no interval (R = 1: one realization has no spread)"
+    lines.append(f"  CPI inside the direct ensemble's 95 % Student-t interval of its mean: "
+                 f"{percent(a['inside_direct_band'], no_band)} of points (an exact CPI with independent seeds and "
+                 f"equal spread: {percent(a['exact_inside_direct_band'], 'no interval')})")
+    lines.append(f"  CPI inside Welch's 95 % Student-t interval of the difference of the two means: "
+                 f"{percent(a['inside_difference_band'], no_band)} (an exact CPI: about 95 %)")
     lines.append(f"cost: DEM-time speed-up of CPI (simulated / DEM time) {ratio(c['simulated_time'], c['dem_time']):.2f}x; "
                  f"wall-time ratio direct / CPI {ratio(d['wall_seconds'], c['wall_seconds']):.2f}x for the run loops, "
                  f"{ratio(d['total_wall_seconds'], c['total_wall_seconds']):.2f}x for the whole runs (settling included)")

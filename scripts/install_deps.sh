@@ -14,7 +14,7 @@ packages=(
   libhdf5-openmpi-dev zlib1g-dev
   libfmt-dev
   catch2
-  python3-matplotlib python3-h5py python3-numpy
+  python3-matplotlib python3-h5py python3-numpy python3-scipy
 )
 if [ "${EFDEM_WITH_LAMMPS:-0}" = "1" ]; then
   packages+=(lammps)

@@ -2,11 +2,16 @@
 """Plot the bed quantities an efdem run recorded with observe.bed = true: the pressure drop
 over the bed weight per area, the bed height, each species' mean height and the Lacey mixing
 index against time, and the solid-fraction profile phi(z) at a few times. Ensemble means as
-lines, the realizations' range as a band.
+lines, with the 95 % Student-t interval of the mean of the R realizations as a band (as in
+plot_icdf.py, scripts/ensemble_bands.py; none for R = 1). One legend below the panels says what
+every colour, line style and band means: a run is a colour and a line style in every time panel
+(the species panel keeps the run's line style and gives each species its own colour, none of the
+runs' colours), the phi(z) times are shades of grey.
 
     /usr/bin/python3 scripts/plot_bed.py RUN.h5 [RUN2.h5 ...] -o bed.png [--profiles 4]
 
-Needs Debian's python3-matplotlib, python3-h5py and python3-numpy (run it with /usr/bin/python3).
+Needs Debian's python3-matplotlib, python3-h5py, python3-numpy and python3-scipy (run it with
+/usr/bin/python3).
 Exit code 2 with a message for a file that is missing, not an HDF5 run file, or has no /bed.
 """
 import argparse
@@ -24,8 +29,19 @@ try:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    import ensemble_bands
+    import plot_layout
 except ImportError as e:  # another python3 than Debian's
-    sys.exit(f"plot_bed.py: {e}; run it with /usr/bin/python3 (Debian python3-matplotlib python3-h5py)")
+    sys.exit(f"plot_bed.py: {e}; run it with /usr/bin/python3 (Debian python3-matplotlib python3-h5py python3-scipy)")
+
+# One meaning per colour: runs take RUN_COLOURS (with STYLES) in every time panel; species take
+# SPECIES_COLOURS, none of the runs'; the phi(z) profiles' times are greys.
+RUN_COLOURS = ["C0", "C1", "C9", "C8"]
+SPECIES_COLOURS = ["C2", "C4", "C5", "C6"]
+STYLES = ["-", "--", ":", "-."]
 
 
 def load(path):
@@ -43,11 +59,36 @@ def load(path):
         }
 
 
-def band(ax, t, rows, label, style, colour=None):
-    mean = np.nanmean(rows, axis=1)
-    line, = ax.plot(t, mean, style, color=colour, lw=1.2, label=label)
-    if rows.shape[1] > 1:
-        ax.fill_between(t, np.nanmin(rows, axis=1), np.nanmax(rows, axis=1), color=line.get_color(), alpha=0.15, lw=0)
+def band(ax, t, rows, style, colour):
+    """The mean of rows (samples, realizations; NaN for a dropped one) and its 95 % interval."""
+    mean, half = ensemble_bands.sample_half_width(rows)
+    ax.plot(t, mean, style, color=colour, lw=1.2)
+    if np.isfinite(half).any():
+        ax.fill_between(t, mean - half, mean + half, color=colour, alpha=0.15, lw=0)
+
+
+def legend_entries(runs, first, picks):
+    """The figure legend: runs, species, the band's meaning, the phi(z) times."""
+    handles = []
+    for k, r in enumerate(runs):
+        label = f"{r['name']} ({r['mode']}, R = {r['R']})"
+        if r["R"] < 2:
+            label += "; " + ensemble_bands.NO_BAND_LABEL
+        handles.append(Line2D([], [], color=RUN_COLOURS[k % len(RUN_COLOURS)], ls=STYLES[k % len(STYLES)],
+                              label=label))
+    for j, name in enumerate(first["species"]):
+        handles.append(Line2D([], [], color=SPECIES_COLOURS[j % len(SPECIES_COLOURS)], lw=3,
+                              label=f"{name} species (mean height panel; line style: the run)"))
+    if any(r["R"] > 1 for r in runs):
+        handles.append(Patch(color="0.5", alpha=0.3, lw=0, label=f"band: {ensemble_bands.BAND_LABEL}"))
+    for n, i in enumerate(picks):
+        handles.append(Line2D([], [], color=grey(n, len(picks)), lw=1.2,
+                              label=f"$\\phi(z)$ at t = {first['t'][i]:.4g}"))
+    return handles
+
+
+def grey(n, count):
+    return str(0.7 - 0.7 * n / max(count - 1, 1))
 
 
 def main(argv=None):
@@ -60,23 +101,21 @@ def main(argv=None):
         runs = [load(p) for p in a.runs]
     except run_files.UsageError as e:
         run_files.fail("plot_bed.py", e)
-    fig, axes = plt.subplots(2, 3, figsize=(14, 7.5))
+    fig, axes = plt.subplots(2, 3, figsize=(14, 8.5))
     ax_dp, ax_h, ax_mix, ax_sp, ax_phi, ax_exp = axes.ravel()
-    styles = ["-", "--", ":", "-."]
     for k, r in enumerate(runs):
-        s = styles[k % len(styles)]
-        label = f"{r['name']} ({r['mode']}, R = {r['R']})"
-        band(ax_dp, r["t"], r["ratio"], label, s)
-        band(ax_h, r["t"], r["height"], label, s)
-        band(ax_mix, r["t"], r["mixing"], label, s)
-        for j, name in enumerate(r["species"]):
-            band(ax_sp, r["t"], r["species_height"][:, :, j], f"{name}, {r['name']}", s, f"C{j}")
-        band(ax_exp, r["t"], r["height"] / r["height"][0], label, s)
+        s, c = STYLES[k % len(STYLES)], RUN_COLOURS[k % len(RUN_COLOURS)]
+        band(ax_dp, r["t"], r["ratio"], s, c)
+        band(ax_h, r["t"], r["height"], s, c)
+        band(ax_mix, r["t"], r["mixing"], s, c)
+        for j in range(len(r["species"])):
+            band(ax_sp, r["t"], r["species_height"][:, :, j], s, SPECIES_COLOURS[j % len(SPECIES_COLOURS)])
+        band(ax_exp, r["t"], r["height"] / r["height"][0], s, c)
     first = runs[0]
     n = len(first["t"])
     picks = sorted(set(np.linspace(0, n - 1, max(1, a.profiles)).round().astype(int)))
-    for i in picks:
-        ax_phi.plot(first["phi"][i], first["z"], lw=1.2, label=f"t = {first['t'][i]:.4g}")
+    for m, i in enumerate(picks):
+        ax_phi.plot(first["phi"][i], first["z"], lw=1.2, color=grey(m, len(picks)))
     ax_dp.axhline(1.0, color="0.5", lw=0.8)
     ax_dp.set(xlabel=r"t [$\sqrt{d_p/g}$]", ylabel=r"$\Delta P\,/\,(W/A)$ [-]", title="pressure drop / bed weight per area")
     ax_h.set(xlabel=r"t [$\sqrt{d_p/g}$]", ylabel=r"bed height H$_{99}$ [$d_p$]", title="bed height (99 % of the solid volume below)")
@@ -87,8 +126,7 @@ def main(argv=None):
                title=f"$\\phi(z)$, ensemble mean of {first['name']} (slabs of {first['dz']:g} $d_p$)")
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
+    plot_layout.legend_beside(fig, legend_entries(runs, first, picks), side="bottom", ncol=3)
     fig.savefig(a.output, dpi=110)
     print(f"plot_bed.py: wrote {a.output}")
     return 0

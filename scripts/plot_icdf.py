@@ -4,15 +4,18 @@ overlay several runs (e.g. a direct and a CPI ensemble of the same scene).
 
     /usr/bin/python3 scripts/plot_icdf.py RUN.h5 [RUN2.h5 ...] -o icdf.png [--nodes 0.1 0.5 0.9]
 
-Each selected node p_i is drawn as a line Q(p_i)(t) with a 95 % band of the ensemble mean
-(mean +- 1.96 sqrt(variance / R)); the colour is the node, the line style the run's mode (the
+Each selected node p_i is drawn as a line Q(p_i)(t) with the 95 % Student-t interval of the
+mean of the R realizations as a band (mean +- t(0.975, R - 1) sqrt(variance / R),
+scripts/ensemble_bands.py; a run of R = 1 has no band and its legend entry says so); the legend,
+beside the axes, names the band. The colour is the node, the line style the run's mode (the
 run file's `mode` attribute): direct solid, CPI dashed (a second run of the same mode dotted or
 dash-dotted). CPI runs show as bursts (their samples) separated by the projective jumps (from
 /cpi/t_end, /cpi/dt, /cpi/status; rejected jumps are not part of the trajectory), drawn as thin
 dotted connectors, like Fig. 2 of Moon et al. (2007); a vertical line marks where the last jump
 landed. The legend names every run (mode, R, seed, jumps, end status if not completed).
 Exit 2 with a message for a missing file, a file that is not an efdem run file, or one without
-samples. Needs Debian's python3-matplotlib, python3-h5py and python3-numpy (/usr/bin/python3).
+samples. Needs Debian's python3-matplotlib, python3-h5py, python3-numpy and python3-scipy
+(/usr/bin/python3).
 """
 import argparse
 import os
@@ -24,8 +27,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 
-import run_files  # noqa: E402  (scripts/run_files.py, beside this script)
+import ensemble_bands  # noqa: E402  (scripts/ensemble_bands.py, beside this script)
+import plot_layout  # noqa: E402
+import run_files  # noqa: E402
 
 
 def load(path):
@@ -42,6 +48,7 @@ def load(path):
             "t": f["samples/time"][:],
             "mean": f["samples/mean"][:],
             "var": f["samples/variance"][:],
+            "R_used": run_files.realizations_per_sample(f),
             "jumps": [],
         }
         if "cpi" in f and "t_end" in f["cpi"] and "dt" in f["cpi"]:
@@ -62,7 +69,10 @@ def run_label(run):
         label += f", {len(run['jumps'])} jump{'s' if len(run['jumps']) != 1 else ''}"
     if not run["status"].startswith("completed"):
         label += f", {run['status'][:40]}"
-    return label + ")"
+    label += ")"
+    if run["R"] < 2:
+        label += "; " + ensemble_bands.NO_BAND_LABEL
+    return label
 
 
 def segments(t, jumps):
@@ -91,7 +101,7 @@ def main(argv=None):
         runs = [load(p) for p in args.runs]
     except run_files.UsageError as e:
         run_files.fail("plot_icdf", e)
-    fig, ax = plt.subplots(figsize=(8, 5.5), dpi=120)
+    fig, ax = plt.subplots(figsize=(12, 5.5), dpi=120)
     # The line style says the mode; a second run of the same mode gets the next variant.
     mode_styles = {"direct": [dict(lw=1.2, ls="-"), dict(lw=1.2, ls=(0, (1, 1)))],
                    "cpi": [dict(lw=2.2, ls="--"), dict(lw=2.2, ls="-.")]}
@@ -106,12 +116,12 @@ def main(argv=None):
         for j, target in enumerate(args.nodes):
             i = int(np.argmin(np.abs(p - target)))
             color = colors[j % len(colors)]
-            half = 1.96 * np.sqrt(run["var"][:, i] / max(run["R"], 1))
+            half = ensemble_bands.half_width(run["var"][:, i], run["R_used"])  # NaN where R < 2
             for a, b in segments(run["t"], run["jumps"]):
                 t = run["t"][a:b]
                 m = run["mean"][a:b, i]
                 ax.plot(t, m, color=color, alpha=0.9, **style)
-                if run["R"] > 1:
+                if np.isfinite(half[a:b]).any():
                     ax.fill_between(t, m - half[a:b], m + half[a:b], color=color, alpha=0.15, lw=0)
             for t0, t1 in run["jumps"]:
                 k0 = np.searchsorted(run["t"], t0 - 1e-9)
@@ -133,13 +143,15 @@ def main(argv=None):
     for j, target in enumerate(args.nodes):
         i = int(np.argmin(np.abs(p0 - target)))
         handles.append(Line2D([], [], color=colors[j % len(colors)], lw=4, label=f"p = {p0[i]:.2f}"))
+    if any(r["R"] > 1 for r in runs):
+        handles.append(Patch(color="0.5", alpha=0.3, lw=0, label=f"band: {ensemble_bands.BAND_LABEL}\n"
+                             r"(mean $\pm$ t(0.975, R$-$1) s/$\sqrt{R}$, s the realizations' sample std)"))
     species = runs[0]["species"]
     ax.set_xlabel(r"time  [$\sqrt{d_p/g}$]")
     ax.set_ylabel(f"height of the {species} particles, ICDF $Q(p)$  [$d_p$]")
-    ax.set_title(args.title or "Ensemble-mean ICDF of particle heights (bands: 95 % of the mean)")
+    ax.set_title(args.title or "Ensemble-mean ICDF of particle heights")
     ax.grid(alpha=0.3)
-    ax.legend(handles=handles, fontsize=7, ncol=1, loc="best")
-    fig.tight_layout()
+    plot_layout.legend_beside(fig, handles, side="right")
     try:
         fig.savefig(args.output)
     except OSError as e:

@@ -52,3 +52,15 @@ def open_run(path, datasets=()):
             raise UsageError(f"{path}: the run file has no {'/' + name if name not in f else 'rows in /' + name} "
                              f"(end_status '{status}': a run that ended before its first sample?)")
     return f
+
+
+def realizations_per_sample(f):
+    """The realizations in the ensemble means at each sample of open run file `f`:
+    /samples/realizations_used (R less those a failure dropped), or the `realizations` attribute
+    for every sample in files without it."""
+    n = len(f["samples/time"])
+    if "samples/realizations_used" in f:
+        return f["samples/realizations_used"][:n].astype(float)
+    import numpy as np
+
+    return np.full(n, float(f.attrs.get("realizations", 1)))

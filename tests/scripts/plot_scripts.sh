@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The scripts that read files (scripts/plot_icdf.py, scripts/demo_summary.py,
+# The scripts that read files (scripts/plot_icdf.py, scripts/plot_bed.py, scripts/demo_summary.py,
 # scripts/plot_validation.py) on real small run files and on bad input:
 # * good input: exit 0; plot_icdf writes the PNG and names each run's mode and line style, and
-#   the CPI run's last projective jump where the run file's /cpi records put it; demo_summary
+#   the CPI run's last projective jump where the run file's /cpi records put it; plot_icdf's and
+#   plot_bed's legends name the band (the 95 % Student-t interval of the mean), sit outside the
+#   axes, and a run of R = 1 has no band and says so; demo_summary
 #   prints its labelled lines, and its numbers are facts of constructed pairs (a CPI file whose
 #   means equal the direct ones: RMS 0, 100 % inside; shifted by 1 d_p: RMS 1.000) and of the
 #   run file (speed-up = simulated_time / dem_time);
@@ -19,9 +21,9 @@ pass() { echo "PASS: $*"; }
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
 # Two small runs of the tiny scene: direct, and cpi with one jump (warm-up 0.5, burst 1.5 to
-# t = 2, jump 1.5 to 3.5, last burst to 5).
+# t = 2, jump 1.5 to 3.5, last burst to 5); with the bed quantities, for plot_bed.
 for mode in direct cpi; do
-  "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=$mode run.duration=5 \
+  "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=$mode run.duration=5 observe.bed=true \
     output.directory="$work" output.prefix=$mode > "$work/$mode.log" 2>&1 \
     || { cat "$work/$mode.log"; echo "FAIL: the $mode run"; exit 1; }
 done
@@ -43,6 +45,57 @@ expect 0 "line style '--', last projective jump lands at t = 3.5" "plot_icdf dir
 [ -s "$work/icdf.png" ] && pass "icdf.png written" || fail "icdf.png not written"
 expect 0 "direct: direct.h5 (R = 2, seed 11): line style '-'" "plot_icdf names the direct run" \
   $py "$src/scripts/plot_icdf.py" "$work/direct.h5" -o "$work/direct.png"
+
+# The legends as drawn: the band named, beside the axes (not over them); R = 1: no band, said.
+# one.h5 is the direct run cut to its first realization (R = 1, variance 0, as efdem writes it).
+$py - "$work" <<'PY' || fail "could not make the R = 1 run file"
+import shutil, sys, h5py
+w = sys.argv[1]
+shutil.copy(f"{w}/direct.h5", f"{w}/one.h5")
+with h5py.File(f"{w}/one.h5", "a") as f:
+    f.attrs["realizations"] = 1
+    f["samples/realizations_used"][...] = 1
+    f["samples/variance"][...] = 0.0
+    for name in ("height", "pressure_drop_ratio", "mixing_index", "species_height"):
+        d = f[f"bed/{name}"][...]
+        d[:, 1:] = float("nan")  # the second realization dropped
+        f[f"bed/{name}"][...] = d
+PY
+legends() {  # legends SCRIPT RUN.h5... : one line per legend text, then 'bands: N' and 'covers: ...'
+  local script=$1; shift
+  $py - "$src/scripts" "$script" "$work/legend.png" "$@" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+import importlib
+import matplotlib.pyplot as plt
+mod = importlib.import_module(sys.argv[2])
+mod.main(sys.argv[4:] + ["-o", sys.argv[3]])
+fig = plt.gcf()
+fig.canvas.draw()
+for legend in fig.legends:
+    print("\n".join(t.get_text() for t in legend.get_texts()))
+    lb = legend.get_window_extent()
+    for ax in fig.axes:
+        ab = ax.get_window_extent()
+        if lb.x0 < ab.x1 and ab.x0 < lb.x1 and lb.y0 < ab.y1 and ab.y0 < lb.y1:
+            print("covers: an axes")
+print("bands:", sum(len(ax.collections) for ax in fig.axes))
+PY
+}
+for script in plot_icdf plot_bed; do
+  out=$(legends $script "$work/direct.h5" "$work/cpi.h5" 2>&1)
+  grep -qF "band: 95 % Student-t interval of the mean of R realizations" <<< "$out" \
+    && pass "$script: the legend names the band" || fail "$script: no band in the legend: $out"
+  ! grep -q "covers:" <<< "$out" && grep -q "^bands: [1-9]" <<< "$out" \
+    && pass "$script: bands drawn, the legend beside the axes" || fail "$script: legend over the axes or no band: $out"
+  out=$(legends $script "$work/one.h5" 2>&1)
+  grep -qF "R = 1: no band (one realization has no spread)" <<< "$out" && grep -q "^bands: 0$" <<< "$out" \
+    && ! grep -q "^band: " <<< "$out" \
+    && pass "$script: R = 1 draws no band and says so" || fail "$script, R = 1: $out"
+done
+expect 0 "plot_bed.py: wrote $work/bed.png" "plot_bed direct + cpi" \
+  $py "$src/scripts/plot_bed.py" "$work/direct.h5" "$work/cpi.h5" -o "$work/bed.png"
+[ -s "$work/bed.png" ] && pass "bed.png written" || fail "bed.png not written"
 
 # Bad files, made here: text, HDF5 without the attributes, a run file without /samples/mean.
 echo "not a run file" > "$work/text.h5"
@@ -67,8 +120,8 @@ expect 2 "cannot be written" "plot_icdf, output folder missing" \
 
 # demo_summary: the real pair, then constructed pairs whose answers are known.
 out=$($py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/cpi.h5" 2>&1); code=$?
-for line in "RMS difference of the ensemble means" "inside the direct ensemble's 95 % band" \
-            "within 1.96 standard errors of the difference" "DEM-time speed-up of CPI (simulated / DEM time)" \
+for line in "RMS difference of the ensemble means" "inside the direct ensemble's 95 % Student-t interval of its mean" \
+            "inside Welch's 95 % Student-t interval of the difference" "DEM-time speed-up of CPI (simulated / DEM time)" \
             "wall-time ratio direct / CPI" "noise floor of this comparison" "1 projective jump(s) kept, 0 rejected"; do
   [ $code -eq 0 ] && grep -qF "$line" <<< "$out" && pass "demo_summary: '$line'" || fail "demo_summary lacks '$line': $out"
 done
@@ -96,8 +149,14 @@ PY
 # Equal means: every difference is 0 (<= any band); shifted by 1 d_p everywhere: RMS exactly 1.
 expect 0 "RMS difference of the ensemble means (CPI - direct): 0.000 d_p" "demo_summary, equal means" \
   $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
-expect 0 "95 % band of its mean: 100 % of points" "demo_summary, equal means inside" \
+expect 0 "95 % Student-t interval of its mean: 100 % of points" "demo_summary, equal means inside" \
   $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
+# R = 2 and 2: an exact CPI's mean is inside the direct interval at 2 P(|t_1| <= 12.706 / sqrt 2) - 1.
+expect 0 "(an exact CPI with independent seeds and equal spread: 93 %)" "demo_summary, exact share for R = 2" \
+  $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/same.h5"
+# A direct run of one realization has no interval: said, not a share of 0 or 100 %.
+expect 0 "interval of its mean: no interval (R = 1: one realization has no spread)" "demo_summary, R = 1" \
+  $py "$src/scripts/demo_summary.py" "$work/one.h5" "$work/cpi.h5"
 expect 0 "RMS difference of the ensemble means (CPI - direct): 1.000 d_p" "demo_summary, shifted by 1" \
   $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/shifted.h5"
 # The floor: the same ensemble twice has sqrt(2) times one's standard error at every point.
