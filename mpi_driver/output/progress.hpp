@@ -4,6 +4,7 @@
 /// fraction done, particle-steps per wall second, and the estimated time left.
 
 #include <chrono>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -35,6 +36,7 @@ class Progress {
     double expected_particle_steps_ = 0.0;
     Clock::time_point start_ = Clock::now();
     Clock::time_point last_ = Clock::time_point::min();
+    double t_furthest_ = -std::numeric_limits<double>::infinity();  ///< the latest time reached
     std::string checkpoint_;  ///< the newest checkpoint not yet said (empty: none)
 };
 

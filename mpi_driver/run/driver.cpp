@@ -177,7 +177,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
     sum.lift_seconds = stepper.overhead().lift_seconds;
     if (stepper.failures() > 0 && sum.end_status.rfind("completed", 0) == 0)
         sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
-    sum.controller = run.integrator().summary(stepper.realizations());
+    sum.controller = run.integrator().summary(stepper.realizations(), out.coarse_steps);
     if (!sum.controller.empty()) log::info("{}", sum.controller);
     return sum;
 }

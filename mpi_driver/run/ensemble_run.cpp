@@ -11,7 +11,6 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "core/version.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
@@ -20,7 +19,6 @@
 #include "mpi_driver/parallel/ensemble_layout.hpp"
 #include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/run/driver.hpp"
-#include "mpi_driver/run/ensemble_size.hpp"
 #include "mpi_driver/run/run_end.hpp"
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_provenance.hpp"
@@ -109,9 +107,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         }
         log::info("restarted from {} at t = {:.6g}", restart->path.string(), local.front()->time());
     }
-    log::info("efdem {}: {} run of {} on {} ({} particles each), output {}/{}.*", version(),
-              prov.mode, table.file(), ensemble_size(mpi.size(), s.realizations_per_rank),
-              local.front()->particles(), s.output.directory.string(), s.output.prefix);
+    // (The header was printed before the beds were built: setup.cpp.)
+    log::info("{} particles per realization; the run starts at t = {:.6g}",
+              local.front()->particles(), local.front()->time());
 
     StepperSettings ss;
     ss.sample_interval = s.observe.interval;

@@ -27,11 +27,21 @@ void SettlingProgressLine::operator()(const dem::SettlingProgress& p) {
     }
     if (std::chrono::duration<double>(now - last_).count() < min_seconds_) return;
     last_ = now;
-    log::info(
-        "settling realization {}: {}, t = {:.4g} / {:.4g}, {} steps, KE/particle {:.2e} (settled "
-        "below {:.2e}), {}",
-        p.realization, dem::to_string(p.stage), p.time, p.stage_end, p.steps, p.ke_per_particle,
-        p.ke_threshold, format_duration(elapsed));
+    // What is measured against what: the stages before relaxing end at a set time; relaxing ends
+    // when the kinetic energy falls below the threshold, and bed.settle.max_time is only the
+    // limit at which it gives up.
+    if (p.stage == dem::SettlingProgress::Stage::relaxing)
+        log::info(
+            "settling realization {}: relaxing until KE/particle < {:.2e}: now {:.2e} ({:.3g} x "
+            "the threshold), t = {:.4g} (gives up at {:.4g}, bed.settle.max_time), {} steps, {}",
+            p.realization, p.ke_threshold, p.ke_per_particle, p.ke_per_particle / p.ke_threshold,
+            p.time, p.stage_end, p.steps, format_duration(elapsed));
+    else
+        log::info(
+            "settling realization {}: {} stage, t = {:.4g} of {:.4g}, {} steps, KE/particle {:.2e} "
+            "(then relaxing until below {:.2e}), {}",
+            p.realization, dem::to_string(p.stage), p.time, p.stage_end, p.steps, p.ke_per_particle,
+            p.ke_threshold, format_duration(elapsed));
 }
 
 }  // namespace efdem::mpi_driver

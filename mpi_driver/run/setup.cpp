@@ -10,11 +10,13 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/version.hpp"
 #include "dem/realization_builder.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/parallel/scene_input.hpp"
 #include "mpi_driver/parallel/stop_signal.hpp"
+#include "mpi_driver/run/ensemble_size.hpp"
 #include "mpi_driver/run/output_guard.hpp"
 #include "mpi_driver/run/settling_progress.hpp"
 #if EFDEM_HAVE_HDF5
@@ -69,6 +71,13 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
                                      "micro states in memory that a checkpoint does not hold)",
                                      options.restart, settings.mode_name()));
     const bool skip_settling = out.check || !options.restart.empty();
+    // The run's header before the beds are built: settling a large bed takes minutes, and the
+    // user should see at once what runs where.
+    if (!out.check && mpi.is_root())
+        log::info("efdem {}: {} run of {} on {}, output {}/{}.*{}", version(), settings.mode_name(),
+                  out.table->file(), ensemble_size(mpi.size(), settings.realizations_per_rank),
+                  settings.output.directory.string(), settings.output.prefix,
+                  options.restart.empty() ? "" : fmt::format("; continuing {}", options.restart));
     for (int j = 0; j < k; ++j) {
         const long realization = out.check ? 0 : static_cast<long>(mpi.rank()) * k + j;
         out.systems.push_back(

@@ -18,6 +18,16 @@ for kind in reject shrink; do
   timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$here/tiny_scene.cfg" "${common[@]}" cpi.debug.force=$kind \
     output.prefix=$kind > "$work/$kind.log" 2>&1 || { echo "FAIL: $kind run failed"; cat "$work/$kind.log"; exit 1; }
 done
+# The progress line does not go back when the rejected jump sends the clock back: its share is
+# the furthest reached, and the line after the rejection says that a stretch is redone.
+/usr/bin/python3 - "$work/reject.log" <<'PY' || { grep "^t = " "$work/reject.log"; echo "FAIL: the progress went backwards or did not say it redoes"; exit 1; }
+import re, sys
+lines = [l for l in open(sys.argv[1]) if l.startswith("t = ")]
+shares = [float(re.search(r"\(\s*([0-9.]+) %\)", l).group(1)) for l in lines]
+assert all(b >= a for a, b in zip(shares, shares[1:])), shares
+assert any("redoing up to t = " in l for l in lines)
+PY
+echo "PASS: the progress line never went back; after the rejection it says it redoes"
 # Input the controller cannot serve: exit 2, a message naming the key, no rank left waiting.
 refused() {  # refused NP KEY_TEXT OVERRIDES...
   local np=$1 want=$2; shift 2

@@ -496,12 +496,16 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     return rec;
 }
 
-std::string MultistepProjectiveIntegrator::summary(int realizations) const {
+std::string MultistepProjectiveIntegrator::summary(int realizations, long bursts) const {
     const Totals& t = totals_;
+    // Every burst counts: the first one (which only measures a slope) and any the end of the
+    // run left no room to jump from are bursts without a jump.
+    const long without = std::max(0L, bursts - t.accepted - t.rejected - t.direct);
     std::string s = fmt::format(
-        "{}: {} jumps kept, {} rejected, {} bursts run directly (tolerance allowed DT < "
-        "cpi.dt_min)",
-        name(), t.accepted, t.rejected, t.direct);
+        "{}: {} bursts: {} with a jump kept, {} with a jump rejected, {} run directly (tolerance "
+        "allowed DT < cpi.dt_min), {} without a jump (the first, which measures the first slope; "
+        "those in a fast transient; the end of the run)",
+        name(), bursts, t.accepted, t.rejected, t.direct, without);
     // Every rejected jump cost a burst of DEM time that bought nothing.
     if (t.rejected > 0)
         s += fmt::format(

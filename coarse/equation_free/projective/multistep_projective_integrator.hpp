@@ -139,7 +139,7 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// Adaptive: the run's controller in a few lines for the log and the run file: jumps kept,
     /// rejected, direct bursts, mean DT, the statistical share of the error, and the mean DT
     /// the tolerance would allow with 2 and 4 times the `realizations`.
-    std::string summary(int realizations) const override;
+    std::string summary(int realizations, long bursts) const override;
 
   private:
     /// One burst measured: its slope node, end state, decay estimate; false (and rec says

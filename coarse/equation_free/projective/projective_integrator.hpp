@@ -175,9 +175,11 @@ class ProjectiveIntegrator {
     /// save_state() returned, so that the next step is bit for bit the one the saved run made.
     virtual IntegratorState save_state() const { return std::nullopt; }
     /// What the integrator did over the run, in a few lines for the log and the run file
-    /// (`realizations`: the ensemble's R); empty for integrators with nothing to add.
-    virtual std::string summary(int realizations) const {
+    /// (`realizations`: the ensemble's R; `bursts`: the coarse steps of the run, one burst
+    /// each); empty for integrators with nothing to add.
+    virtual std::string summary(int realizations, long bursts) const {
         (void)realizations;
+        (void)bursts;
         return {};
     }
     /// \pre state is what this kind of integrator saves (nullopt for those without a state).
