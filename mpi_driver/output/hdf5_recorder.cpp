@@ -74,7 +74,8 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
       m_(p.p_grid.size()),
       dim_(coarse_dimension),
       species_(p.species_names.size()),
-      slabs_(static_cast<std::size_t>(p.profile_slabs)) {
+      slabs_(static_cast<std::size_t>(p.profile_slabs)),
+      si_pressure_(p.si.pressure) {
     // On a disk with room for the reserve but little more the first writes fail: the run file
     // must not be left unreadable or 'running', nor the reserve behind.
     try {
@@ -115,6 +116,15 @@ void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
     file_.attribute("/", "observed_species", p.observed_species);
     file_.attribute("/", "scene_file", p.scene_file);
     file_.attribute("/", "overrides", p.overrides);
+    if (p.si.known()) {  // one reduced unit in SI, numbers a unit library can take
+        file_.attribute("/", "si_length_m", p.si.length);
+        file_.attribute("/", "si_time_s", p.si.time);
+        file_.attribute("/", "si_velocity_m_per_s", p.si.velocity);
+        file_.attribute("/", "si_acceleration_m_per_s2", p.si.acceleration);
+        file_.attribute("/", "si_density_kg_per_m3", p.si.density);
+        file_.attribute("/", "si_mass_kg", p.si.mass);
+        file_.attribute("/", "si_pressure_Pa", p.si.pressure);
+    }
     file_.write_text("/scene", p.scene_text);
     document("/scene");
     file_.write_text("/parameters", p.parameters);
@@ -199,6 +209,10 @@ void Hdf5Recorder::bed_sample(const SampleRecord& s) {
         const std::vector<hsize_t> per =
             members > 1 || group == "/bed" ? std::vector<hsize_t>{members} : std::vector<hsize_t>{};
         series(group + "/pressure_drop", per, T::real).append(as_span(b.pressure_drop));
+        if (std::isfinite(si_pressure_)) {
+            const Eigen::VectorXd pa = b.pressure_drop * si_pressure_;
+            series(group + "/pressure_drop_pa", per, T::real).append(as_span(pa));
+        }
         series(group + "/pressure_drop_ratio", per, T::real).append(as_span(b.pressure_drop_ratio));
         series(group + "/height", per, T::real).append(as_span(b.height));
         series(group + "/mixing_index", per, T::real).append(as_span(b.mixing_index));

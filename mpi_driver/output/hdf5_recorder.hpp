@@ -61,6 +61,7 @@ class Hdf5Recorder final : public RunRecorder {
     std::map<std::string, H5Series> series_;
     std::size_t species_ = 0, slabs_ = 0;  ///< observe.bed: the axes of /bed
     Eigen::VectorXd initial_height_;       ///< each realization's bed height at the first sample
+    double si_pressure_;                   ///< rho_s g d_p [Pa]; NaN: the scene gives no SI scale
 };
 
 }  // namespace efdem::mpi_driver

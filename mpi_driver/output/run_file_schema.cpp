@@ -65,6 +65,10 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "gas pressure drop across the bed, sum_j dz (-dp/dz)_j", sample_r},
         {"/bed/pressure_drop_ratio", "1",
          "pressure drop / (bed weight per area): 1 for a bed the gas fully supports", sample_r},
+        {"/bed/pressure_drop_pa", "Pa",
+         "/bed/pressure_drop in pascal (x the root attribute si_pressure_Pa; only where the scene "
+         "gives the SI scales)",
+         sample_r},
         {"/bed/height", "d_p", "bed height: 99 % of the particle volume lies below it", sample_r},
         {"/bed/expansion", "1", "bed height / bed height at the run's first sample", sample_r},
         {"/bed/mixing_index", "1",
@@ -81,6 +85,7 @@ const std::vector<DatasetDoc>& run_file_schema() {
          {"sample", "realization", "slab"}},
         {"/bed/mean/pressure_drop", "rho_s g d_p", "ensemble mean of /bed/pressure_drop", sample},
         {"/bed/mean/pressure_drop_ratio", "1", "ensemble mean of /bed/pressure_drop_ratio", sample},
+        {"/bed/mean/pressure_drop_pa", "Pa", "ensemble mean of /bed/pressure_drop_pa", sample},
         {"/bed/mean/height", "d_p", "ensemble mean of /bed/height", sample},
         {"/bed/mean/expansion", "1",
          "ensemble-mean bed height / its value at the run's first sample", sample},

@@ -5,7 +5,9 @@
 /// the complete record) and CSV (the mean ICDF and the coarse steps, for quick scripting)
 /// implement it.
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +74,32 @@ class RunRecorder : public SampleSink {
 };
 
 /// Provenance stored with every run.
+/// What one reduced unit is in SI, when the scene gives the physical scales (gas_drag's
+/// particle_diameter, particle_density and gravity; NaN otherwise: a scene that sets gas_drag.A
+/// is dimensionless only). Multiply a reduced value by the unit of its kind.
+struct SiUnits {
+    double length = std::numeric_limits<double>::quiet_NaN();        ///< d_p [m]
+    double time = std::numeric_limits<double>::quiet_NaN();          ///< sqrt(d_p/g) [s]
+    double velocity = std::numeric_limits<double>::quiet_NaN();      ///< sqrt(g d_p) [m/s]
+    double acceleration = std::numeric_limits<double>::quiet_NaN();  ///< g [m/s^2]
+    double density = std::numeric_limits<double>::quiet_NaN();       ///< rho_s [kg/m^3]
+    double mass = std::numeric_limits<double>::quiet_NaN();          ///< rho_s d_p^3 [kg]
+    double pressure = std::numeric_limits<double>::quiet_NaN();      ///< rho_s g d_p [Pa]
+    bool known() const { return std::isfinite(length); }
+    /// From d_p [m], rho_s [kg/m^3] and g [m/s^2].
+    static SiUnits from(double d_p, double rho_s, double g) {
+        SiUnits u;
+        u.length = d_p;
+        u.time = std::sqrt(d_p / g);
+        u.velocity = std::sqrt(g * d_p);
+        u.acceleration = g;
+        u.density = rho_s;
+        u.mass = rho_s * d_p * d_p * d_p;
+        u.pressure = rho_s * g * d_p;
+        return u;
+    }
+};
+
 struct RunProvenance {
     std::string scene_file;
     std::string scene_text;
@@ -90,6 +118,7 @@ struct RunProvenance {
     long profile_slabs = 0;      ///< phi(z) slabs from the floor
     double mixing_layer = 0;     ///< Lacey layer thickness [d_p]
     double weight_per_area = 0;  ///< W / A of realization 0 [rho_s g d_p]
+    SiUnits si;                  ///< the reduced units in SI (not known: NaN)
 };
 
 }  // namespace efdem::mpi_driver

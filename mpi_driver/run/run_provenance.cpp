@@ -7,6 +7,7 @@
 
 #include "coarse/demixing/probability_grid.hpp"
 #include "dem/beds/bed_diagnostics.hpp"
+#include "dem/gas/gas_drag.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -41,6 +42,12 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
     p.seed = s.seed;
     p.p_grid = coarse::ProbabilityGrid(s.observe.quantiles).values();
     p.observed_species = any.species()[s.observe.species].name;
+    // The SI scales, where the scene gives them (gas_drag's physical keys, not gas_drag.A).
+    if (const auto* drag = dynamic_cast<const dem::GasDrag*>(any.find_effect("gas_drag"));
+        drag && drag->spec().physical) {
+        const dem::GasProperties& g = drag->spec().gas;
+        p.si = SiUnits::from(g.particle_diameter, g.particle_density, g.gravity);
+    }
     if (bed) {
         for (std::size_t k = 0; k < bed->species; ++k)
             p.species_names.push_back(any.species()[static_cast<dem::SpeciesId>(k)].name);

@@ -53,3 +53,29 @@ rc=$?
 set -e
 [ "$rc" = 2 ] && grep -q "observe.bed=true" "$work/err" || { echo "plot_bed.py on a run without /bed: rc $rc: $(cat "$work/err")"; exit 1; }
 echo "bed_observables: plot ok"
+
+# The SI scales: on a scene with the physical drag keys (defaults: d_p = 1e-4 m, rho_s = 900
+# kg/m^3, g = 9.81 m/s^2) the root says what one reduced unit is in SI, and the pressure drop is
+# also in pascal; a scene that gives gas_drag.A has no SI scale and writes neither.
+"$mpiexec" -n 1 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=direct run.duration=0.5 observe.bed=true \
+  output.directory="$work" output.prefix=dimensionless gas_drag.A=0.114939 > "$work/log_dimless" 2>&1 \
+  || { cat "$work/log_dimless"; exit 1; }
+/usr/bin/python3 - "$work/bed.h5" "$work/dimensionless.h5" <<'PY'
+import math, sys
+import h5py
+import numpy as np
+with h5py.File(sys.argv[1], "r") as f:
+    a = f.attrs
+    # The time unit efdem --check prints for these scales: sqrt(d_p/g) = 3.193 ms.
+    assert abs(a["si_time_s"] - 3.193e-3) < 1e-6, a["si_time_s"]
+    assert math.isclose(a["si_time_s"], math.sqrt(a["si_length_m"] / a["si_acceleration_m_per_s2"]), rel_tol=1e-12)
+    assert math.isclose(a["si_velocity_m_per_s"] * a["si_time_s"], a["si_length_m"], rel_tol=1e-12)
+    assert math.isclose(a["si_pressure_Pa"], 900 * 9.81 * 1e-4, rel_tol=1e-12)
+    assert math.isclose(a["si_mass_kg"], 900 * 1e-12, rel_tol=1e-12)
+    pd, pa = f["bed/pressure_drop"][()], f["bed/pressure_drop_pa"][()]
+    assert f["bed/pressure_drop_pa"].attrs["units"] == "Pa"
+    assert np.allclose(pa, pd * a["si_pressure_Pa"], rtol=1e-15, atol=0)
+with h5py.File(sys.argv[2], "r") as f:
+    assert not any(k.startswith("si_") for k in f.attrs) and "pressure_drop_pa" not in f["bed"]
+print("bed_observables: SI scales ok")
+PY
