@@ -12,7 +12,12 @@
 ///   signal: where it was saved, how to continue), "efdem: ..." on stderr, always printed.
 /// * output(): what a command prints as its answer (--help, --list-effects, --check, ...):
 ///   stdout on the root, whatever the level.
+///
+/// The root also keeps a copy of everything it prints in a file (open_copy(): the run's
+/// PREFIX.log); what it printed before the file was opened (the header, settling) is kept in
+/// memory and written first.
 
+#include <filesystem>
 #include <string>
 #include <utility>
 
@@ -26,6 +31,11 @@ enum class Level { quiet = 0, warn = 1, info = 2, debug = 3 };
 void configure(int rank, int n_ranks, Level level);
 Level level();
 int rank();
+
+/// Root: from now on every line it prints also goes to `path`, after `preamble` (what is not
+/// printed on the screen, e.g. the scene as read) and the lines printed so far. `append`:
+/// continue an existing file (a restarted run). Returns "" or why the file cannot be written.
+std::string open_copy(const std::filesystem::path& path, bool append, const std::string& preamble);
 
 void write_info(const std::string& message);
 void write_warn(const std::string& message);

@@ -44,7 +44,7 @@ bool is_realization_file(std::string_view name, const std::string& prefix) {
 }
 
 bool is_run_file(std::string_view name, const std::string& prefix) {
-    return name == prefix + ".h5" || name == prefix + ".h5.reserve" ||
+    return name == prefix + ".h5" || name == prefix + ".h5.reserve" || name == prefix + ".log" ||
            name == prefix + "_mean_icdf.csv" || name == prefix + "_cpi_steps.csv" ||
            name == prefix + "_csv_meta.json";
 }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -149,6 +150,25 @@ Agreement replace_earlier_run(const MpiSession& mpi, const RunSettings& settings
     return agree_on_failure(mpi.comm(), removal, why);
 }
 
+/// Root: PREFIX.log from here on, once nothing of an earlier run can be in the way (the guard
+/// passed, output.overwrite deleted it): the scene as read, then everything printed so far and
+/// from now on. A restart appends to the run's log.
+void open_log(const ParamTable& table, const RunSettings& settings, const RunOptions& options) {
+    const std::filesystem::path path =
+        settings.output.directory / (settings.output.prefix + ".log");
+    std::string preamble;
+    if (!options.restart.empty())
+        preamble += fmt::format("----- restart={}: the run continues -----\n", options.restart);
+    preamble += fmt::format("----- scene {}, as read -----\n{}", table.file(), table.text());
+    if (!preamble.ends_with('\n')) preamble += '\n';
+    preamble += fmt::format("----- command-line overrides: {} -----\n",
+                            table.overrides().empty()
+                                ? std::string("none")
+                                : fmt::format("{}", fmt::join(table.overrides(), " ")));
+    if (const std::string why = log::open_copy(path, !options.restart.empty(), preamble);
+        !why.empty())
+        log::warn("no log file: {}; the run goes on, printing to the screen only", why);
+}
 }  // namespace
 
 Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wall, SetUp& out) {
@@ -184,9 +204,12 @@ Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wa
     // settling.
     wall.settling_seconds = SetupWall::seconds_since(settling_start);
     if (agreed.exit_code != kExitOk) return agreed;
+    Agreement done = agreed;
     if (!out.check && out.settings->output.overwrite && options.restart.empty())
-        return replace_earlier_run(mpi, *out.settings);
-    return agreed;
+        done = replace_earlier_run(mpi, *out.settings);
+    if (done.exit_code == kExitOk && !out.check && mpi.is_root())
+        open_log(*out.table, *out.settings, options);
+    return done;
 }
 
 }  // namespace efdem::mpi_driver
