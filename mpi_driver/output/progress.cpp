@@ -17,8 +17,8 @@ double Progress::elapsed_seconds() const {
 }
 
 void Progress::update(double t_sim, double particle_steps, const std::string& extra, bool force) {
-    // A rejected jump sends the clock back to the state before it: the share shown is the
-    // furthest reached, and the line says that a stretch is being redone.
+    // A rejected jump (or a steady solve's next evaluation) sends the clock back: the share
+    // shown is the furthest reached, and the line says that a stretch is being redone.
     const bool redoing = t_sim < t_furthest_;
     t_furthest_ = std::max(t_furthest_, t_sim);
     const auto now = Clock::now();
@@ -38,8 +38,7 @@ void Progress::update(double t_sim, double particle_steps, const std::string& ex
         "t = {:9.3f} / {:g} ({:5.1f} %)  {:.3g} particle-steps/s  elapsed {}  ETA {}{}{}{}{}{}",
         t_sim, t_end_, 100 * shown, rate, format_duration(wall),
         work_done > 0 ? format_duration(eta) : "-",
-        redoing ? fmt::format("  (redoing up to t = {:.6g} after a rejected jump)", t_furthest_)
-                : std::string(),
+        redoing ? fmt::format("  (redoing up to t = {:.6g})", t_furthest_) : std::string(),
         extra.empty() ? "" : "  ", extra, checkpoint_.empty() ? "" : "  ", checkpoint_);
     checkpoint_.clear();
 }
