@@ -39,8 +39,9 @@ void print(std::FILE* stream, const std::string& text) {
 }
 }  // namespace
 
-std::string open_copy(const std::filesystem::path& path, bool append, const std::string& preamble) {
-    auto f = std::make_unique<std::ofstream>(path, append ? std::ios::app : std::ios::trunc);
+std::string open_copy(const std::filesystem::path& path, bool replace,
+                      const std::string& preamble) {
+    auto f = std::make_unique<std::ofstream>(path, replace ? std::ios::trunc : std::ios::app);
     if (!*f) return fmt::format("{} cannot be opened for writing", path.string());
     *f << preamble << g_pending;
     f->flush();

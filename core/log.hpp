@@ -14,7 +14,7 @@
 ///   stdout on the root, whatever the level.
 ///
 /// The root also keeps a copy of everything it prints in a file (open_copy(): the run's
-/// PREFIX.log); what it printed before the file was opened (the header, settling) is kept in
+/// PREFIX_log.txt); what it printed before the file was opened (the header, settling) is kept in
 /// memory and written first.
 
 #include <filesystem>
@@ -33,9 +33,9 @@ Level level();
 int rank();
 
 /// Root: from now on every line it prints also goes to `path`, after `preamble` (what is not
-/// printed on the screen, e.g. the scene as read) and the lines printed so far. `append`:
-/// continue an existing file (a restarted run). Returns "" or why the file cannot be written.
-std::string open_copy(const std::filesystem::path& path, bool append, const std::string& preamble);
+/// printed on the screen, e.g. the scene as read) and the lines printed so far. The file is
+/// appended to, or replaced with `replace`. Returns "" or why the file cannot be written.
+std::string open_copy(const std::filesystem::path& path, bool replace, const std::string& preamble);
 
 void write_info(const std::string& message);
 void write_warn(const std::string& message);

@@ -44,9 +44,9 @@ bool is_realization_file(std::string_view name, const std::string& prefix) {
 }
 
 bool is_run_file(std::string_view name, const std::string& prefix) {
-    return name == prefix + ".h5" || name == prefix + ".h5.reserve" || name == prefix + ".log" ||
-           name == prefix + "_mean_icdf.csv" || name == prefix + "_cpi_steps.csv" ||
-           name == prefix + "_csv_meta.json";
+    return name == prefix + ".h5" || name == prefix + ".h5.reserve" ||
+           name == prefix + "_log.txt" || name == prefix + "_mean_icdf.csv" ||
+           name == prefix + "_cpi_steps.csv" || name == prefix + "_csv_meta.json";
 }
 
 void collect(const std::filesystem::path& dir, const std::string& prefix, bool checkpoints,

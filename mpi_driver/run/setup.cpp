@@ -150,12 +150,14 @@ Agreement replace_earlier_run(const MpiSession& mpi, const RunSettings& settings
     return agree_on_failure(mpi.comm(), removal, why);
 }
 
-/// Root: PREFIX.log from here on, once nothing of an earlier run can be in the way (the guard
-/// passed, output.overwrite deleted it): the scene as read, then everything printed so far and
-/// from now on. A restart appends to the run's log.
+/// Root: PREFIX_log.txt from here on, once the output guard has passed (it counts the log as a
+/// file of its run, so an earlier run's is never in the way): the scene as read, then
+/// everything printed so far and from now on; a restart appends to its run's log. Not
+/// PREFIX.log: that is where batch scripts send a job's output (`mpirun efdem ... >
+/// PREFIX.log`, under mpirun a pipe, so the two could not be told apart and would interleave).
 void open_log(const ParamTable& table, const RunSettings& settings, const RunOptions& options) {
     const std::filesystem::path path =
-        settings.output.directory / (settings.output.prefix + ".log");
+        settings.output.directory / (settings.output.prefix + "_log.txt");
     std::string preamble;
     if (!options.restart.empty())
         preamble += fmt::format("----- restart={}: the run continues -----\n", options.restart);
@@ -165,8 +167,8 @@ void open_log(const ParamTable& table, const RunSettings& settings, const RunOpt
                             table.overrides().empty()
                                 ? std::string("none")
                                 : fmt::format("{}", fmt::join(table.overrides(), " ")));
-    if (const std::string why = log::open_copy(path, !options.restart.empty(), preamble);
-        !why.empty())
+    const bool replace = settings.output.overwrite && options.restart.empty();
+    if (const std::string why = log::open_copy(path, replace, preamble); !why.empty())
         log::warn("no log file: {}; the run goes on, printing to the screen only", why);
 }
 }  // namespace

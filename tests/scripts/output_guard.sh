@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Output is never lost, and a run file says how its run ended (docs/reliability.md, "Output").
-#  0. The run's log PREFIX.log echoes the scene and holds everything the root printed.
+#  0. The run's log PREFIX_log.txt echoes the scene and holds everything the root printed.
 #  1. A second run with the prefix of an earlier one is refused (exit 2, naming the file) and
 #     leaves every file of the earlier run byte for byte as it was; --check refuses it too.
 #  2. output.overwrite = true deletes all of the earlier run's files first: no stale VTK frame
@@ -23,15 +23,18 @@ efd "$efdem" "$scene" mode=direct run.duration=2 output.vtk_interval=0.5 output.
 before=$(cd "$out" && sha256sum * | sort)
 [ "$(ls "$out"/*.vtp | wc -l)" -eq 5 ] || fail "expected 5 VTK frames from the first run"
 
-# 0. The run's log, PREFIX.log: the scene as read and the overrides, then every line the root
+# 0. The run's log, PREFIX_log.txt: the scene as read and the overrides, then every line the root
 #    printed, from the header (printed before the beds were built) to the closing line.
 log_ok=1
-grep -q "^----- scene $scene, as read -----$" "$out/efdem.log" && grep -q "^effects = gravity" "$out/efdem.log" \
-  && grep -q "^----- command-line overrides: mode=direct run.duration=2 .*output.directory=$out -----$" "$out/efdem.log" \
-  && grep -q "^efdem .*: direct run of $scene on 1 rank x 1 per rank = 1 realization" "$out/efdem.log" \
-  && [ "$(grep -v '^-----' "$out/efdem.log" | tail -n 1)" = "$(tail -n 1 "$work/first.log")" ] || log_ok=0
+grep -q "^----- scene $scene, as read -----$" "$out/efdem_log.txt" && grep -q "^effects = gravity" "$out/efdem_log.txt" \
+  && grep -q "^----- command-line overrides: mode=direct run.duration=2 .*output.directory=$out -----$" "$out/efdem_log.txt" \
+  && grep -q "^efdem .*: direct run of $scene on 1 rank x 1 per rank = 1 realization" "$out/efdem_log.txt" \
+  && [ "$(grep -v '^-----' "$out/efdem_log.txt" | tail -n 1)" = "$(tail -n 1 "$work/first.log")" ] || log_ok=0
 [ $log_ok -eq 1 ] && echo "PASS: the run's log holds the scene, the overrides and every line it printed" \
-  || { cat "$out/efdem.log"; fail "the run's log efdem.log"; }
+  || { cat "$out/efdem_log.txt"; fail "the run's log efdem_log.txt"; }
+
+#    Its name is not PREFIX.log, where these tests (and batch scripts) send the job's output.
+[ -s "$work/first.log" ] && ! grep -q "^----- scene" "$work/first.log" || fail "the job's own output file"
 
 # 1. Refused, nothing touched (the log included); --check says the same.
 efd "$efdem" "$scene" mode=direct run.duration=1 seed=5 output.directory="$out" > "$work/again.log" 2>&1
@@ -54,7 +57,7 @@ code=$?
 seed=$(/usr/bin/python3 -c "import h5py; print(h5py.File('$out/efdem.h5', 'r').attrs['seed'])")
 if [ $code -eq 0 ] && [ -z "$(ls "$out" | grep -E '\.(vtp|pvd)$')" ] && [ "$seed" = "5" ] \
    && grep -q "deleted the 10 file(s) of the earlier run" "$work/overwrite.log" \
-   && [ "$(grep -c '^----- scene' "$out/efdem.log")" -eq 1 ] && grep -q "overrides: .*seed=5" "$out/efdem.log"; then
+   && [ "$(grep -c '^----- scene' "$out/efdem_log.txt")" -eq 1 ] && grep -q "overrides: .*seed=5" "$out/efdem_log.txt"; then
   echo "PASS: output.overwrite = true replaced the earlier run (all 10 of its files, 5 VTK frames, the CSV sidecar and the log among them, were deleted first; the log is the new run's alone)"
 else
   grep -v "^t = " "$work/overwrite.log"; ls "$out"; fail "overwrite: exit $code, seed $seed"
