@@ -93,7 +93,22 @@ Hdf5Recorder::Hdf5Recorder(const std::filesystem::path& directory, const std::st
 }
 
 void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
-    if (resume) {  // how this part of the run is executed (compare_runs.py ignores these)
+    // What one reduced unit is in SI: the scene's, so also written into a run file put back
+    // from a checkpoint written before these attributes existed.
+    if (p.si.known()) {  // one reduced unit in SI, numbers a unit library can take
+        file_.attribute("/", "si_length_m", p.si.length);
+        file_.attribute("/", "si_time_s", p.si.time);
+        file_.attribute("/", "si_velocity_m_per_s", p.si.velocity);
+        file_.attribute("/", "si_acceleration_m_per_s2", p.si.acceleration);
+        file_.attribute("/", "si_density_kg_per_m3", p.si.density);
+        file_.attribute("/", "si_mass_kg", p.si.mass);
+        file_.attribute("/", "si_pressure_Pa", p.si.pressure);
+    }
+    if (resume) {
+        // A run file from before /bed/pressure_drop_pa: the column would start mid-run.
+        if (file_.exists("/bed/pressure_drop") && !file_.exists("/bed/pressure_drop_pa"))
+            si_pressure_ = std::numeric_limits<double>::quiet_NaN();
+        // How this part of the run is executed (compare_runs.py ignores these).
         file_.attribute("/", "ranks", std::int64_t{p.ranks});
         file_.attribute("/", "realizations_per_rank", std::int64_t{p.realizations_per_rank});
         file_.attribute("/", "end_status", std::string("running"));
@@ -116,15 +131,6 @@ void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
     file_.attribute("/", "observed_species", p.observed_species);
     file_.attribute("/", "scene_file", p.scene_file);
     file_.attribute("/", "overrides", p.overrides);
-    if (p.si.known()) {  // one reduced unit in SI, numbers a unit library can take
-        file_.attribute("/", "si_length_m", p.si.length);
-        file_.attribute("/", "si_time_s", p.si.time);
-        file_.attribute("/", "si_velocity_m_per_s", p.si.velocity);
-        file_.attribute("/", "si_acceleration_m_per_s2", p.si.acceleration);
-        file_.attribute("/", "si_density_kg_per_m3", p.si.density);
-        file_.attribute("/", "si_mass_kg", p.si.mass);
-        file_.attribute("/", "si_pressure_Pa", p.si.pressure);
-    }
     file_.write_text("/scene", p.scene_text);
     document("/scene");
     file_.write_text("/parameters", p.parameters);

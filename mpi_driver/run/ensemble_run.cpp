@@ -22,6 +22,7 @@
 #include "mpi_driver/run/run_end.hpp"
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_provenance.hpp"
+#include "mpi_driver/run/setup.hpp"
 #include "mpi_driver/run/steady_driver.hpp"
 #if EFDEM_HAVE_HDF5
 #include "mpi_driver/checkpoint/checkpoint_writer.hpp"
@@ -107,6 +108,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         }
         log::info("restarted from {} at t = {:.6g}", restart->path.string(), local.front()->time());
     }
+    open_run_log(mpi, table, s, restart ? restart->path.string() : std::string());
     // (The header was printed before the beds were built: setup.cpp.)
     log::info("{} particles per realization; the run starts at t = {:.6g}",
               local.front()->particles(), local.front()->time());

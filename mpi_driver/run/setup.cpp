@@ -150,27 +150,6 @@ Agreement replace_earlier_run(const MpiSession& mpi, const RunSettings& settings
     return agree_on_failure(mpi.comm(), removal, why);
 }
 
-/// Root: PREFIX_log.txt from here on, once the output guard has passed (it counts the log as a
-/// file of its run, so an earlier run's is never in the way): the scene as read, then
-/// everything printed so far and from now on; a restart appends to its run's log. Not
-/// PREFIX.log: that is where batch scripts send a job's output (`mpirun efdem ... >
-/// PREFIX.log`, under mpirun a pipe, so the two could not be told apart and would interleave).
-void open_log(const ParamTable& table, const RunSettings& settings, const RunOptions& options) {
-    const std::filesystem::path path =
-        settings.output.directory / (settings.output.prefix + "_log.txt");
-    std::string preamble;
-    if (!options.restart.empty())
-        preamble += fmt::format("----- restart={}: the run continues -----\n", options.restart);
-    preamble += fmt::format("----- scene {}, as read -----\n{}", table.file(), table.text());
-    if (!preamble.ends_with('\n')) preamble += '\n';
-    preamble += fmt::format("----- command-line overrides: {} -----\n",
-                            table.overrides().empty()
-                                ? std::string("none")
-                                : fmt::format("{}", fmt::join(table.overrides(), " ")));
-    const bool replace = settings.output.overwrite && options.restart.empty();
-    if (const std::string why = log::open_copy(path, replace, preamble); !why.empty())
-        log::warn("no log file: {}; the run goes on, printing to the screen only", why);
-}
 }  // namespace
 
 Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wall, SetUp& out) {
@@ -209,9 +188,31 @@ Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wa
     Agreement done = agreed;
     if (!out.check && out.settings->output.overwrite && options.restart.empty())
         done = replace_earlier_run(mpi, *out.settings);
-    if (done.exit_code == kExitOk && !out.check && mpi.is_root())
-        open_log(*out.table, *out.settings, options);
     return done;
+}
+
+/// Root: PREFIX_log.txt from here on, once the output guard has passed (it counts the log as a
+/// file of its run, so an earlier run's is never in the way): the scene as read, then
+/// everything printed so far and from now on; a restart appends to its run's log. Not
+/// PREFIX.log: that is where batch scripts send a job's output (`mpirun efdem ... >
+/// PREFIX.log`, under mpirun a pipe, so the two could not be told apart and would interleave).
+void open_run_log(const MpiSession& mpi, const ParamTable& table, const RunSettings& settings,
+                  const std::string& restart) {
+    if (!mpi.is_root()) return;
+    const std::filesystem::path path =
+        settings.output.directory / (settings.output.prefix + "_log.txt");
+    std::string preamble;
+    if (!restart.empty())
+        preamble += fmt::format("----- restart={}: the run continues -----\n", restart);
+    preamble += fmt::format("----- scene {}, as read -----\n{}", table.file(), table.text());
+    if (!preamble.ends_with('\n')) preamble += '\n';
+    preamble += fmt::format("----- command-line overrides: {} -----\n",
+                            table.overrides().empty()
+                                ? std::string("none")
+                                : fmt::format("{}", fmt::join(table.overrides(), " ")));
+    const bool replace = settings.output.overwrite && restart.empty();
+    if (const std::string why = log::open_copy(path, replace, preamble); !why.empty())
+        log::warn("no log file: {}; the run goes on, printing to the screen only", why);
 }
 
 }  // namespace efdem::mpi_driver

@@ -52,4 +52,10 @@ struct SetUp {
 /// settling's wall time in `wall`. The agreement's exit code is 0 when `out` is ready.
 Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wall, SetUp& out);
 
+/// Root, once the run can start (set up, and a restart's states restored): the run's log,
+/// PREFIX_log.txt, from here on, with everything printed so far (log::open_copy). `restart`:
+/// the checkpoint continued (empty: a new run). A set-up or restart that fails leaves no log.
+void open_run_log(const MpiSession& mpi, const ParamTable& table, const RunSettings& settings,
+                  const std::string& restart);
+
 }  // namespace efdem::mpi_driver
