@@ -287,7 +287,8 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
             // Stopped inside the sample somewhere: no rank uses it, and the counters stay those
             // of its start. Direct: back to that start (the checkpoint's state); cpi: the
             // checkpoint is the resume point's.
-            if (keep_sample_start) go_back_to_sample_start(sample_start);
+            if (keep_sample_start)
+                restore_agreed(sample_start, "the start of a sample cut by a stop signal");
             interrupted_ = signal;
             return s;
         }
@@ -325,13 +326,13 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
     return samples;
 }
 
-void EnsembleStepper::go_back_to_sample_start(const std::vector<RealizationState>& start) {
+void EnsembleStepper::restore_agreed(const std::vector<RealizationState>& states,
+                                     const char* where) {
     std::string failure;
     try {
-        EnsembleSnapshots::restore_realizations(local_, start);
+        EnsembleSnapshots::restore_realizations(local_, states);
     } catch (const std::exception& e) {
-        failure =
-            std::string("going back to the start of a sample cut by a stop signal: ") + e.what();
+        failure = std::string("going back to ") + where + ": " + e.what();
     }
     agree_on_stage(failure, local_.front()->index());
 }
@@ -404,13 +405,7 @@ EnsembleSnapshot EnsembleStepper::snapshot(const char* when) const {
 
 void EnsembleStepper::return_to(const EnsembleSnapshot& s, const char* when, bool keep_membership) {
     at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
-    std::string failure;
-    try {
-        EnsembleSnapshots::restore_realizations(local_, s.realizations);
-    } catch (const std::exception& e) {
-        failure = std::string("going back to ") + when + ": " + e.what();
-    }
-    agree_on_stage(failure, local_.front()->index());
+    restore_agreed(s.realizations, when);
     // The discarded work was done: it stays in the cost.
     const double micro = micro_time_, steps = particle_steps_;
     StepperState now;

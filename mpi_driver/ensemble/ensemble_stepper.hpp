@@ -251,8 +251,9 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     /// Returns the samples taken (fewer than `samples` when a stop was agreed; a sample in which
     /// a rank stopped on the signal is not taken).
     long do_run(long samples, bool top_half, coarse::BurstSamples* out);
-    /// Every rank, direct: the realizations back to `start` after a sample cut by a stop.
-    void go_back_to_sample_start(const std::vector<RealizationState>& start);
+    /// Collective: this rank's realizations back to `states` (the kept state, the resume point,
+    /// a sample's start); a failure on any rank ends the run on all ("going back to WHERE").
+    void restore_agreed(const std::vector<RealizationState>& states, const char* where);
     /// Root: at_rest_since_ from a new sample.
     void note_rest(const SampleRecord& rec);
     /// lift() and lift_apart() on the root: the command to the other ranks, then do_lift().

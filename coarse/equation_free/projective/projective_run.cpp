@@ -216,9 +216,8 @@ void ProjectiveRun::warm_up() {
 
 void ProjectiveRun::warmup_safe_point(const BurstSamples& w, double burst) {
     // The samples of the last burst length (and a tolerance), as the drift test selects them.
-    const double from = stepper_.time() - burst - time_tolerance(t_end_);
-    std::size_t first = 0;
-    while (first < w.t.size() && w.t[first] < from) ++first;
+    const std::size_t first =
+        first_sample_at_or_after(w.t, stepper_.time() - burst - time_tolerance(t_end_));
     BurstSamples& tail = state_.warmup_tail;
     tail = {};
     const auto keep = [first](const auto& all, auto& kept) {
