@@ -3,9 +3,11 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -14,6 +16,7 @@
 #include "core/contracts.hpp"
 #include "core/error.hpp"
 #include "mpi_driver/output/h5_file.hpp"
+#include "mpi_driver/parallel/mpi_broadcast.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -147,66 +150,121 @@ std::vector<double> flatten(const std::vector<Vec3>& v, std::size_t rows) {
     return out;
 }
 
-/// A parallel-HDF5 file being written collectively: shared datasets, each rank writing one
-/// contiguous block of rows (its realizations are consecutive in global order).
-class CollectiveFile {
-  public:
-    CollectiveFile(const std::filesystem::path& path, MPI_Comm comm) : path_(path.string()) {
-        H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-        const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-        H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
-        file_ = H5Fcreate(path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-        H5Pclose(fapl);
-        if (file_ < 0)
-            throw RuntimeFailure(fmt::format("cannot create the checkpoint file {}", path_));
-        dxpl_ = H5Pcreate(H5P_DATASET_XFER);
-        H5Pset_dxpl_mpio(dxpl_, H5FD_MPIO_COLLECTIVE);
-        const hid_t g = H5Gcreate2(file_, "/realizations", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        if (g < 0)
-            throw RuntimeFailure(fmt::format("HDF5 error in {}: create /realizations", path_));
-        H5Gclose(g);
-    }
-    ~CollectiveFile() {
-        if (dxpl_ >= 0) H5Pclose(dxpl_);
-        if (file_ >= 0) H5Fclose(file_);
-    }
-    CollectiveFile(const CollectiveFile&) = delete;
-    CollectiveFile& operator=(const CollectiveFile&) = delete;
+/// Where one realization's rows start in the /realizations datasets.
+struct RowStart {
+    hsize_t realization = 0, particle = 0, pair = 0;
+};
 
-    /// Dataset `name` of total_rows x width; this rank writes rows [first, first + rows).
-    template <class T>
-    void write_block(const std::string& name, hid_t type, hsize_t total_rows, hsize_t width,
-                     hsize_t first, const std::vector<T>& data) {
-        const hsize_t rows = width == 0 ? 0 : data.size() / width;
-        const int rank = width == 1 ? 1 : 2;
-        const hsize_t dims[2] = {total_rows, width};
-        const hid_t fspace = H5Screate_simple(rank, dims, nullptr);
-        const hid_t d =
-            H5Dcreate2(file_, name.c_str(), type, fspace, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        herr_t status = d < 0 ? -1 : 0;
-        if (status >= 0 && total_rows > 0) {
-            const hsize_t start[2] = {first, 0}, count[2] = {rows, width};
-            if (rows > 0)
-                H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, count, nullptr);
-            else
-                H5Sselect_none(fspace);
-            const hsize_t mdims[2] = {std::max<hsize_t>(rows, 1), width};
-            const hid_t mspace = H5Screate_simple(rank, mdims, nullptr);
-            if (rows == 0) H5Sselect_none(mspace);
-            status = H5Dwrite(d, type, mspace, fspace, dxpl_, rows > 0 ? data.data() : nullptr);
-            H5Sclose(mspace);
+/// The /realizations datasets of a checkpoint the root writes alone: created at their full
+/// sizes, then filled one realization at a time (rows in global realization order).
+class RealizationTable {
+  public:
+    RealizationTable(H5File& f, hsize_t realizations, hsize_t particles, hsize_t pairs) : f_(f) {
+        f.create_group("/realizations");
+        create("meta", H5T_NATIVE_INT64, realizations, 6);
+        create("checksum", H5T_NATIVE_INT64, realizations, 1);
+        create("still_samples", H5T_NATIVE_INT64, realizations, 1);
+        create("time", H5T_NATIVE_DOUBLE, realizations, 1);
+        for (const char* name : kVectors) create(name, H5T_NATIVE_DOUBLE, particles, 3);
+        create("tag", H5T_NATIVE_INT64, particles, 1);
+        create("species", H5T_NATIVE_UINT8, particles, 1);
+        create("pair_tags", H5T_NATIVE_INT64, pairs, 2);
+        create("pair_xi", H5T_NATIVE_DOUBLE, pairs, 3);
+    }
+
+    void write(const RealizationState& s, RowStart at) {
+        const std::size_t n = s.particles();
+        const std::vector<std::int64_t> meta{s.index,
+                                             s.step,
+                                             static_cast<std::int64_t>(n),
+                                             static_cast<std::int64_t>(s.pairs.size()),
+                                             s.reference.empty() ? 0 : 1,
+                                             s.wall[0].empty() ? 0 : 1};
+        rows("meta", H5T_NATIVE_INT64, at.realization, 6, meta);
+        rows("checksum", H5T_NATIVE_INT64, at.realization, 1,
+             std::vector<std::int64_t>{to_stored(s.checksum())});
+        rows("still_samples", H5T_NATIVE_INT64, at.realization, 1,
+             std::vector<std::int64_t>{s.still_samples});
+        rows("time", H5T_NATIVE_DOUBLE, at.realization, 1, std::vector<double>{s.time});
+        const std::vector<Vec3>* arrays[8] = {&s.x,      &s.v,         &s.omega,   &s.force,
+                                              &s.torque, &s.reference, &s.wall[0], &s.wall[1]};
+        for (int a = 0; a < 8; ++a)
+            rows(kVectors[a], H5T_NATIVE_DOUBLE, at.particle, 3, flatten(*arrays[a], n));
+        rows("tag", H5T_NATIVE_INT64, at.particle, 1,
+             std::vector<std::int64_t>(s.tag.begin(), s.tag.end()));
+        rows("species", H5T_NATIVE_UINT8, at.particle, 1, s.species);
+        std::vector<std::int64_t> pair_tags;
+        std::vector<double> pair_xi;
+        for (const auto& p : s.pairs) {
+            pair_tags.insert(pair_tags.end(), {p.tag_i, p.tag_j});
+            pair_xi.insert(pair_xi.end(), {p.xi.x, p.xi.y, p.xi.z});
         }
-        if (d >= 0) H5Dclose(d);
-        H5Sclose(fspace);
-        if (status < 0)
-            throw RuntimeFailure(fmt::format("HDF5 error in {}: write {}", path_, name));
+        rows("pair_tags", H5T_NATIVE_INT64, at.pair, 2, pair_tags);
+        rows("pair_xi", H5T_NATIVE_DOUBLE, at.pair, 3, pair_xi);
     }
 
   private:
-    std::string path_;
-    hid_t file_ = -1;
-    hid_t dxpl_ = -1;
+    static constexpr const char* kVectors[8] = {"x",      "v",         "omega",      "force",
+                                                "torque", "reference", "wall_floor", "wall_lid"};
+
+    void create(const std::string& name, hid_t type, hsize_t total_rows, hsize_t width) {
+        const hsize_t dims[2] = {total_rows, width};
+        const hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, nullptr);
+        const std::string path = "/realizations/" + name;
+        const hid_t d =
+            H5Dcreate2(f_.id(), path.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        H5Sclose(space);
+        f_.check_id(d, "create " + path);
+        H5Dclose(d);
+    }
+
+    /// Rows [first, first + data.size() / width) of dataset `name`.
+    template <class T>
+    void rows(const std::string& name, hid_t type, hsize_t first, hsize_t width,
+              const std::vector<T>& data) {
+        const hsize_t count = data.size() / width;
+        if (count == 0) return;
+        const std::string path = "/realizations/" + name;
+        const hid_t d = f_.check_id(H5Dopen2(f_.id(), path.c_str(), H5P_DEFAULT), "open " + path);
+        const hid_t fspace = H5Dget_space(d);
+        const hsize_t start[2] = {first, 0}, cnt[2] = {count, width};
+        H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, cnt, nullptr);
+        const hid_t mspace = H5Screate_simple(width == 1 ? 1 : 2, cnt, nullptr);
+        const herr_t status = H5Dwrite(d, type, mspace, fspace, H5P_DEFAULT, data.data());
+        H5Sclose(mspace);
+        H5Sclose(fspace);
+        H5Dclose(d);
+        f_.check(status, "write " + path);
+    }
+
+    H5File& f_;
 };
+
+constexpr int kStateTag = 7301;  ///< a realization's state on its way to the checkpoint's writer
+constexpr std::size_t kChunk = std::size_t{1} << 30;  ///< bytes per message (MPI counts are int)
+
+/// A non-root rank's realization states to the root (which writes them): per state its size,
+/// then its bytes in chunks of at most 1 GiB.
+void send_states(const std::vector<RealizationState>& local, MPI_Comm comm) {
+    for (const RealizationState& s : local) {
+        const std::vector<std::uint8_t> bytes = pack(s);
+        const std::uint64_t size = bytes.size();
+        MPI_Send(&size, 1, MPI_UINT64_T, 0, kStateTag, comm);
+        for (std::size_t at = 0; at < bytes.size(); at += kChunk)
+            MPI_Send(bytes.data() + at, static_cast<int>(std::min(kChunk, bytes.size() - at)),
+                     MPI_BYTE, 0, kStateTag, comm);
+    }
+}
+
+RealizationState receive_state(int from, MPI_Comm comm) {
+    std::uint64_t size = 0;
+    MPI_Recv(&size, 1, MPI_UINT64_T, from, kStateTag, comm, MPI_STATUS_IGNORE);
+    std::vector<std::uint8_t> bytes(size);
+    for (std::size_t at = 0; at < bytes.size(); at += kChunk)
+        MPI_Recv(bytes.data() + at, static_cast<int>(std::min(kChunk, bytes.size() - at)),
+                 MPI_BYTE, from, kStateTag, comm, MPI_STATUS_IGNORE);
+    return unpack(bytes);
+}
 }  // namespace
 
 CheckpointWriter::CheckpointWriter(const EnsembleLayout& layout, const CheckpointSettings& settings,
@@ -223,28 +281,94 @@ std::filesystem::path CheckpointWriter::write(long sequence,
                                               const CheckpointHeader* header) const {
     const std::filesystem::path final_path =
         settings_.directory / checkpoint_file_name(prefix_, sequence);
+    ensure_space(final_path, local);
+    const RowCounts counts = count_rows(local);
+    // Every byte is written by the root, so that whatever fails is known to one rank that can
+    // tell all the others (a failed collective MPI-IO write could not be agreed on).
+    std::string failure;
+    if (layout_.is_root())
+        failure = write_on_root(final_path, sequence, local, counts, *header);
+    else
+        send_states(local, layout_.mpi().comm());
+    broadcast_string(layout_.mpi().comm(), failure);
+    if (!failure.empty())
+        throw CheckpointWriteError(fmt::format("writing checkpoint {}: {}", sequence, failure));
+    return final_path;
+}
+
+CheckpointWriter::RowCounts CheckpointWriter::count_rows(
+    const std::vector<RealizationState>& local) const {
+    std::array<double, 2> mine{0, 0}, total{0, 0};  // exact: counts far below 2^53
+    for (const auto& s : local) {
+        mine[0] += static_cast<double>(s.particles());
+        mine[1] += static_cast<double>(s.pairs.size());
+    }
+    MPI_Reduce(mine.data(), total.data(), 2, MPI_DOUBLE, MPI_SUM, 0, layout_.mpi().comm());
+    return {static_cast<hsize_t>(total[0]), static_cast<hsize_t>(total[1])};
+}
+
+std::string CheckpointWriter::write_on_root(const std::filesystem::path& final_path, long sequence,
+                                            const std::vector<RealizationState>& local,
+                                            const RowCounts& counts,
+                                            const CheckpointHeader& header) const {
     std::filesystem::path tmp = final_path;
     tmp += ".tmp";
-    ensure_space(final_path, local);
-    write_realizations(tmp, local);
-    MPI_Barrier(layout_.mpi().comm());
-    if (!layout_.is_root()) return final_path;
-    if (settings_.debug_delay > 0)  // test hook: a window in which the job can be killed mid-write
-        std::this_thread::sleep_for(std::chrono::duration<double>(settings_.debug_delay));
-    try {
-        write_header(tmp, sequence, *header);
-    } catch (const std::exception&) {
+    std::string failure;  // the first; later steps are skipped, but every state is received
+    auto attempt = [&](auto&& step) {
+        if (!failure.empty()) return;
+        try {
+            step();
+        } catch (const std::exception& e) {
+            failure = e.what();
+        }
+    };
+    std::optional<H5File> file;
+    std::optional<RealizationTable> table;
+    attempt([&] {
+        file.emplace(H5File::create(tmp));
+        table.emplace(*file, static_cast<hsize_t>(layout_.size()), counts.particles, counts.pairs);
+    });
+    const MPI_Comm comm = layout_.mpi().comm();
+    RowStart at;
+    for (int rank = 0; rank < layout_.mpi().size(); ++rank) {
+        for (int j = 0; j < layout_.per_rank(); ++j) {
+            const RealizationState received =
+                rank == 0 ? RealizationState{} : receive_state(rank, comm);
+            const RealizationState& s = rank == 0 ? local[static_cast<std::size_t>(j)] : received;
+            EFDEM_ASSERT(s.index == static_cast<long>(at.realization));
+            attempt([&] { table->write(s, at); });
+            at.realization += 1;
+            at.particle += s.particles();
+            at.pair += s.pairs.size();
+        }
+        if (rank == 0 && settings_.debug_delay > 0)  // test hook: the job can be killed, or the
+            // disk filled, while the file is open and the other ranks' rows are still to come
+            std::this_thread::sleep_for(std::chrono::duration<double>(settings_.debug_delay));
+    }
+    attempt([&] { write_header(*file, sequence, header); });
+    if (!failure.empty() && file) {
+        // A file that failed for lack of space can fail to close too, and HDF5 then keeps it
+        // half closed, which crashes the library's clean-up at exit: its rows are dropped
+        // first, so that the close has the room they took.
+        std::error_code ignored;
+        std::filesystem::resize_file(tmp, 0, ignored);
+    }
+    table.reset();
+    file.reset();
+    attempt([&] {
+        std::error_code ec;
+        std::filesystem::rename(tmp, final_path, ec);
+        if (ec)
+            throw RuntimeFailure(fmt::format("cannot rename the checkpoint {} to {}: {}",
+                                             tmp.string(), final_path.string(), ec.message()));
+    });
+    if (failure.empty()) {
+        prune(final_path);
+    } else {
         std::error_code ignored;
         std::filesystem::remove(tmp, ignored);  // a checkpoint that can never be whole
-        throw;
     }
-    std::error_code ec;
-    std::filesystem::rename(tmp, final_path, ec);
-    if (ec)
-        throw RuntimeFailure(fmt::format("cannot rename the checkpoint {} to {}: {}", tmp.string(),
-                                         final_path.string(), ec.message()));
-    prune(final_path);
-    return final_path;
+    return failure;
 }
 
 void CheckpointWriter::ensure_space(const std::filesystem::path& path,
@@ -280,71 +404,7 @@ void CheckpointWriter::ensure_space(const std::filesystem::path& path,
                         path.string(), verdict[1] / 1e6));
 }
 
-void CheckpointWriter::write_realizations(const std::filesystem::path& tmp,
-                                          const std::vector<RealizationState>& local) const {
-    const MPI_Comm comm = layout_.mpi().comm();
-    const int k = layout_.per_rank(), total = layout_.size();
-    std::vector<long> mine, all(static_cast<std::size_t>(2 * total));
-    for (const auto& s : local) {
-        mine.push_back(static_cast<long>(s.particles()));
-        mine.push_back(static_cast<long>(s.pairs.size()));
-    }
-    MPI_Allgather(mine.data(), 2 * k, MPI_LONG, all.data(), 2 * k, MPI_LONG, comm);
-    hsize_t n_total = 0, p_total = 0, n_first = 0, p_first = 0;
-    for (int r = 0; r < total; ++r) {
-        if (r == layout_.first_index()) {
-            n_first = n_total;
-            p_first = p_total;
-        }
-        n_total += static_cast<hsize_t>(all[2 * r]);
-        p_total += static_cast<hsize_t>(all[2 * r + 1]);
-    }
-
-    std::vector<std::int64_t> meta, checksum, tags, pair_tags, still;
-    std::vector<double> time, pair_xi;
-    std::vector<std::uint8_t> species;
-    std::vector<double> blocks[8];  // x, v, omega, force, torque, reference, wall_floor, wall_lid
-    for (const auto& s : local) {
-        const std::size_t n = s.particles();
-        meta.insert(meta.end(), {s.index, s.step, static_cast<std::int64_t>(n),
-                                 static_cast<std::int64_t>(s.pairs.size()),
-                                 s.reference.empty() ? 0 : 1, s.wall[0].empty() ? 0 : 1});
-        checksum.push_back(to_stored(s.checksum()));
-        still.push_back(s.still_samples);
-        time.push_back(s.time);
-        const std::vector<Vec3>* arrays[8] = {&s.x,      &s.v,         &s.omega,   &s.force,
-                                              &s.torque, &s.reference, &s.wall[0], &s.wall[1]};
-        for (int a = 0; a < 8; ++a) {
-            const auto flat = flatten(*arrays[a], n);
-            blocks[a].insert(blocks[a].end(), flat.begin(), flat.end());
-        }
-        tags.insert(tags.end(), s.tag.begin(), s.tag.end());
-        species.insert(species.end(), s.species.begin(), s.species.end());
-        for (const auto& p : s.pairs) {
-            pair_tags.insert(pair_tags.end(), {p.tag_i, p.tag_j});
-            pair_xi.insert(pair_xi.end(), {p.xi.x, p.xi.y, p.xi.z});
-        }
-    }
-    CollectiveFile f(tmp, comm);
-    const auto R = static_cast<hsize_t>(total);
-    const auto first = static_cast<hsize_t>(layout_.first_index());
-    f.write_block("/realizations/meta", H5T_NATIVE_INT64, R, 6, first, meta);
-    f.write_block("/realizations/checksum", H5T_NATIVE_INT64, R, 1, first, checksum);
-    f.write_block("/realizations/still_samples", H5T_NATIVE_INT64, R, 1, first, still);
-    f.write_block("/realizations/time", H5T_NATIVE_DOUBLE, R, 1, first, time);
-    const char* names[8] = {"x",      "v",         "omega",      "force",
-                            "torque", "reference", "wall_floor", "wall_lid"};
-    for (int a = 0; a < 8; ++a)
-        f.write_block(fmt::format("/realizations/{}", names[a]), H5T_NATIVE_DOUBLE, n_total, 3,
-                      n_first, blocks[a]);
-    f.write_block("/realizations/tag", H5T_NATIVE_INT64, n_total, 1, n_first, tags);
-    f.write_block("/realizations/species", H5T_NATIVE_UINT8, n_total, 1, n_first, species);
-    f.write_block("/realizations/pair_tags", H5T_NATIVE_INT64, p_total, 2, p_first, pair_tags);
-    f.write_block("/realizations/pair_xi", H5T_NATIVE_DOUBLE, p_total, 3, p_first, pair_xi);
-}
-
-void CheckpointWriter::write_header(const std::filesystem::path& tmp, long sequence,
-                                    const CheckpointHeader& state) const {
+void CheckpointWriter::write_header(H5File& f, long sequence, const CheckpointHeader& state) const {
     CheckpointHeader h = identity_;
     h.sequence = sequence;
     h.stepper = state.stepper;
@@ -356,7 +416,6 @@ void CheckpointWriter::write_header(const std::filesystem::path& tmp, long seque
     std::sort(h.outputs.begin(), h.outputs.end(),
               [](const auto& a, const auto& b) { return a.name < b.name; });
 
-    H5File f = H5File::open(tmp, true);
     f.attribute("/", "format_version", h.format_version);
     f.write_build_provenance();
     f.attribute("/", "mode", h.mode);

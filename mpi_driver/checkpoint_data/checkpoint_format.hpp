@@ -111,10 +111,15 @@ struct RealizationState;
 
 /// Where the EnsembleStepper sends a checkpoint (CheckpointWriter; an interface so that the
 /// stepper does not depend on HDF5).
-/// Thrown on every rank alike (collectively agreed) when a checkpoint would not fit on the disk.
-class CheckpointSpaceError : public RuntimeFailure {
+/// Thrown on every rank alike (collectively agreed) when a checkpoint cannot be written.
+class CheckpointWriteError : public RuntimeFailure {
   public:
-    explicit CheckpointSpaceError(const std::string& message) : RuntimeFailure(message) {}
+    explicit CheckpointWriteError(const std::string& message) : RuntimeFailure(message) {}
+};
+/// The CheckpointWriteError of a checkpoint that would not fit on the disk (nothing written).
+class CheckpointSpaceError : public CheckpointWriteError {
+  public:
+    explicit CheckpointSpaceError(const std::string& message) : CheckpointWriteError(message) {}
 };
 
 class CheckpointSink {

@@ -13,7 +13,7 @@
 /// | checkpoint.directory         | where checkpoints are written                        | output.directory |
 /// | restart.allow_physics_change | accept a restart whose scene changes physics keys    | false   |
 /// | debug.checkpoint_delay       | test only: seconds to sleep inside every checkpoint  | 0       |
-/// |                              | write (between the collective part and the marker)   |         |
+/// |                              | write (after the root's own rows, before the rest)   |         |
 // clang-format on
 
 #include <filesystem>

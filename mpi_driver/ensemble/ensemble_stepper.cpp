@@ -372,7 +372,7 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
             last_checkpoint_time_ = time();
         }
         return last_checkpoint_;
-    } catch (const CheckpointSpaceError& e) {
+    } catch (const CheckpointWriteError& e) {
         // Every rank knows it at once: they end together, and the root marks the run file.
         if (layout_.is_root()) log::error("{}", e.what());
         throw RunFailed(e.what());
