@@ -261,8 +261,8 @@ RealizationState receive_state(int from, MPI_Comm comm) {
     MPI_Recv(&size, 1, MPI_UINT64_T, from, kStateTag, comm, MPI_STATUS_IGNORE);
     std::vector<std::uint8_t> bytes(size);
     for (std::size_t at = 0; at < bytes.size(); at += kChunk)
-        MPI_Recv(bytes.data() + at, static_cast<int>(std::min(kChunk, bytes.size() - at)),
-                 MPI_BYTE, from, kStateTag, comm, MPI_STATUS_IGNORE);
+        MPI_Recv(bytes.data() + at, static_cast<int>(std::min(kChunk, bytes.size() - at)), MPI_BYTE,
+                 from, kStateTag, comm, MPI_STATUS_IGNORE);
     return unpack(bytes);
 }
 }  // namespace
