@@ -41,6 +41,15 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid, bool to
     }
     if (!p.x().empty()) o.mean_height /= static_cast<double>(p.x().size());
     if (bed_) o.bed = dem::observe_bed(system_, *bed_).pack();
+    if (output_.thermo_every > 0) {
+        const dem::ThermoStats st = system_.thermo_stats();
+        const double n = static_cast<double>(std::max<std::size_t>(1, p.size()));
+        o.thermo.ke_per_particle = system_.kinetic_energy() / n;
+        o.thermo.contacts_per_particle = static_cast<double>(st.contacts) / n;
+        o.thermo.max_overlap = st.max_overlap;
+        o.thermo.neighbor_builds =
+            system_.neighbor_list() ? static_cast<double>(system_.neighbor_list()->builds()) : 0;
+    }
     return o;
 }
 

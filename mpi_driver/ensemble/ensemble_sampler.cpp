@@ -10,7 +10,7 @@ namespace efdem::mpi_driver {
 
 namespace {
 /// Per realization and sample: centre of mass, lowest and highest centre, mean height, at rest.
-constexpr Eigen::Index kScalars = 5;
+constexpr Eigen::Index kScalars = 9;
 
 /// The rows of `all` listed in `rows` (all rows when every realization is in the ensemble).
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Index>& rows) {
@@ -81,7 +81,9 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
         icdf.push_back(std::move(o.icdf));
         if (top) top_icdf.push_back(std::move(o.top));
         Eigen::VectorXd row(kScalars);
-        row << o.com, o.z_min, o.z_max, o.mean_height, r->at_rest() ? 1.0 : 0.0;
+        const ThermoNumbers& th = o.thermo;
+        row << o.com, o.z_min, o.z_max, o.mean_height, r->at_rest() ? 1.0 : 0.0, th.ke_per_particle,
+            th.contacts_per_particle, th.max_overlap, th.neighbor_builds;
         scalars.push_back(std::move(row));
         if (bed_width > 0) {
             EFDEM_ASSERT(static_cast<Eigen::Index>(o.bed.size()) == bed_width);
@@ -113,6 +115,7 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
     rec.variance = coarse::ensemble_variance(used_icdf, rec.mean);
     rec.com = all_scalar_rows.col(0);
     rec.at_rest = all_scalar_rows.col(4);
+    rec.thermo = all_scalar_rows.rightCols(4);
     if (settings_.bed) {
         rec.bed = bed_record(all_bed_rows, *settings_.bed);
         rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(),

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -23,6 +24,15 @@
 
 namespace efdem::mpi_driver {
 
+/// A realization's state in the numbers of a LAMMPS thermo line (docs/output.md, "Thermo").
+struct ThermoNumbers {
+    static constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    double ke_per_particle = nan;        ///< translational + rotational [rho_s g d_p^4]
+    double contacts_per_particle = nan;  ///< touching pairs per particle
+    double max_overlap = nan;            ///< largest overlap / the pair's diameter
+    double neighbor_builds = nan;        ///< neighbour-list builds so far
+};
+
 /// What a realization reports at one sample (heights in d_p).
 struct Observation {
     Eigen::VectorXd icdf;  ///< ICDF of the observed species on the p-grid
@@ -35,6 +45,8 @@ struct Observation {
     double z_max = 0;  ///< highest particle centre
     /// The packed dem::BedObservation (observe.bed = true; empty otherwise).
     std::vector<double> bed;
+    /// LAMMPS-style thermo numbers (output.thermo_interval > 0; NaN otherwise).
+    ThermoNumbers thermo;
 };
 
 /// Data moved for a lift: reals and bytes (either may be empty).

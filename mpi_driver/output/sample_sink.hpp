@@ -33,6 +33,9 @@ struct SampleRecord {
     /// R: 1 where the realization is at rest (Realization::at_rest), 0 where it moves, NaN where
     /// it was dropped.
     Eigen::VectorXd at_rest;
+    /// R x 4: each realization's thermo numbers (ThermoNumbers: KE per particle, contacts per
+    /// particle, largest overlap, neighbour-list builds); NaN where dropped or not measured.
+    Eigen::MatrixXd thermo;
     /// observe.bed: each realization's bed quantities and their mean over the realizations in
     /// the ensemble; empty otherwise.
     BedRecord bed;

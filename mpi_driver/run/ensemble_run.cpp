@@ -16,6 +16,7 @@
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "mpi_driver/output/csv_recorder.hpp"
 #include "mpi_driver/output/recorder_list.hpp"
+#include "mpi_driver/output/thermo_screen.hpp"
 #include "mpi_driver/parallel/ensemble_layout.hpp"
 #include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/run/driver.hpp"
@@ -79,6 +80,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
 #endif
             owned.push_back(
                 std::make_unique<CsvRecorder>(s.output.directory, s.output.prefix, prov, resume));
+            if (s.output.thermo_interval > 0)
+                owned.push_back(
+                    std::make_unique<ThermoScreen>(s.output.thermo_interval, layout.size()));
             recorders = std::make_unique<RecorderList>(std::move(owned));
         }
         RealizationOutput out{
