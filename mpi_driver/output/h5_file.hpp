@@ -36,6 +36,7 @@ class H5Series {
     void append_integer(std::int64_t value) { append(std::span<const std::int64_t>(&value, 1)); }
     void append_text(const std::string& text);
     hsize_t rows() const { return rows_; }
+    hsize_t row_size() const { return row_size_; }
 
   private:
     H5Series() = default;

@@ -258,8 +258,6 @@ H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row
     auto it = series_.find(name);
     if (it == series_.end()) {
         const bool existing = file_.exists(name);  // a restarted run appends; documented when made
-        hsize_t row_size = 1;
-        for (hsize_t d : row_shape) row_size *= d;
         it = series_
                  .emplace(name, existing ? H5Series::open(file_, name, type)
                                          : H5Series(file_, name, std::move(row_shape), type))
@@ -272,20 +270,22 @@ H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row
             // this record's row first.
             const std::vector<std::string_view>& dims = dataset_doc(name).dims;
             const std::string axis = dims.empty() ? name : axis_of(name, dims[0]);
-            const hsize_t earlier =
-                axis != name && file_.exists(axis) ? file_.shape(axis).at(0) : hsize_t{0};
-            for (hsize_t k = 1; k < earlier; ++k) {
-                if (type == H5Series::Type::real)
-                    it->second.append(
-                        std::vector<double>(row_size, std::numeric_limits<double>::quiet_NaN()));
-                else if (type == H5Series::Type::integer)
-                    it->second.append(std::vector<std::int64_t>(row_size, -1));
-                else
-                    it->second.append_text("");
-            }
+            if (axis != name && file_.exists(axis) && file_.shape(axis).at(0) > 1)
+                fill_rows(it->second, type, file_.shape(axis).at(0) - 1);
         }
     }
     return it->second;
+}
+
+void Hdf5Recorder::fill_rows(H5Series& s, H5Series::Type type, hsize_t rows) {
+    while (s.rows() < rows) {
+        if (type == H5Series::Type::real)
+            s.append(std::vector<double>(s.row_size(), std::numeric_limits<double>::quiet_NaN()));
+        else if (type == H5Series::Type::integer)
+            s.append(std::vector<std::int64_t>(s.row_size(), -1));
+        else
+            s.append_text("");
+    }
 }
 
 void Hdf5Recorder::bed_sample(const SampleRecord& s) {
@@ -369,6 +369,14 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
         series("/samples/compact", {4}, T::real).append(as_span(s.compact));
         series("/samples/compact_status", {}, T::integer).append_integer(s.compact_status);
     }
+    // The records not every sample makes (the compact fit stops when its observable falls
+    // back): a sample without one gets a fill row there, so that every array of /samples keeps
+    // the rows of /samples/time.
+    const hsize_t rows = series("/samples/time", {}, T::real).rows();
+    for (const auto& [name, type] :
+         {std::pair{"/samples/at_rest", T::integer}, std::pair{"/samples/top_mean", T::real},
+          std::pair{"/samples/compact", T::real}, std::pair{"/samples/compact_status", T::integer}})
+        if (file_.exists(name)) fill_rows(series(name, {}, type), type, rows);
     if (species_ > 0 && !s.bed.empty()) bed_sample(s);
     file_.flush();
 }

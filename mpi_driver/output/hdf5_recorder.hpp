@@ -48,6 +48,9 @@ class Hdf5Recorder final : public RunRecorder {
     /// part of a restarted one.
     void start(const RunProvenance& p, bool resume);
     H5Series& series(const std::string& name, std::vector<hsize_t> row_shape, H5Series::Type type);
+    /// Appends fill rows (NaN, -1, empty text) to `s` until it has `rows` rows: a record an
+    /// array did not get keeps the array's rows those of its axis.
+    static void fill_rows(H5Series& s, H5Series::Type type, hsize_t rows);
     /// Writes `name`'s units, description and dimension scales (run_file_schema.hpp).
     void document(const std::string& name);
     /// A documented axis dataset 0, 1, ..., n-1 (/realization, /cpi/coarse_node), unless it
