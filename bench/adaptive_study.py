@@ -63,6 +63,7 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
+import run_files  # noqa: E402
 import plot_layout  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
@@ -172,7 +173,7 @@ def load(path):
     with h5py.File(path, "r") as f:
         d = {k: attr_text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
         d["t"] = f["samples/time"][:]
-        d["mean"] = f["samples/mean"][:]
+        d["mean"] = run_files.get(f, "samples/mean_icdf")[:]
         d["var"] = f["samples/variance"][:]
         d["icdf"] = f["samples/icdf"][:]  # samples x R x nodes
         if "cpi/status" in f:

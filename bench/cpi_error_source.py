@@ -46,6 +46,7 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
+import run_files  # noqa: E402
 
 sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
@@ -150,7 +151,7 @@ def load(out, name):
     with h5py.File(path, "r") as f:
         d = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
         d["t"] = f["samples/time"][:]
-        d["mean"] = f["samples/mean"][:]
+        d["mean"] = run_files.get(f, "samples/mean_icdf")[:]
         d["var"] = f["samples/variance"][:]
         d["icdf"] = f["samples/icdf"][:]
         if "samples/com" in f:

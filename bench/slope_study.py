@@ -59,6 +59,7 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
 import accuracy_metrics as am  # noqa: E402
+import run_files  # noqa: E402
 
 sys.path.insert(0, HERE)
 import study_runs as sr  # noqa: E402
@@ -135,7 +136,7 @@ def load(path):
     with h5py.File(path, "r") as f:
         d = {k: sr.text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
         d["t"] = f["samples/time"][:]
-        d["mean"] = f["samples/mean"][:]
+        d["mean"] = run_files.get(f, "samples/mean_icdf")[:]
         if "cpi/controller" in f:
             c = f["cpi/controller"]
             d["controller"] = {k: c[k][:] for k in c.keys()}

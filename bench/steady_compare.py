@@ -29,7 +29,7 @@ def main():
     a = ap.parse_args()
     try:
         with run_files.open_run(os.path.join(a.folder, "direct.h5"), ["samples/time"]) as d:
-            t, mean = d["samples/time"][:], d["samples/mean"][:]
+            t, mean = d["samples/time"][:], run_files.get(d, "samples/mean_icdf")[:]
             p = d["p"][:]
             R = int(d.attrs["realizations"])
             direct_dem = float(d.attrs.get("dem_time", t[-1]))

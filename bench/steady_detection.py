@@ -18,11 +18,15 @@ Writes bench/results/steady_detection.md (default files only).
 """
 import argparse
 import os
+import sys
 
 import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
+import run_files  # noqa: E402
+
 RESULTS = os.path.join(HERE, "results")
 DEFAULT = [
     ("U_s 0.19, CPI cpi.accuracy 1.5", "accuracy_study/demo_acc1.5.h5"),
@@ -42,7 +46,7 @@ def text(v):
 def windows(f):
     """(time, mean ICDF over the window) per CPI burst kept (or 10-unit windows every 30 units of a
     direct run), and the per-burst z of a CPI run (NaN for a direct one)."""
-    ts, mean = f["samples/time"][:], f["samples/mean"][:]
+    ts, mean = f["samples/time"][:], run_files.get(f, "samples/mean_icdf")[:]
     if "cpi" in f:
         status = [text(s) for s in f["cpi/status"][:]]
         keep = np.array([s != "rejected" for s in status])

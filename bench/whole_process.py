@@ -33,6 +33,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
+import run_files  # noqa: E402
+
 sys.path.insert(0, HERE)
 import stop_times as st  # noqa: E402
 import study_runs as sr  # noqa: E402
@@ -96,7 +99,7 @@ def make(args, case):
 def load(path):
     with h5py.File(path, "r") as f:
         d = {k: sr.text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
-        d["t"], d["mean"], d["icdf"] = f["samples/time"][:], f["samples/mean"][:], f["samples/icdf"][:]
+        d["t"], d["mean"], d["icdf"] = f["samples/time"][:], run_files.get(f, "samples/mean_icdf")[:], f["samples/icdf"][:]
         d["rest"] = f["samples/at_rest"][:] if "samples/at_rest" in f else None
     return d
 

@@ -29,6 +29,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import accuracy_metrics as am  # noqa: E402
 import plot_layout  # noqa: E402
+import run_files  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 # The scenes of the study are checked in; the study only overrides keys. Full study: the demo bed
@@ -108,7 +109,7 @@ def load(h5):
     with h5py.File(h5, "r") as f:
         d = {k: f.attrs[k] for k in ("realizations", "wall_seconds", "particle_steps", "simulated_time", "dem_time")}
         d["t"] = f["samples/time"][:]
-        d["mean"] = f["samples/mean"][:]
+        d["mean"] = run_files.get(f, "samples/mean_icdf")[:]
         d["var"] = f["samples/variance"][:]
         d["p"] = f["p"][:]
         d["scene"] = f["scene"][()].decode() if isinstance(f["scene"][()], bytes) else f["scene"][()]

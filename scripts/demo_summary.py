@@ -33,7 +33,7 @@ import numpy as np
 import ensemble_bands
 import run_files
 
-NEEDED = ["p", "samples/time", "samples/mean", "samples/variance"]
+NEEDED = ["p", "samples/time", "samples/mean_icdf", "samples/variance"]
 
 
 def load(path, mode):
@@ -43,7 +43,7 @@ def load(path, mode):
         if got != mode:
             raise run_files.UsageError(f"{path}: a {got} run; expected the {mode} run here "
                                        "(arguments: DIRECT.h5 CPI.h5)")
-        run = {k: f[k][:] for k in NEEDED}
+        run = {k: run_files.get(f, k)[:] for k in NEEDED}
         run["realizations_used"] = run_files.realizations_per_sample(f)
         for k in ("realizations", "simulated_time", "dem_time", "wall_seconds", "particle_steps"):
             if k not in f.attrs:
@@ -72,7 +72,7 @@ def agreement(d, c):
                                       return_indices=True)
     if len(common) == 0:
         raise run_files.UsageError("the two runs share no sample time (other observe.interval or time spans)")
-    md, mc = d["samples/mean"][i_d], c["samples/mean"][i_c]
+    md, mc = d["samples/mean_icdf"][i_d], c["samples/mean_icdf"][i_c]
     # The realizations in each mean at each common time, as a column against the nodes.
     n_d, n_c = d["realizations_used"][i_d][:, None], c["realizations_used"][i_c][:, None]
     var_d, var_c = d["samples/variance"][i_d], c["samples/variance"][i_c]  # unbiased (R - 1) variances

@@ -4,7 +4,7 @@
 #
 #   bash scripts/install_deps.sh            # build + test + plotting dependencies
 #   EFDEM_WITH_LAMMPS=1 bash scripts/install_deps.sh   # also the LAMMPS peer for bench/
-#   EFDEM_WITH_CLIENTS=1 bash scripts/install_deps.sh  # also VTK and pandas for the clients tier
+#   EFDEM_WITH_CLIENTS=1 bash scripts/install_deps.sh  # also VTK, pandas, xarray (netCDF4, h5netcdf) for the clients tier
 set -euo pipefail
 
 packages=(
@@ -20,7 +20,7 @@ if [ "${EFDEM_WITH_LAMMPS:-0}" = "1" ]; then
   packages+=(lammps)
 fi
 if [ "${EFDEM_WITH_CLIENTS:-0}" = "1" ]; then
-  packages+=(python3-vtk9 python3-pandas)
+  packages+=(python3-vtk9 python3-pandas python3-xarray python3-netcdf4 python3-h5netcdf)
 fi
 
 missing=()

@@ -28,6 +28,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, "..", "bench", "scenes", "demo_bed.cfg")  # the demo bed without the demo's cpi block
 sys.path.insert(0, HERE)
 import plot_icdf  # noqa: E402
+import run_files  # noqa: E402
 
 RUNS = {
     # name: (mode, R, overrides)
@@ -118,7 +119,7 @@ def fig3_4(args):
     A, B, C, D = d["samples/compact"][k]
     pp = np.linspace(p[0], p[-1], 200)
     fig, ax = plt.subplots(figsize=(6, 4.5), dpi=120)
-    q_l, q_top = d["samples/mean"][k], d["samples/top_mean"][k]
+    q_l, q_top = run_files.get(d, "samples/mean_icdf")[k], d["samples/top_mean"][k]
     ax.plot(p, q_top, "s-", label="$Q_{top}(p)$: the 500 highest particles")
     ax.plot(p, q_l, "o-", label="$Q_L(p)$: the light particles")
     ax.plot(p, q_top - q_l, "^", label="$y = Q_{top} - Q_L$")

@@ -55,7 +55,7 @@ def load(path):
             "R": int(f.attrs.get("realizations", 1)), "t": f["samples/time"][:],
             "ratio": b["pressure_drop_ratio"][:], "height": b["height"][:], "mixing": b["mixing_index"][:],
             "species_height": b["species_height"][:], "species": [run_files.text(v) for v in b["species"][:]],
-            "phi": b["mean/solid_fraction"][:], "z": b["z"][:], "dz": float(b.attrs["profile_dz"]),
+            "phi": run_files.get(f, "bed/ensemble_mean/solid_fraction")[:], "z": b["z"][:], "dz": float(b.attrs["profile_dz"]),
         }
 
 

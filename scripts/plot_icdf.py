@@ -35,7 +35,7 @@ import run_files  # noqa: E402
 
 
 def load(path):
-    f = run_files.open_run(path, ["p", "samples/time", "samples/mean", "samples/variance"])
+    f = run_files.open_run(path, ["p", "samples/time", "samples/mean_icdf", "samples/variance"])
     with f:
         run = {
             "path": path,
@@ -46,7 +46,7 @@ def load(path):
             "species": run_files.text(f.attrs.get("observed_species", "light")),
             "p": f["p"][:],
             "t": f["samples/time"][:],
-            "mean": f["samples/mean"][:],
+            "mean": run_files.get(f, "samples/mean_icdf")[:],
             "var": f["samples/variance"][:],
             "R_used": run_files.realizations_per_sample(f),
             "jumps": [],

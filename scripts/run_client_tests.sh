@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The clients tier: efdem's output read by what a user reads it with. VTK frames and series
 # through VTK's own XML readers (python3-vtk9, what ParaView uses), the CSV files and thermo
-# logs through plain pandas.read_csv (python3-pandas). Installs those packages when they are
+# logs through plain pandas.read_csv (python3-pandas), every group of the run file through
+# xarray with netCDF4 and h5netcdf, and docs/output.md's Python examples run on a real run's
+# files. Installs those packages when they are
 # missing (scripts/install_deps.sh with EFDEM_WITH_CLIENTS=1), builds like scripts/build.sh,
 # then runs `ctest -L clients`.
 #

@@ -265,9 +265,11 @@ void H5File::write_texts(const std::string& name, const std::vector<std::string>
 }
 
 void H5File::document(const std::string& name, const std::string& units,
-                      const std::string& description, const std::vector<std::string>& labels,
+                      const std::string& long_name, const std::string& description,
+                      const std::vector<std::string>& labels,
                       const std::vector<std::string>& scales) {
     attribute(name, "units", units);
+    attribute(name, "long_name", long_name);
     attribute(name, "description", description);
     if (labels.empty()) return;
     const hid_t d = check_id(H5Dopen2(file_, name.c_str(), H5P_DEFAULT), "open " + name);
@@ -286,6 +288,34 @@ void H5File::document(const std::string& name, const std::string& units,
     }
     H5Dclose(d);
     check(status, "dimension scales of " + name);
+}
+
+void H5File::strip_dimension_scales() {
+    std::vector<std::string> links, datasets;
+    check(H5Lvisit(
+              file_, H5_INDEX_NAME, H5_ITER_INC,
+              [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
+                  static_cast<std::vector<std::string>*>(data)->push_back(name);
+                  return 0;
+              },
+              &links),
+          "list the file's objects");
+    for (const std::string& name : links) {
+        const hid_t obj = check_id(H5Oopen(file_, name.c_str(), H5P_DEFAULT), "open " + name);
+        if (H5Iget_type(obj) == H5I_DATASET) datasets.push_back(name);
+        H5Oclose(obj);
+    }
+    for (const std::string& name : datasets)
+        for (const char* attr :
+             {"DIMENSION_LIST", "REFERENCE_LIST", "DIMENSION_LABELS", "CLASS", "NAME"})
+            if (has_attribute(name, attr))
+                check(H5Adelete_by_name(file_, name.c_str(), attr, H5P_DEFAULT),
+                      fmt::format("remove the dimension scale attribute {}@{}", name, attr));
+}
+
+void H5File::move(const std::string& from, const std::string& to) {
+    check(H5Lmove(file_, from.c_str(), file_, to.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+          fmt::format("rename {} to {}", from, to));
 }
 
 bool H5File::exists(const std::string& name) const {

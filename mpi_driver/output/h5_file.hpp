@@ -36,6 +36,7 @@ class H5Series {
     void append_integer(std::int64_t value) { append(std::span<const std::int64_t>(&value, 1)); }
     void append_text(const std::string& text);
     hsize_t rows() const { return rows_; }
+    hsize_t row_size() const { return row_size_; }
 
   private:
     H5Series() = default;
@@ -81,11 +82,19 @@ class H5File {
     void write_bytes(const std::string& name, std::span<const std::uint8_t> data);
     /// A 1D dataset of variable-length strings.
     void write_texts(const std::string& name, const std::vector<std::string>& texts);
-    /// Makes `name` self-describing: attributes `units` and `description`, a label on each
-    /// dimension (HDF5 dimension scales), and the axis dataset `scales[i]` attached to dimension
-    /// i where it is non-empty and exists; `scales[i] == name` makes `name` itself that axis.
-    void document(const std::string& name, const std::string& units, const std::string& description,
-                  const std::vector<std::string>& labels, const std::vector<std::string>& scales);
+    /// Makes `name` self-describing: attributes `units`, `long_name` and `description`, a label
+    /// on each dimension (HDF5 dimension scales), and the axis dataset `scales[i]` attached to
+    /// dimension i where it is non-empty and exists; `scales[i] == name` makes `name` itself
+    /// that axis (a dimension scale named `labels[i]`).
+    void document(const std::string& name, const std::string& units, const std::string& long_name,
+                  const std::string& description, const std::vector<std::string>& labels,
+                  const std::vector<std::string>& scales);
+    /// Removes every dimension scale of the file: no dataset is a scale, has one attached or
+    /// labels its dimensions any more (the attributes CLASS, NAME, REFERENCE_LIST,
+    /// DIMENSION_LIST, DIMENSION_LABELS go), so that document() can lay them out anew.
+    void strip_dimension_scales();
+    /// Renames (moves) the link `from` to `to` (a dataset or a group with all it holds).
+    void move(const std::string& from, const std::string& to);
     void flush();
 
     // Reading (checkpoints): RuntimeFailure naming the file and object on any failure.

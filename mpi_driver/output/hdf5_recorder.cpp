@@ -105,6 +105,9 @@ void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
         file_.attribute("/", "si_pressure_Pa", p.si.pressure);
     }
     if (resume) {
+        if (!file_.has_attribute("/", "format_version") ||
+            file_.attribute_integer("/", "format_version") < kRunFileFormatVersion)
+            upgrade(p);
         // A run file from before /bed/pressure_drop_pa: the column would start mid-run.
         if (file_.exists("/bed/pressure_drop") && !file_.exists("/bed/pressure_drop_pa"))
             si_pressure_ = std::numeric_limits<double>::quiet_NaN();
@@ -135,39 +138,104 @@ void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
     document("/scene");
     file_.write_text("/parameters", p.parameters);
     document("/parameters");
-    file_.write("/p", as_span(p.p_grid), {static_cast<hsize_t>(m_)});
-    document("/p");
-    index_axis("/realization", realizations_);
     file_.create_group("/samples");
-    if (p.mode == "cpi") {
-        file_.create_group("/cpi");
-        index_axis("/cpi/coarse_node", dim_);
-    }
+    if (p.mode == "cpi") file_.create_group("/cpi");
     if (p.mode == "steady" || p.mode == "continuation") {
         file_.create_group("/steady");
         file_.create_group("/steady/iterate");
-        index_axis("/steady/coarse_node", dim_);
         if (p.mode == "continuation") file_.create_group("/branch");
     }
     if (species_ > 0) {
         file_.create_group("/bed");
-        file_.create_group("/bed/mean");
+        file_.create_group("/bed/ensemble_mean");
         file_.attribute("/bed", "weight_per_area", p.weight_per_area);
         file_.attribute("/bed", "profile_dz", p.profile_dz);
         file_.attribute("/bed", "mixing_layer", p.mixing_layer);
         file_.attribute("/bed", "mixing_species", p.observed_species);
+    }
+    ensure_axes(p);
+    file_.flush();
+}
+
+void Hdf5Recorder::ensure_axes(const RunProvenance& p) {
+    using T = H5Series::Type;
+    auto reals = [&](const std::string& name, const std::vector<double>& v) {
+        if (file_.exists(name)) return;
+        file_.write(name, v, {static_cast<hsize_t>(v.size())});
+        document(name);
+    };
+    auto texts = [&](const std::string& name, const std::vector<std::string>& v) {
+        if (file_.exists(name)) return;
+        file_.write_texts(name, v);
+        document(name);
+    };
+    // A growing axis: a copy of `source`'s first `rows` rows (those of the arrays it labels).
+    auto copy = [&](const std::string& name, const std::string& source, const std::string& rows) {
+        if (file_.exists(name)) return;
+        H5Series& s = series(name, {}, T::real);
+        if (file_.exists(source) && file_.exists(rows))
+            for (double v : file_.read_doubles(source, 0, file_.shape(rows).at(0))) s.append(v);
+    };
+    const std::vector<double> grid(p.p_grid.data(), p.p_grid.data() + p.p_grid.size());
+    reals("/p", grid);
+    index_axis("/realization", realizations_);
+    series("/samples/time", {}, T::real);
+    reals("/samples/p", grid);
+    index_axis("/samples/realization", realizations_);
+    texts("/samples/compact_parameter", {"A", "B", "C", "D"});
+    if (file_.exists("/cpi")) {
+        series("/cpi/t_start", {}, T::real);
+        index_axis("/cpi/coarse_node", dim_);
+        index_axis("/cpi/realization", realizations_);
+    }
+    if (file_.exists("/cpi/controller")) {
+        copy("/cpi/controller/t_start", "/cpi/t_start", "/cpi/controller/accepted");
+        index_axis("/cpi/controller/coarse_node", dim_);
+    }
+    if (file_.exists("/steady")) {
+        index_axis("/steady/coarse_node", dim_);
+        series("/steady/iterate/dem_time", {}, T::real);
+        index_axis("/steady/iterate/coarse_node", dim_);
+    }
+    if (file_.exists("/branch")) {
+        series("/branch/parameter", {}, T::real);
+        index_axis("/branch/coarse_node", dim_);
+    }
+    if (file_.exists("/bed")) {
         std::vector<double> z(slabs_);
         for (std::size_t j = 0; j < slabs_; ++j)
             z[j] = (static_cast<double>(j) + 0.5) * p.profile_dz;
-        file_.write("/bed/z", z, {static_cast<hsize_t>(slabs_)});
-        document("/bed/z");
-        file_.write_texts("/bed/species", p.species_names);
-        document("/bed/species");
+        copy("/bed/time", "/samples/time", "/bed/height");
+        index_axis("/bed/realization", realizations_);
+        reals("/bed/z", z);
+        texts("/bed/species", p.species_names);
+        copy("/bed/ensemble_mean/time", "/samples/time", "/bed/ensemble_mean/height");
+        reals("/bed/ensemble_mean/z", z);
+        texts("/bed/ensemble_mean/species", p.species_names);
     }
+}
+
+void Hdf5Recorder::upgrade(const RunProvenance& p) {
+    file_.strip_dimension_scales();
+    for (const auto& [from, to] : renamed_in_format_3())
+        if (file_.exists(std::string(from)) && !file_.exists(std::string(to)))
+            file_.move(std::string(from), std::string(to));
+    // The axes there are first (the arrays attach them), then the added ones, then the rest.
+    auto is_axis = [](const DatasetDoc& d) {
+        return d.dims.size() == 1 && axis_of(d.path, d.dims[0]) == d.path;
+    };
+    std::vector<std::string> axes, arrays;
+    for (const DatasetDoc& d : run_file_schema())
+        if (file_.exists(std::string(d.path))) (is_axis(d) ? axes : arrays).emplace_back(d.path);
+    for (const std::string& name : axes) document(name);
+    ensure_axes(p);
+    for (const std::string& name : arrays) document(name);
+    file_.attribute("/", "format_version", kRunFileFormatVersion);
     file_.flush();
 }
 
 void Hdf5Recorder::index_axis(const std::string& name, Eigen::Index n) {
+    if (file_.exists(name)) return;
     std::vector<std::int64_t> index(static_cast<std::size_t>(n));
     std::iota(index.begin(), index.end(), std::int64_t{0});
     file_.write(name, index, {static_cast<hsize_t>(n)});
@@ -179,9 +247,10 @@ void Hdf5Recorder::document(const std::string& name) {
     std::vector<std::string> labels, scales;
     for (std::string_view dim : d.dims) {
         labels.emplace_back(dim);
-        scales.emplace_back(dimension_scale(dim));
+        scales.push_back(axis_of(name, dim));
     }
-    file_.document(name, std::string(d.units), std::string(d.description), labels, scales);
+    file_.document(name, std::string(d.units), std::string(d.long_name), std::string(d.description),
+                   labels, scales);
 }
 
 H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row_shape,
@@ -193,9 +262,30 @@ H5Series& Hdf5Recorder::series(const std::string& name, std::vector<hsize_t> row
                  .emplace(name, existing ? H5Series::open(file_, name, type)
                                          : H5Series(file_, name, std::move(row_shape), type))
                  .first;
-        if (!existing) document(name);
+        if (!existing) {
+            document(name);
+            // A series that starts after its axis (one an older efdem did not record, in a run
+            // file a restart continues) begins with a fill row for each earlier row of the axis
+            // (NaN, -1 or empty text), so that its rows stay those of the axis. The axis got
+            // this record's row first.
+            const std::vector<std::string_view>& dims = dataset_doc(name).dims;
+            const std::string axis = dims.empty() ? name : axis_of(name, dims[0]);
+            if (axis != name && file_.exists(axis) && file_.shape(axis).at(0) > 1)
+                fill_rows(it->second, type, file_.shape(axis).at(0) - 1);
+        }
     }
     return it->second;
+}
+
+void Hdf5Recorder::fill_rows(H5Series& s, H5Series::Type type, hsize_t rows) {
+    while (s.rows() < rows) {
+        if (type == H5Series::Type::real)
+            s.append(std::vector<double>(s.row_size(), std::numeric_limits<double>::quiet_NaN()));
+        else if (type == H5Series::Type::integer)
+            s.append(std::vector<std::int64_t>(s.row_size(), -1));
+        else
+            s.append_text("");
+    }
 }
 
 void Hdf5Recorder::bed_sample(const SampleRecord& s) {
@@ -211,6 +301,8 @@ void Hdf5Recorder::bed_sample(const SampleRecord& s) {
                 first.data(), static_cast<Eigen::Index>(first.size()));
         }
     }
+    series("/bed/time", {}, T::real).append(s.time);
+    series("/bed/ensemble_mean/time", {}, T::real).append(s.time);
     auto rows = [&](const std::string& group, const BedRecord& b, hsize_t members) {
         const std::vector<hsize_t> per =
             members > 1 || group == "/bed" ? std::vector<hsize_t>{members} : std::vector<hsize_t>{};
@@ -236,7 +328,7 @@ void Hdf5Recorder::bed_sample(const SampleRecord& s) {
             .append(std::span<const double>(phi.data(), static_cast<std::size_t>(phi.size())));
     };
     rows("/bed", s.bed, r);
-    rows("/bed/mean", s.bed_mean, 1);
+    rows("/bed/ensemble_mean", s.bed_mean, 1);
     const Eigen::VectorXd expansion = s.bed.height.cwiseQuotient(initial_height_);
     series("/bed/expansion", {r}, T::real).append(as_span(expansion));
     // The mean's expansion: the mean height over the mean initial height of the realizations
@@ -247,7 +339,7 @@ void Hdf5Recorder::bed_sample(const SampleRecord& s) {
             h0 += initial_height_[i];
             used += 1;
         }
-    series("/bed/mean/expansion", {}, T::real)
+    series("/bed/ensemble_mean/expansion", {}, T::real)
         .append(used > 0 ? s.bed_mean.height[0] / (h0 / used)
                          : std::numeric_limits<double>::quiet_NaN());
 }
@@ -256,7 +348,7 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
     using T = H5Series::Type;
     const auto m = static_cast<hsize_t>(m_), r = static_cast<hsize_t>(realizations_);
     series("/samples/time", {}, T::real).append(s.time);
-    series("/samples/mean", {m}, T::real).append(as_span(s.mean));
+    series("/samples/mean_icdf", {m}, T::real).append(as_span(s.mean));
     series("/samples/variance", {m}, T::real).append(as_span(s.variance));
     // Row-major R x m for the file.
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> icdf =
@@ -277,6 +369,14 @@ void Hdf5Recorder::sample(const SampleRecord& s) {
         series("/samples/compact", {4}, T::real).append(as_span(s.compact));
         series("/samples/compact_status", {}, T::integer).append_integer(s.compact_status);
     }
+    // The records not every sample makes (the compact fit stops when its observable falls
+    // back): a sample without one gets a fill row there, so that every array of /samples keeps
+    // the rows of /samples/time.
+    const hsize_t rows = series("/samples/time", {}, T::real).rows();
+    for (const auto& [name, type] :
+         {std::pair{"/samples/at_rest", T::integer}, std::pair{"/samples/top_mean", T::real},
+          std::pair{"/samples/compact", T::real}, std::pair{"/samples/compact_status", T::integer}})
+        if (file_.exists(name)) fill_rows(series(name, {}, type), type, rows);
     if (species_ > 0 && !s.bed.empty()) bed_sample(s);
     file_.flush();
 }
@@ -322,7 +422,11 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
     if (const coarse::ControllerRecord& c = rec.controller; c.active) {
         // /cpi/controller/*: one row per coarse step of the multistep integrator (every row of
         // /cpi when it is the run's integrator). Errors RMS over the coarse vector [d_p].
-        if (!file_.exists("/cpi/controller")) file_.create_group("/cpi/controller");
+        if (!file_.exists("/cpi/controller")) {
+            file_.create_group("/cpi/controller");
+            index_axis("/cpi/controller/coarse_node", dim_);
+        }
+        scalar("controller/t_start", rec.t_start);
         integer("controller/accepted", c.accepted ? 1 : 0);
         integer("controller/steps", c.steps);
         const std::pair<const char*, double> reals[] = {
@@ -454,6 +558,7 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         for (const coarse::FoldEstimate& f : o.branch.folds())
             folds.push_back(f.parameter * o.parameter_scale);
         if (!folds.empty()) {
+            index_axis("/branch/fold", static_cast<Eigen::Index>(folds.size()));
             file_.write("/branch/fold_parameter", folds, {static_cast<hsize_t>(folds.size())});
             document("/branch/fold_parameter");
         }
@@ -483,8 +588,13 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         file_.write(name, v, {static_cast<hsize_t>(v.size())});
         document(name);
     };
-    if (!r.step_lengths.empty()) reals("/steady/step_length", r.step_lengths);
+    auto size = [](const auto& v) { return static_cast<Eigen::Index>(v.size()); };
+    if (!r.step_lengths.empty()) {
+        index_axis("/steady/step", size(r.step_lengths));
+        reals("/steady/step_length", r.step_lengths);
+    }
     if (!r.krylov_iterations.empty()) {
+        index_axis("/steady/newton_step", size(r.krylov_iterations));
         integers("/steady/krylov_products",
                  std::vector<std::int64_t>(r.krylov_iterations.begin(), r.krylov_iterations.end()));
         std::vector<double> res;
@@ -494,6 +604,7 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
                 res.push_back(v);
                 step.push_back(static_cast<std::int64_t>(k));
             }
+        index_axis("/steady/gmres_entry", size(res));
         reals("/steady/gmres_residual", res);
         integers("/steady/gmres_newton_step", step);
     }
@@ -506,6 +617,7 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
             residual.push_back(e.residual);
             noise.push_back(e.noise);
         }
+        index_axis("/steady/eigenvalue", size(re));
         reals("/steady/eigenvalue_real", re);
         reals("/steady/eigenvalue_imag", im);
         reals("/steady/eigenvalue_rate", rate);

@@ -2,7 +2,7 @@
 # Validation tier (ctest -L validation, scripts/run_validation.sh): the pressure drop efdem
 # records (observe.bed) is the bed weight per area once the bed is fluidized. A light
 # single-species bed (U_mf,bed = 0.1005, docs/validation.md section 1) at U_s = 0.22 and 0.30
-# (2.2 and 3 U_mf), 30 time units each: the time average of /bed/mean/pressure_drop_ratio over
+# (2.2 and 3 U_mf), 30 time units each: the time average of /bed/ensemble_mean/pressure_drop_ratio over
 # t > 10 must be within 2 % of 1. The binary demo bed at U_s = 0.41 is reported, not checked
 # (heavy spheres resting on the floor carry part of the weight, so it reads a few % low).
 #   bed_pressure_drop.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
@@ -26,7 +26,7 @@ work, bad = sys.argv[1], []
 for name, checked in (("single_0.22", True), ("single_0.30", True), ("binary", False)):
     with h5py.File(os.path.join(work, name + ".h5"), "r") as f:
         t = f["samples/time"][:]
-        r = f["bed/mean/pressure_drop_ratio"][:][t > 10]
+        r = f["bed/ensemble_mean/pressure_drop_ratio"][:][t > 10]
     # Samples 0.5 apart are correlated; the standard error below is a lower bound (blocks of
     # 5 time units give about twice it), and 2 % is 10 of them.
     se = r.std(ddof=1) / np.sqrt(len(r))

@@ -5,9 +5,11 @@ and inside the bed, variances non-negative, provenance present, cpi records cons
 
     /usr/bin/python3 check_run_file.py RUN.h5 [--mode cpi|direct] [--realizations R] [--bed]
 
-Every run file is also checked to be self-describing: every dataset has non-empty `units` and
-`description` attributes, every dimension a label, and the sample, realization, node and step
-axes are attached as dimension scales (/samples/time, /realization, /p, /cpi/t_start).
+Every run file is also checked to be self-describing and readable group by group by netCDF-4
+readers (format 3): every dataset has non-empty `units`, `long_name` and `description`
+attributes, every dimension a label, and the axis of that name in the dataset's own group
+(/samples/time, /samples/p, /bed/time, ...) is attached to it as a dimension scale of the
+dimension's length.
 --bed: the run recorded observe.bed = true; /bed is checked (shapes, ranges, and the solid-
 fraction profile holds the particles' whole volume when the bed lies below its top).
 """
@@ -18,23 +20,29 @@ import h5py
 import numpy as np
 
 
-AXES = {"sample": "/samples/time", "realization": "/realization", "node": "/p", "step": "/cpi/t_start",
-        "species": "/bed/species", "slab": "/bed/z", "failure": "/failures/time", "coarse_node": "/cpi/coarse_node"}
-
-
 def check_self_describing(f, check):
+    check(int(f.attrs.get("format_version", 0)) == 3, f"format_version {f.attrs.get('format_version')} != 3")
+
     def visit(name, obj):
         if not isinstance(obj, h5py.Dataset):
             return
-        for key in ("units", "description"):
+        for key in ("units", "long_name", "description"):
             value = obj.attrs.get(key)
             check(value is not None and len(str(value)) > 0, f"/{name} has no {key}")
+        group = "/" + name.rpartition("/")[0]
         for k, dim in enumerate(obj.dims):
             check(len(dim.label) > 0, f"/{name} dimension {k} has no name")
-            axis = AXES.get(dim.label)
-            if axis and axis != "/" + name and axis.lstrip("/") in f:
-                scales = [s.name for s in dim.values()]
-                check(axis in scales, f"/{name} dimension {k} ({dim.label}) has no {axis} scale attached")
+            # The axis: the dataset of the dimension's name in the same group (netCDF-4 sees no
+            # axis of a sibling group, xarray none of a parent group).
+            axis = group.rstrip("/") + "/" + dim.label
+            if axis == "/" + name:
+                check(h5py.h5ds.is_scale(obj.id), f"/{name} is not a dimension scale")
+                continue
+            scales = [s.name for s in dim.values()]
+            check(scales == [axis], f"/{name} dimension {k} ({dim.label}): attached {scales}, not [{axis}]")
+            if axis.lstrip("/") in f:
+                check(len(f[axis]) == obj.shape[k],
+                      f"/{name} dimension {k} ({dim.label}) has {obj.shape[k]} entries, its axis {axis} {len(f[axis])}")
     f.visititems(visit)
 
 
@@ -45,7 +53,7 @@ def check_bed(f, check, n, R, particles, area):
     b = f["bed"]
     for name in ("pressure_drop", "pressure_drop_ratio", "height", "expansion", "mixing_index"):
         check(b[name].shape == (n, R), f"/bed/{name} shape {b[name].shape} != {(n, R)}")
-        check(b["mean/" + name].shape == (n,), f"/bed/mean/{name} shape {b['mean/' + name].shape}")
+        check(b["ensemble_mean/" + name].shape == (n,), f"/bed/ensemble_mean/{name} shape {b['ensemble_mean/' + name].shape}")
     S, J = len(b["species"]), len(b["z"])
     check(b["species_height"].shape == (n, R, S), f"/bed/species_height shape {b['species_height'].shape}")
     check(b["solid_fraction"].shape == (n, R, J), f"/bed/solid_fraction shape {b['solid_fraction'].shape}")
@@ -56,7 +64,10 @@ def check_bed(f, check, n, R, particles, area):
     check(np.all(b["height"][:] > 0), "a bed height <= 0")
     ratio = b["pressure_drop_ratio"][:]
     check(np.all(ratio >= 0) and np.all(ratio < 2), f"pressure_drop_ratio outside [0, 2): {ratio.min()}..{ratio.max()}")
-    check(np.allclose(b["mean/height"][:], b["height"][:].mean(axis=1), rtol=1e-12), "/bed/mean/height is not the mean")
+    check(np.allclose(b["ensemble_mean/height"][:], b["height"][:].mean(axis=1), rtol=1e-12),
+          "/bed/ensemble_mean/height is not the mean")
+    check(np.array_equal(b["time"][:], f["samples/time"][:]) and np.array_equal(b["ensemble_mean/time"][:], f["samples/time"][:]),
+          "/bed/time or /bed/ensemble_mean/time is not /samples/time")
     check(np.allclose(b["expansion"][0], 1.0), "expansion at the first sample is not 1")
     if particles and area:
         # The exact partial volumes put every sphere's whole volume into the slabs (the floor
@@ -89,7 +100,7 @@ def main(argv=None):
         p = f["p"][:]
         m = len(p)
         t = f["samples/time"][:]
-        mean = f["samples/mean"][:]
+        mean = f["samples/mean_icdf"][:]
         var = f["samples/variance"][:]
         icdf = f["samples/icdf"][:]
         n = len(t)

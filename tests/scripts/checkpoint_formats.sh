@@ -2,7 +2,8 @@
 # Every checkpoint format this efdem reads restarts a run that continues bit for bit: stored files
 # of formats 1, 2 and 3 (tests/data/checkpoint_format_*.h5) and one written now (format 4), each
 # restarted on 2 ranks and compared with the uninterrupted run of this binary (compare_runs.py on
-# the run file, the CSVs byte for byte).
+# the run file, the CSVs byte for byte). The stored checkpoints hold run files of format 2, which
+# the restart upgrades to format 3 (check_run_file.py checks the layout).
 #
 # The stored files (tests/data/README.md):
 #   checkpoint_format_3_adaptive.h5  written by efdem c8ed428 (format 3, before the integrator's
@@ -130,7 +131,8 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
     output.directory="$work" output.prefix=$kind-f$version restart="$file"
   grep -q "restarted from" "$work/$kind-f$version.log" || { echo "FAIL: no restart in $kind-f$version.log"; exit 1; }
   # The slope pool's and the healing evidence's records (issue 33) came after formats 1-3: the run
-  # file stored in such a checkpoint has no rows of them before the restart. And a format-3 state
+  # file stored in such a checkpoint has no rows of them before the restart (they begin with fill
+  # rows, checked below). And a format-3 state
   # carries the decay verdict of the code that wrote it (before 15fd576), which assesses the
   # first step's stability from a rate the current code counts as noise: that step's stability
   # record differs, its DT and every sample do not (compared).
@@ -146,5 +148,27 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
                                 cpi/controller/transient cpi/controller/transient_threshold
                                 cpi/stability_assessed cpi/stability_rate cpi/stability_amplification)
   same_output $kind-ref $kind-f$version "${ignore[@]}"
+  # The run file put back from an older checkpoint is format 2: the restart upgraded it to
+  # format 3 (renames, every group's own axes, dimension scales laid anew).
+  /usr/bin/python3 "$here/check_run_file.py" "$work/$kind-f$version.h5" --mode cpi \
+    || { echo "FAIL: the run file restarted from $(basename "$file") is not a format-3 run file"; exit 1; }
+  # The records the old run did not make start with fill rows up to the restart: every ignored
+  # dataset has the uninterrupted run's shape, and /samples/at_rest is -1 before the restart and
+  # the uninterrupted run's after it.
+  [ "$version" = 4 ] || /usr/bin/python3 - "$work/$kind-ref.h5" "$work/$kind-f$version.h5" "${ignore[@]:1}" <<'EOF'
+import sys
+import h5py
+import numpy as np
+ref, got = h5py.File(sys.argv[1], "r"), h5py.File(sys.argv[2], "r")
+bad = [n for n in sys.argv[3:] if n in ref and n in got and ref[n].shape != got[n].shape]
+if bad:
+    sys.exit(f"FAIL: {sys.argv[2]}: rows not aligned with their axis in {bad}")
+a, b = ref["samples/at_rest"][:], got["samples/at_rest"][:]
+filled = np.all(b == -1, axis=1)
+k = int(np.argmin(filled)) if not filled.all() else len(b)
+if not (0 < k < len(b) and filled[:k].all() and np.array_equal(a[k:], b[k:])):
+    sys.exit(f"FAIL: {sys.argv[2]}: /samples/at_rest is not -1 up to the restart and the uninterrupted run's after it")
+print(f"PASS: the records the old run did not make are filled up to the restart ({k} of {len(b)} samples)")
+EOF
   echo "PASS: $kind run restarted from a format-$version checkpoint ($(basename "$file")) equals the uninterrupted run"
 done

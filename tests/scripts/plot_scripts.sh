@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The scripts that read files (scripts/plot_icdf.py, scripts/plot_bed.py, scripts/demo_summary.py,
-# scripts/plot_validation.py) on real small run files and on bad input:
+# scripts/plot_validation.py) on real small run files, also laid out as format 2, and on bad input:
 # * good input: exit 0; plot_icdf writes the PNG and names each run's mode and line style, and
 #   the CPI run's last projective jump where the run file's /cpi records put it; plot_icdf's and
 #   plot_bed's legends name the band (the 95 % Student-t interval of the mean), sit outside the
@@ -106,14 +106,14 @@ with h5py.File(f"{w}/other.h5", "w") as f:
     f["x"] = [1.0]
 shutil.copy(f"{w}/direct.h5", f"{w}/nosamples.h5")
 with h5py.File(f"{w}/nosamples.h5", "a") as f:
-    del f["samples/mean"]
+    del f["samples/mean_icdf"]
 PY
 expect 2 "required: runs" "plot_icdf without arguments" $py "$src/scripts/plot_icdf.py"
 expect 2 "missing.h5: no such file" "plot_icdf, missing file" $py "$src/scripts/plot_icdf.py" "$work/missing.h5"
 expect 2 "text.h5: not an HDF5 file" "plot_icdf, text file" $py "$src/scripts/plot_icdf.py" "$work/text.h5"
 expect 2 "other.h5: an HDF5 file but not an efdem run file" "plot_icdf, other HDF5" \
   $py "$src/scripts/plot_icdf.py" "$work/other.h5"
-expect 2 "nosamples.h5: the run file has no /samples/mean" "plot_icdf, no samples" \
+expect 2 "nosamples.h5: the run file has no /samples/mean_icdf" "plot_icdf, no samples" \
   $py "$src/scripts/plot_icdf.py" "$work/nosamples.h5"
 expect 2 "cannot be written" "plot_icdf, output folder missing" \
   $py "$src/scripts/plot_icdf.py" "$work/direct.h5" -o "$work/no/such/folder/x.png"
@@ -135,7 +135,7 @@ for name, shift in (("same", 0.0), ("shifted", 1.0)):
     shutil.copy(f"{w}/direct.h5", f"{w}/{name}.h5")
     with h5py.File(f"{w}/{name}.h5", "a") as f:
         f.attrs["mode"] = "cpi"
-        f["samples/mean"][...] = f["samples/mean"][...] + shift
+        f["samples/mean_icdf"][...] = f["samples/mean_icdf"][...] + shift
 # A CPI file of a longer span than the direct run's (the old quick start's 40 against 100).
 shutil.copy(f"{w}/cpi.h5", f"{w}/longer.h5")
 with h5py.File(f"{w}/longer.h5", "a") as f:
@@ -170,6 +170,29 @@ expect 2 "cpi.h5: a cpi run; expected the direct run here" "demo_summary, runs s
   $py "$src/scripts/demo_summary.py" "$work/cpi.h5" "$work/direct.h5"
 expect 2 "missing.h5: no such file" "demo_summary, missing file" \
   $py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/missing.h5"
+
+# Run files of format 2 (written before format 3, e.g. those kept in bench/results): the two runs
+# laid out as format 2 did (/samples/mean, /bed/mean, no group-local axes) read the same: the
+# summary prints the same lines, the plots are drawn.
+$py - "$work" <<'PY' || fail "could not make the format-2 run files"
+import shutil, sys, h5py
+w = sys.argv[1]
+for mode in ("direct", "cpi"):
+    shutil.copy(f"{w}/{mode}.h5", f"{w}/{mode}_f2.h5")
+    with h5py.File(f"{w}/{mode}_f2.h5", "a") as f:
+        f.attrs["format_version"] = 2
+        f.move("samples/mean_icdf", "samples/mean")
+        f.move("bed/ensemble_mean", "bed/mean")
+        for name in ("samples/p", "samples/realization", "samples/compact_parameter", "bed/time", "bed/realization",
+                     "bed/mean/time", "bed/mean/z", "bed/mean/species", "cpi/realization"):
+            if name in f:
+                del f[name]
+PY
+new=$($py "$src/scripts/demo_summary.py" "$work/direct.h5" "$work/cpi.h5" 2>&1 | grep -v "wall")
+old=$($py "$src/scripts/demo_summary.py" "$work/direct_f2.h5" "$work/cpi_f2.h5" 2>&1 | grep -v "wall")
+[ -n "$old" ] && [ "$old" = "$new" ] && pass "demo_summary reads format 2: the same summary"   || fail "demo_summary of the format-2 files differs: $old"
+expect 0 "line style '--', last projective jump lands at t = 3.5" "plot_icdf, format 2"   $py "$src/scripts/plot_icdf.py" "$work/direct_f2.h5" "$work/cpi_f2.h5" -o "$work/icdf_f2.png"
+expect 0 "plot_bed.py: wrote $work/bed_f2.png" "plot_bed, format 2"   $py "$src/scripts/plot_bed.py" "$work/direct_f2.h5" "$work/cpi_f2.h5" -o "$work/bed_f2.png"
 
 # plot_validation: no arguments, no folder, a folder without its CSVs, a CSV without its columns.
 mkdir -p "$work/empty" "$work/bad"

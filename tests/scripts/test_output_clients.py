@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The clients tier: efdem's output read by the programs a fluidized-bed user opens it with.
 
-  test_output_clients.py vtk|csv EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
+  test_output_clients.py vtk|csv|xarray|docs EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 
 vtk: a tiny direct run writes VTK frames; VTK's own readers (vtkXMLDataParser for the .pvd,
      vtkXMLPolyDataReader for each .vtp, as ParaView uses them) must see one point and one vertex
@@ -10,8 +10,16 @@ vtk: a tiny direct run writes VTK frames; VTK's own readers (vtkXMLDataParser fo
 csv: a tiny cpi run with thermo logs; plain pandas.read_csv(path) (no options) must give the
      documented columns, one row per sample or coarse step of the run file, and no NaN where
      there is always a value; the JSON sidecar must describe every column and the run's end.
+xarray: run files of every kind (cpi adaptive with observe.bed, direct with a dropped realization,
+     continuation): every group opened by xarray with its default engine (netCDF4) and with
+     h5netcdf holds every dataset of the group with h5py's values, every dimension a coordinate
+     with units and long_name, no variable named like a Dataset method; .sel(p = 0.5) and
+     .sel(time = t) give h5py's value at that node and time.
+docs: every ```python block of docs/output.md (the xarray, h5py, pandas, VTK and JSON examples)
+     runs without error on the files of a real run, laid out under the names the doc uses.
 
-Run by `ctest -L clients` (scripts/run_client_tests.sh installs python3-vtk9 and python3-pandas).
+Run by `ctest -L clients` (scripts/run_client_tests.sh installs python3-vtk9, python3-pandas,
+python3-xarray, python3-netcdf4 and python3-h5netcdf).
 A missing client module is a failure with a message, never a pass.
 """
 import glob
@@ -41,6 +49,7 @@ def run_efdem(argv, out, *keys):
     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     if r.returncode != 0:
         sys.exit(f"FAIL: efdem exited with {r.returncode}:\n{r.stdout}")
+    return r.stdout
 
 
 class Checks:
@@ -204,7 +213,142 @@ def test_csv(argv):
     check.done()
 
 
+def same_values(a, b):
+    """Equal arrays (NaN equal to NaN; text as str)."""
+    import numpy as np
+
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype.kind in "OSU" or b.dtype.kind in "OSU":
+        text = np.vectorize(lambda v: v.decode() if isinstance(v, bytes) else str(v), otypes=[str])
+        return a.shape == b.shape and (a.size == 0 or np.array_equal(text(a), text(b)))
+    return a.shape == b.shape and np.array_equal(a, b, equal_nan=a.dtype.kind == "f")
+
+
+def check_group(check, xr, h5py, path, group, engine):
+    """One group of run file `path` through xarray (`engine`, None: the default) against h5py."""
+    import numpy as np
+
+    where = f"{os.path.basename(path)} {group} ({engine or 'default engine'})"
+    try:
+        ds = xr.open_dataset(path, group=group, engine=engine)
+    except Exception as e:  # noqa: BLE001  (any failure to open is the finding)
+        check(False, f"{where}: xarray cannot open it: {type(e).__name__}: {e}")
+        return
+    with ds, h5py.File(path, "r") as f:
+        g = f[group]
+        names = [k for k, v in g.items() if isinstance(v, h5py.Dataset)]
+        missing = [k for k in names if k not in ds.variables]
+        check(not missing, f"{where}: every dataset is a variable ({len(names)}; missing {missing})")
+        differ = [k for k in names if k in ds.variables and not same_values(ds[k].values, g[k][()])]
+        check(not differ, f"{where}: every variable has h5py's values (differ: {differ})")
+        not_coords = [d for d in ds.dims if d not in ds.coords]
+        check(not not_coords, f"{where}: every dimension {list(ds.dims)} is a coordinate (not: {not_coords})")
+        bare = [k for k in ds.variables if not ds[k].attrs.get("units") or not ds[k].attrs.get("long_name")]
+        check(not bare, f"{where}: every variable has units and long_name (not: {bare})")
+        methods = [k for k in ds.variables if hasattr(xr.Dataset, k)]
+        check(not methods, f"{where}: no variable named like a Dataset method ({methods})")
+        if "p" in ds.dims:
+            j = int(np.flatnonzero(g["p"][:] == 0.5)[0])
+            arrays = [k for k in ds.data_vars if "p" in ds[k].dims]
+            bad = [k for k in arrays if not same_values(ds[k].sel(p=0.5).values, np.take(g[k][()], j, axis=ds[k].dims.index("p")))]
+            if arrays or group != "/":  # the root holds the axis /p only
+                check(arrays and not bad, f"{where}: .sel(p=0.5) of {arrays} is h5py's node {j} (differ: {bad})")
+        if "time" in ds.dims and ds.sizes["time"] > 0:
+            k = ds.sizes["time"] // 2
+            t = float(g["time"][k])
+            arrays = [a for a in ds.data_vars if "time" in ds[a].dims]
+            bad = [a for a in arrays if not same_values(ds[a].sel(time=t).values, np.take(g[a][()], k, axis=ds[a].dims.index("time")))]
+            check(arrays and not bad, f"{where}: .sel(time={t:g}) of {len(arrays)} arrays is h5py's row {k} (differ: {bad})")
+        if group == "samples":
+            j = int(np.flatnonzero(g["p"][:] == 0.5)[0])
+            k = len(g["time"]) - 1
+            value = ds["mean_icdf"].sel(p=0.5, time=float(g["time"][k])).item()
+            check(value == g["mean_icdf"][k, j] and 0 < value < LID,
+                  f"{where}: mean_icdf.sel(p=0.5, time=last) = {value:.6g} d_p, h5py's [{k}, {j}], inside the box")
+            label = xr.plot.utils.label_from_attrs(ds["mean_icdf"])
+            check(label.replace("\n", " ") == "ensemble-mean ICDF [d_p]", f"{where}: plot label {label!r}")
+
+
+def test_xarray(argv):
+    xr = need("xarray", "python3-xarray")
+    need("netCDF4", "python3-netcdf4")
+    need("h5netcdf", "python3-h5netcdf")
+    h5py = need("h5py", "python3-h5py")
+    check = Checks()
+    runs = {
+        "cpi": ["mode=cpi", "observe.bed=true", "cpi.projection=adaptive", "cpi.tolerance=0.06", "cpi.dt_min=0.5",
+                "run.duration=12", "ensemble.realizations_per_rank=4"],
+        "drop": ["mode=direct", "observe.bed=true", "run.duration=2", "ensemble.realizations_per_rank=4",
+                 "ensemble.on_failure=drop", "debug.fail_realization=1", "debug.fail_time=1"],
+        "branch": ["mode=continuation", "continuation.parameter=gas_drag.superficial_velocity", "continuation.end=0.5",
+                   "continuation.step=0.05", "continuation.max_points=2", "run.duration=0", "steady.warmup=1",
+                   "steady.tau=1", "steady.max_iterations=1", "steady.max_krylov=2", "steady.eigenvalues=1",
+                   "steady.eigenvalue_products=2", "steady.noise_factor=50", "ensemble.realizations_per_rank=2"],
+    }
+    with tempfile.TemporaryDirectory() as out:
+        groups_seen = set()
+        for prefix, keys in runs.items():
+            run_efdem(argv, out, *keys, f"output.prefix={prefix}")
+            path = os.path.join(out, f"{prefix}.h5")
+            groups = ["/"]
+            with h5py.File(path, "r") as f:
+                f.visititems(lambda name, obj: groups.append(name) if isinstance(obj, h5py.Group) else None)
+            groups_seen |= set(groups)
+            for group in groups:
+                for engine in (None, "h5netcdf"):
+                    check_group(check, xr, h5py, path, group, engine)
+        expected = {"/", "samples", "bed", "bed/ensemble_mean", "cpi", "cpi/controller", "failures", "steady",
+                    "steady/iterate", "branch"}
+        check(expected <= groups_seen, f"the runs made every group ({sorted(expected - groups_seen)} missing)")
+        # The default engine is netCDF-4's own library: a file it cannot read is not netCDF-4.
+        check(xr.backends.plugins.guess_engine(os.path.join(out, "cpi.h5")) == "netcdf4",
+              "xarray's default engine for a run file is netcdf4")
+    check.done()
+
+
+def doc_blocks(path):
+    """The ```python blocks of a markdown file, in order."""
+    blocks, block = [], None
+    with open(path) as f:
+        for line in f:
+            if block is None and line.strip() == "```python":
+                block = []
+            elif block is not None and line.strip() == "```":
+                blocks.append("".join(block))
+                block = None
+            elif block is not None:
+                block.append(line)
+    return blocks
+
+
+def test_docs(argv):
+    for module, package in (("xarray", "python3-xarray"), ("pandas", "python3-pandas"), ("vtk", "python3-vtk9")):
+        need(module, package)
+    check = Checks()
+    doc = os.path.join(HERE, "..", "..", "docs", "output.md")
+    blocks = doc_blocks(doc)
+    kinds = [k for k in ("xarray", "h5py", "pandas", "vtk", "json") if not any(f"import {k}" in b for b in blocks)]
+    check(not kinds, f"docs/output.md has {len(blocks)} python examples, one for each reader (none for {kinds})")
+    with tempfile.TemporaryDirectory() as out:
+        run_efdem(argv, os.path.join(out, "out"), "mode=direct", "observe.bed=true", "run.duration=2",
+                  "output.vtk_interval=0.5", "ensemble.realizations_per_rank=2")
+        # The names the doc uses: runs/demo_small/quick_direct.h5 (the README's quick start) and
+        # out/efdem_* (output.directory = out), and a frame in the working folder.
+        os.makedirs(os.path.join(out, "runs", "demo_small"))
+        os.symlink(os.path.join(out, "out", "efdem.h5"), os.path.join(out, "runs", "demo_small", "quick_direct.h5"))
+        os.symlink(os.path.join(out, "out", "efdem_r0000_000004.vtp"), os.path.join(out, "efdem_r0000_000004.vtp"))
+        env = dict(os.environ, MPLBACKEND="Agg")
+        for k, code in enumerate(blocks):
+            r = subprocess.run(["/usr/bin/python3", "-c", code], cwd=out, env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True, timeout=300)
+            first = code.strip().splitlines()[0]
+            check(r.returncode == 0, f"docs/output.md example {k + 1} ({first}) runs" +
+                  ("" if r.returncode == 0 else f":\n{r.stdout}"))
+    check.done()
+
+
 if __name__ == "__main__":
-    if len(sys.argv) < 4 or sys.argv[1] not in ("vtk", "csv"):
+    tests = {"vtk": test_vtk, "csv": test_csv, "xarray": test_xarray, "docs": test_docs}
+    if len(sys.argv) < 4 or sys.argv[1] not in tests:
         sys.exit(__doc__)
-    {"vtk": test_vtk, "csv": test_csv}[sys.argv[1]](sys.argv[2:])
+    tests[sys.argv[1]](sys.argv[2:])
