@@ -59,13 +59,14 @@ if subprocess.call(["/usr/bin/python3", compare, ref, sr.run_file(work, "d")]) !
     fail("the run started again differs from the reference")
 print("PASS: a refused checkpoint makes the study run start again")
 
-# Settled beds reused: the first run of the bed kept them (bed.write), a second run of the same bed
-# (another mode's or case's folder, same seed and bed keys) starts from them and is the same run.
+# Settled beds reused: the first run of the bed kept them (bed.write), and the runs after it start
+# from them: the attempt started again above, and a run of the same bed in another folder (same
+# seed and bed keys), which is the same run.
 kept = glob.glob(os.path.join(work, "beds", "*", "bed_r000[01].data"))
 if len(kept) != 2:
     fail(f"expected the 2 realizations' beds under {work}/beds, found {kept}")
-if "bed.write" not in open(os.path.join(work, "d", "command.txt")).read():
-    fail("the first run of the bed did not keep it")
+if "bed.read" not in open(os.path.join(work, "d", "command.txt")).read():
+    fail("the run started again did not start from the beds its first attempt kept")
 if not sr.run_case(efdem, 2, scene, work, "d2", "direct", dict(over, **{"observe.bed": "false"})):
     fail("the run from the kept beds did not complete")
 if "bed: starting from the settled bed" not in open(os.path.join(work, "d2", "d2.log")).read():
