@@ -25,20 +25,8 @@ namespace {
 /// species against bed.count).
 Particles read_settled_bed(const BedSpec& bed, const DemScene& scene, const Params& bed_scope,
                            const RealizationSpec& spec) {
+    check_kept_bed_exists(bed, bed_scope, spec.realization);
     const std::filesystem::path file = bed.read_file(spec.realization);
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec))
-        bed_scope.fail(
-            "read",
-            bed.read_shared ? fmt::format("names no file ({} does not exist)", file.string())
-                            : fmt::format("has no bed for realization {}: {} does not exist",
-                                          spec.realization, file.string()),
-            bed.read_shared
-                ? "a bed file an earlier run wrote with bed.write (one per realization: "
-                  "NAME_r0000.data, ...)"
-                : "the name an earlier run of as many realizations or more gave bed.write (it "
-                  "wrote NAME_r0000.data, ...), or bed.read.shared = true to give every "
-                  "realization one file");
     Particles p = read_lammps_data(file, scene.species, scene.domain);
     std::vector<long> count(scene.species.size(), 0);
     for (const SpeciesId s : p.species()) ++count[s];
@@ -77,6 +65,23 @@ void add_velocities(Particles& p, const BedSpec& bed, const RealizationSpec& spe
     }
 }
 }  // namespace
+
+void check_kept_bed_exists(const BedSpec& bed, const Params& bed_scope, long realization) {
+    if (bed.read.empty()) return;
+    const std::filesystem::path file = bed.read_file(realization);
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(file, ec)) return;
+    bed_scope.fail("read",
+                   bed.read_shared ? fmt::format("names no file ({} does not exist)", file.string())
+                                   : fmt::format("has no bed for realization {}: {} does not exist",
+                                                 realization, file.string()),
+                   bed.read_shared
+                       ? "a bed file an earlier run wrote with bed.write (one per realization: "
+                         "NAME_r0000.data, ...)"
+                       : "the name an earlier run of as many realizations or more gave "
+                         "bed.write (it wrote NAME_r0000.data, ...), or bed.read.shared = true "
+                         "to give every realization one file");
+}
 
 Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& root,
                     const RealizationSpec& spec, const SettlingReport& settling, Particles* built) {

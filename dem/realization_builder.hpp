@@ -29,6 +29,11 @@ Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& roo
                     const RealizationSpec& spec, const SettlingReport& settling = {},
                     Particles* built = nullptr);
 
+/// InputError naming bed.read if the kept bed realization `realization` reads (bed.read) does
+/// not exist; nothing without bed.read. (`efdem --check` builds realization 0 only and asks this
+/// for the others.)
+void check_kept_bed_exists(const BedSpec& bed, const Params& bed_scope, long realization);
+
 /// Builds one realization: effects, initial bed (build_bed), System. InputError for bad input;
 /// the same keys are read for every realization. `settling`, `built`: as in build_bed.
 System build_system(const Params& root, const RealizationSpec& spec,

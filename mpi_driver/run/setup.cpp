@@ -90,6 +90,12 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
             root, {settings.seed, realization, skip_settling, !options.restart.empty()}, settling,
             keep_beds ? &out.beds.emplace_back() : nullptr));
     }
+    // --check builds realization 0 only: the other realizations' kept beds must be there too.
+    if (out.check && options.restart.empty()) {
+        const dem::BedSpec bed = dem::BedSpec::from_params(root.scope("bed"), scene);
+        for (long r = 1; r < static_cast<long>(out.ranks) * settings.realizations_per_rank; ++r)
+            dem::check_kept_bed_exists(bed, root.scope("bed"), r);
+    }
     out.table->check_all_used(
         [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
     // What a new run may not write over (the same check in --check); the root looks.

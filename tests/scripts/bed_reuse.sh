@@ -51,6 +51,9 @@ grep -q "key 'bed.read' = '$beds': $work/beds/tiny_r0000.data holds 128 light, 1
 expect_exit 2 "$work/missing.log" efd 2 "$efdem" "$scene" "${common[@]}" output.prefix=e bed.read="$beds" ensemble.realizations_per_rank=2
 grep -q "key 'bed.read' = '$beds': has no bed for realization 2: $work/beds/tiny_r0002.data does not exist" "$work/missing.log" \
   || { cat "$work/missing.log"; fail "a realization without its bed: message"; }
+expect_exit 2 "$work/missing_check.log" "$efdem" --check "$scene" "${common[@]}" output.prefix=e bed.read="$beds" ensemble.realizations_per_rank=3
+grep -q "key 'bed.read' = '$beds': has no bed for realization 2: $work/beds/tiny_r0002.data does not exist" "$work/missing_check.log" \
+  || { cat "$work/missing_check.log"; fail "--check of a realization without its bed: message"; }
 expect_exit 2 "$work/box.log" "$efdem" --check "$scene" "${common[@]}" output.prefix=f bed.read="$beds" domain.lx=4.5
 grep -q "$work/beds/tiny_r0000.data.*domain.lx = 4.5" "$work/box.log" || { cat "$work/box.log"; fail "another box: message"; }
 [ $failures -eq 0 ] && echo "PASS: bed.write onto existing beds, other counts, a missing realization, another box: exit 2"
