@@ -91,9 +91,12 @@ Particles build_bed(const BedSpec& bed, const DemScene& scene, const Params& roo
         if (built) *built = p;  // the file's bed, without the velocities added next
         add_velocities(p, bed, spec);
         if (spec.realization == 0)
-            log::info("bed: starting from the settled bed{} {} (bed.read; not settled)",
+            log::info("bed: starting from the settled bed{} {} (bed.read; not settled){}",
                       bed.read_shared ? " every realization shares," : " of realization 0,",
-                      bed.read_file(0).string());
+                      bed.read_file(0).string(),
+                      bed.read_shared ? "; the realizations' ICDFs stay correlated for a mixing "
+                                        "time (docs/how_to_choose.md, \"Reuse a settled bed\")"
+                                      : "");
     } else if (bed.source == BedSpec::Source::lattice) {
         p = lattice_bed(bed, scene, spec);
         if (bed.settle && !spec.skip_settling) {
