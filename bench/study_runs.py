@@ -1,10 +1,17 @@
 """What the resumable studies in bench/ share: one efdem run per folder, skipped when its run file
 says "completed"; an incomplete one continues from its newest checkpoint (every run writes them:
 a direct run every 100 samples, a CPI run after every coarse step; a restart is bit for bit the
-uninterrupted run, mpi:restart_equality), or starts again when it has none or efdem refuses it."""
+uninterrupted run, mpi:restart_equality), or starts again when it has none or efdem refuses it.
+
+Settled beds are reused: the first run of a bed (scene, ranks and the keys that shape the bed:
+seed, species, box, contacts, bed.*) keeps its settled beds (bed.write) in FOLDER/beds/<key>/,
+and every later run of that bed starts from them (bed.read), which gives the same run bit for
+bit without settling again (mpi:bed_reuse). run_case(..., beds=False) settles every run."""
 import datetime as dt_
 import glob
+import hashlib
 import os
+import re
 import shutil
 import subprocess
 import time
@@ -34,13 +41,56 @@ def newest_checkpoint(folder, name):
     return found[-1] if found else None
 
 
-def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None):
+# The keys whose values shape a settled bed (besides the scene file and the rank count): the seed,
+# the time step, the box, the species and the settling's physics and protocol.
+BED_KEYS = re.compile(r"^(seed|dt|effects|ensemble\.realizations_per_rank|domain\.|species\.|bed\.|"
+                      r"pair_contact\.|wall_contact\.|gravity\.|neighbor\.)")
+
+
+def realizations_per_rank(scene, overrides):
+    if "ensemble.realizations_per_rank" in overrides:
+        return int(overrides["ensemble.realizations_per_rank"])
+    with open(scene) as f:
+        for line in f:
+            m = re.match(r"\s*ensemble\.realizations_per_rank\s*=\s*(\d+)", line)
+            if m:
+                return int(m.group(1))
+    return 1
+
+
+def bed_overrides(np_, scene, folder, overrides):
+    """bed.write (the first run of its bed) or bed.read (the beds are there) for a run of SCENE
+    on NP ranks with OVERRIDES: the beds of FOLDER/beds/<key>/, key from the scene's text, NP and
+    the overrides that shape a bed (BED_KEYS)."""
+    if "bed.write" in overrides or "bed.read" in overrides:
+        return {}
+    h = hashlib.sha256()
+    with open(scene, "rb") as f:
+        h.update(f.read())
+    h.update(f"np={np_}\n".encode())
+    for k in sorted(overrides):
+        if BED_KEYS.match(k):
+            h.update(f"{k}={overrides[k]}\n".encode())
+    name = os.path.join(os.path.abspath(folder), "beds", h.hexdigest()[:16], "bed.data")
+    r = np_ * realizations_per_rank(scene, overrides)
+    stem = name[:-len(".data")]
+    if all(os.path.exists(f"{stem}_r{k:04d}.data") for k in range(r)):
+        return {"bed.read": name}
+    # Some but not all of the files: a writer killed while writing; replace them. (A new run's
+    # folder is empty, so output.overwrite deletes nothing else.)
+    return {"bed.write": name, "output.overwrite": "true"}
+
+
+def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None, beds=True):
     """mpirun -np NP efdem SCENE mode=MODE output.* KEY=VALUE... into FOLDER/NAME/ (command.txt,
     NAME.log, NAME.h5), continued from the newest checkpoint of an earlier attempt when there is
-    one. Returns whether it completed."""
+    one. With `beds`, from the settled beds an earlier run of the same bed kept (bed_overrides).
+    Returns whether it completed."""
     label = label or name
     d = os.path.join(folder, name)
     overrides = dict(overrides)
+    if beds:
+        overrides.update(bed_overrides(np_, scene, folder, overrides))
     overrides.setdefault("checkpoint.interval", 100 if mode == "direct" else 1)
     cmd = ["mpirun", "-np", str(np_), "--oversubscribe", efdem, scene, f"mode={mode}",
            f"output.directory={os.path.abspath(d)}", f"output.prefix={name}"] + \

@@ -53,6 +53,9 @@ struct RealizationSpec {
     long realization = 0;    ///< global realization index
     bool skip_settling =
         false;  ///< read every key but do not run the settling (efdem --check, a restart)
+    /// A restart: the bed is a placeholder the checkpoint replaces, so bed.read's files are not
+    /// read either (the unsettled lattice stands in; a restart needs no bed file).
+    bool restart = false;
 };
 
 }  // namespace efdem::dem

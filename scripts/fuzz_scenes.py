@@ -57,7 +57,8 @@ WORDS = ["abc", "true", "false", "light", "heavy", "lattice", "lammps_data", "ho
          "../../etc/passwd", "/", "/dev/zero", "/dev/null", "tiny_bed.data", "%s%n%x", "\\"]
 UNKNOWN_KEYS = ["foo", "foo.bar", "pair_contact.kk", "wall_contact.kn", "gas_drag.law",
                 "bed.settle.maxtime", "domain.lz", "species.name", "Dt", "dt_", "effects.x",
-                "viscous_damping.gamma", "gravity.g", "bed.file", "bed.source", "_", "a" * 300]
+                "viscous_damping.gamma", "gravity.g", "bed.file", "bed.source", "bed.read", "bed.write",
+                "bed.read.shared", "bed.read.velocity_rms", "_", "a" * 300]
 RANDOM_BYTES = [b"\x00", b"\xff", b"\xfe\xff", b"\xc3\x28", b"\xe2\x82", b"\x80", b"\r", b"\t",
                 b"\x1b[31m", b"\x7f", b"\n", b"=", b"#", b'"', b"\xf0\x9f\x92\xa9", b"\x00\x00"]
 REQUIRED_KEYS = ["dt", "effects", "domain.lx", "domain.ly", "species.names", "species.density",

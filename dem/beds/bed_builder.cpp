@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/rng.hpp"
+#include "dem/io/lammps_data.hpp"
 
 namespace efdem::dem {
 
@@ -130,13 +131,35 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
             check_settle_steps(s, "damped_time", b.settle_damped_time, scene.dt);
             check_settle_steps(s, "max_time", b.settle_max_time, scene.dt);
         }
+        // The settled beds of an earlier run of this scene (bed.write): read instead of built
+        // and settled. The lattice's keys above are still read, so that the same scene serves
+        // both runs, and bed.count checks the files.
+        b.read = p.get_or_path("read", "");
+        const Params r = p.scope("read");
+        b.read_shared = r.get_or<bool>("shared", false);
+        // As bed.velocity_rms: a fluidized bed's particles move at 0.01-1 sqrt(g d_p).
+        b.read_velocity_rms = r.get_or<double>("velocity_rms", 0.0, Bounds::closed(0.0, 10.0));
+        if (b.read.empty())
+            for (const char* key : {"shared", "velocity_rms"})
+                if (r.contains(key))
+                    r.fail(key, "is given without bed.read",
+                           "bed.read = NAME (the settled beds an earlier run wrote with "
+                           "bed.write), or no bed.read.* key");
     } else {
         b.source = Source::lammps_data;
         b.file = p.get_path("file");
         b.settle = false;
+        if (p.contains("read"))
+            p.fail("read", "is for a lattice scene (bed.source = lattice)",
+                   "with bed.source = lammps_data the bed is bed.file; bed.read replaces building "
+                   "and settling the lattice of a scene that has one");
     }
     b.permute_species = p.get_or<bool>("permute_species", false);
     return b;
+}
+
+std::filesystem::path BedSpec::read_file(long r) const {
+    return read_shared ? read : realization_file(read, r);
 }
 
 Particles lattice_bed(const BedSpec& bed, const DemScene& scene, const RealizationSpec& spec) {

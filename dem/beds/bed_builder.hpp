@@ -28,8 +28,16 @@
 /// |                        | `light_on_top` / `heavy_on_top` (stratified by        |           |
 /// |                        | density: a fully demixed start, e.g. for mixing runs) |           |
 /// | permute_species        | reassign species by random permutation (exact counts) | false     |
+/// | read                   | lattice: start from the settled beds an earlier run   | none      |
+/// |                        | wrote with bed.write (not built, not settled)         |           |
+/// | read.shared            | every realization reads the file bed.read names       | false     |
+/// |                        | (false: realization r reads realization_file(read, r))|           |
+/// | read.velocity_rms      | rms speed of Gaussian velocities added to the read    | 0         |
+/// |                        | bed (stream `bed_velocities`): decorrelates a shared  |           |
+/// |                        | bed's realizations                                    |           |
 ///
-/// Streams: `packing` (jitter, species permutation), `velocities` (initial velocities).
+/// Streams: `packing` (jitter, species permutation), `velocities` (initial velocities),
+/// `bed_velocities` (bed.read.velocity_rms).
 /// The settling stages: free fall for sqrt(2 H_lattice) + 1 time units (the top layer reaches
 /// the bed), the damped stage, then contacts alone until the threshold.
 
@@ -63,6 +71,14 @@ struct BedSpec {
     std::filesystem::path file;
     enum class Layering { mixed, light_on_top, heavy_on_top } layering = Layering::mixed;
     bool permute_species = false;
+    /// bed.read: the settled beds of an earlier run (empty: build the lattice); with
+    /// read_shared the one file every realization reads, else the name bed.write was given.
+    std::filesystem::path read;
+    bool read_shared = false;
+    double read_velocity_rms = 0;
+
+    /// The file realization `r` reads with bed.read.
+    std::filesystem::path read_file(long r) const;
 
     static BedSpec from_params(const Params& scope, const DemScene& scene);
 };

@@ -4,8 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numeric>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <unordered_map>
 #include <vector>
 
@@ -23,7 +27,7 @@ class GzLines {
     explicit GzLines(const std::filesystem::path& path) : path_(path.string()) {
         std::error_code ec;
         if (!std::filesystem::is_regular_file(path, ec))
-            throw InputError({path_, 0}, "LAMMPS data file not found (bed.file)");
+            throw InputError({path_, 0}, "LAMMPS data file not found");
         file_ = gzopen(path_.c_str(), "rb");
         if (!file_) throw InputError({path_, 0}, "cannot be opened for reading");
     }
@@ -122,6 +126,8 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
     };
     std::vector<Atom> atoms;
     std::unordered_map<Tag, std::size_t> index_of;
+    long n_types = -1;
+    bool have_labels = false;
     std::string section;
     while (in.next(line)) {
         const std::string s = strip(line);
@@ -129,7 +135,8 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
         const bool is_number = std::isdigit(static_cast<unsigned char>(s[0])) || s[0] == '-' ||
                                s[0] == '+' || s[0] == '.';
         if (!is_number) {  // a section keyword
-            section = s.substr(0, s.find_first_of(" \t"));
+            section = s.rfind("Atom Type Labels", 0) == 0 ? std::string("Atom Type Labels")
+                                                          : s.substr(0, s.find_first_of(" \t"));
             if (section == "Atoms" && line.find("sphere") == std::string::npos &&
                 line.find('#') != std::string::npos)
                 throw InputError({in.path(), in.line_number()},
@@ -137,6 +144,10 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
             continue;
         }
         if (section.empty()) {  // header
+            if (s.find("atom types") != std::string::npos)
+                n_types =
+                    whole_number(numbers(s.substr(0, s.find("atom types")), 1, in, "atom types")[0],
+                                 1, 255, in, "the number of atom types");
             if (s.find("atoms") != std::string::npos)
                 n_atoms = whole_number(numbers(s.substr(0, s.find("atoms")), 1, in, "atoms")[0], 0,
                                        kMaxRealizationParticles, in, "the number of atoms");
@@ -149,6 +160,24 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
                     have_box[a] = true;
                 }
             }
+        } else if (section == "Atom Type Labels") {  // `type name`: the species' names
+            std::istringstream ss(s);
+            std::string type_text, label;
+            ss >> type_text >> label;
+            const long type = whole_number(numbers(type_text, 1, in, "Atom Type Labels")[0], 1, 255,
+                                           in, "the labelled atom type");
+            if (type > static_cast<long>(species.size()) ||
+                label != species[static_cast<SpeciesId>(type - 1)].name)
+                throw InputError(
+                    {in.path(), in.line_number()},
+                    fmt::format(
+                        "atom type {} is labelled '{}', but the scene's species {} is {} "
+                        "(species.names: type t is the t-th name)",
+                        type, label, type,
+                        type > static_cast<long>(species.size())
+                            ? std::string("not there")
+                            : fmt::format("'{}'", species[static_cast<SpeciesId>(type - 1)].name)));
+            have_labels = true;
         } else if (section == "Atoms") {
             const auto v = numbers(s, 7, in, "Atoms");
             const auto id = static_cast<Tag>(whole_number(v[0], 1, kMaxAtomId, in, "the atom id"));
@@ -199,6 +228,11 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
     }
     if (n_atoms < 0)
         throw InputError({in.path(), 0}, "the header does not give the number of atoms");
+    if (have_labels && n_types != static_cast<long>(species.size()))
+        throw InputError({in.path(), 0},
+                         fmt::format("the file has {} atom types (species), but species.names "
+                                     "lists {}",
+                                     n_types, species.size()));
     if (static_cast<long>(atoms.size()) != n_atoms)
         throw InputError({in.path(), 0},
                          fmt::format("the header announces {} atoms but the Atoms section "
@@ -222,6 +256,78 @@ Particles read_lammps_data(const std::filesystem::path& file, const SpeciesTable
         p.omega()[p.size() - 1] = a.w;
     }
     return p;
+}
+
+void write_lammps_data(const std::filesystem::path& file, const Particles& p,
+                       const SpeciesTable& species, const Domain& domain,
+                       const std::string& title) {
+    std::vector<std::size_t> order(p.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return p.tag()[a] < p.tag()[b]; });
+    double top = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) top = std::max(top, p.x()[i].z + p.radius()[i]);
+    const double zhi = domain.has_lid() ? domain.lid_height : top;
+    std::string text = fmt::format(
+        "{}\n\n{} atoms\n{} atom types\n\n0 {:.17g} xlo xhi\n0 {:.17g} ylo yhi\n0 {:.17g} zlo "
+        "zhi\n\nAtom Type Labels\n\n",
+        title, p.size(), species.size(), domain.lx, domain.ly, zhi);
+    for (std::size_t s = 0; s < species.size(); ++s)
+        text += fmt::format("{} {}\n", s + 1, species[static_cast<SpeciesId>(s)].name);
+    text += "\nAtoms # sphere\n\n";
+    for (std::size_t i : order) {
+        const Species& sp = species[p.species()[i]];
+        const Vec3 x = domain.wrap(p.x()[i]);
+        text += fmt::format("{} {} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", p.tag()[i],
+                            p.species()[i] + 1, sp.diameter, sp.density, x.x, x.y, x.z);
+    }
+    text += "\nVelocities\n\n";
+    for (std::size_t i : order) {
+        const Vec3 v = p.v()[i], w = p.omega()[i];
+        text += fmt::format("{} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", p.tag()[i], v.x,
+                            v.y, v.z, w.x, w.y, w.z);
+    }
+    const std::string name = file.string();
+    const std::string tmp = name + ".tmp";
+    auto fail = [&](const std::string& why) {
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw RuntimeFailure(fmt::format("cannot write the bed file {}: {}", name, why));
+    };
+    if (const auto parent = file.parent_path(); !parent.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(parent, ec);
+        if (ec) fail(fmt::format("its folder cannot be created ({})", ec.message()));
+    }
+    if (name.ends_with(".gz")) {
+        gzFile g = gzopen(tmp.c_str(), "wb");
+        if (!g) fail("cannot open it");
+        const bool ok = gzwrite(g, text.data(), static_cast<unsigned>(text.size())) ==
+                        static_cast<int>(text.size());
+        if (gzclose(g) != Z_OK || !ok) fail("write error (disk full?)");
+    } else {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out) fail("cannot open it");
+        out.write(text.data(), static_cast<std::streamsize>(text.size()));
+        out.close();
+        if (!out) fail("write error (disk full?)");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, file, ec);
+    if (ec) fail(ec.message());
+}
+
+std::filesystem::path realization_file(const std::filesystem::path& name, long realization) {
+    std::string leaf = name.filename().string();
+    std::string gz;
+    if (leaf.size() > 3 && leaf.ends_with(".gz")) {
+        gz = ".gz";
+        leaf.resize(leaf.size() - 3);
+    }
+    const std::filesystem::path base(leaf);
+    const std::string ext = base.extension().string();
+    const std::string stem = leaf.substr(0, leaf.size() - ext.size());
+    return name.parent_path() / fmt::format("{}_r{:04d}{}{}", stem, realization, ext, gz);
 }
 
 }  // namespace efdem::dem

@@ -88,8 +88,11 @@ bool may_change_on_restart(const std::string& key) {
     for (const char* scope : {"output.", "checkpoint.", "restart.", "debug.", "watchdog."})
         if (key.rfind(scope, 0) == 0) return true;
     // ensemble.at_rest: pausing a bed at rest changes its state by floating-point drift alone.
+    // bed.write, bed.read*: where the initial beds were kept or came from; a restart neither
+    // writes nor reads them (the checkpoint holds every particle state).
     return key == "run.duration" || key == "ensemble.realizations_per_rank" ||
-           key == "ensemble.at_rest";
+           key == "ensemble.at_rest" || key == "bed.write" || key == "bed.read" ||
+           key.rfind("bed.read.", 0) == 0;
 }
 
 bool shapes_the_run_file(const std::string& key) {

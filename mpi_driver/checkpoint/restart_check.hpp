@@ -5,8 +5,9 @@
 /// The realization count must match (a realization's state belongs to its global index). Every
 /// parameter must have the value it had when the checkpoint was written, except those that do
 /// not change the trajectory: run.duration (extend a run), output.*, checkpoint.*, restart.*,
-/// debug.*, watchdog.* and ensemble.realizations_per_rank (the rank layout; results do not
-/// depend on it). The mode and the observe.* keys (the run file's grid) never change; other
+/// debug.*, watchdog.*, ensemble.realizations_per_rank (the rank layout; results do not
+/// depend on it), ensemble.at_rest, and bed.write, bed.read* (a restart neither writes nor reads
+/// beds). The mode and the observe.* keys (the run file's grid) never change; other
 /// differences are refused unless restart.allow_physics_change = true.
 
 #include <filesystem>

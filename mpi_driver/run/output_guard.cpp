@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "dem/io/lammps_data.hpp"
 #include "mpi_driver/checkpoint_data/checkpoint_format.hpp"
 #if EFDEM_HAVE_HDF5
 #include "mpi_driver/checkpoint/checkpoint_reader.hpp"
@@ -118,6 +119,21 @@ void check_output_is_free(const Params& root, const RunSettings& s, bool restart
                 "another output.prefix or output.directory; output.overwrite = true to delete that "
                 "run's files "
                 "and replace it; or continue it with restart=CHECKPOINT");
+}
+
+void check_bed_write_is_free(const Params& root, const RunSettings& s, long realizations,
+                             bool restarting) {
+    if (restarting || s.output.overwrite || s.output.bed_write.empty()) return;
+    std::error_code ec;
+    for (long r = 0; r < realizations; ++r)
+        if (const auto file = dem::realization_file(s.output.bed_write, r);
+            std::filesystem::exists(file, ec))
+            root.scope("bed").fail(
+                "write",
+                fmt::format("would write over {}, which exists (nothing was overwritten)",
+                            file.string()),
+                "a name no earlier bed file has; bed.read = the same name to start from those "
+                "beds instead; or output.overwrite = true to replace them");
 }
 
 #if EFDEM_HAVE_HDF5

@@ -39,6 +39,11 @@ void check_output_is_writable(const Params& root, const RunSettings& settings);
 /// earlier run's files and output.overwrite is false.
 void check_output_is_free(const Params& root, const RunSettings& settings, bool restarting);
 
+/// InputError (naming bed.write) if a new run (not `restarting`) of `realizations` would write
+/// over a bed file that exists (bed.write's NAME_rNNNN files) and output.overwrite is false.
+void check_bed_write_is_free(const Params& root, const RunSettings& settings, long realizations,
+                             bool restarting);
+
 #if EFDEM_HAVE_HDF5
 /// InputError (naming output.prefix) if a restart from `checkpoint` (whose header is `header`)
 /// would write into another run's files (see above), or into files whose run cannot be told.

@@ -178,6 +178,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         output.fail("directory",
                     fmt::format("is {} characters long", s.output.directory.string().size()),
                     "a path of at most 3000 characters");
+    s.output.bed_write = root.scope("bed").get_or_path("write", "");
     s.output.vtk_interval = output.get_or<double>("vtk_interval", 0.0, Bounds::closed(0.0, 1e9));
     if (s.output.vtk_interval > 0)
         whole_multiple(output, "vtk_interval", s.output.vtk_interval, s.observe.interval,

@@ -44,6 +44,8 @@
 /// | output.thermo_interval         | time between thermo lines per realization (0: none) | 0       |
 /// | output.overwrite               | a new run may delete and replace the files an       | false   |
 /// |                                | earlier run left under output.prefix (output_guard) |         |
+/// | bed.write                      | keep each realization's settled bed in a LAMMPS data| none    |
+/// |                                | file (NAME_rNNNN.data) for bed.read (setup.cpp)     |         |
 /// | checkpoint.*, restart.*        | checkpoint_data/checkpoint_settings.hpp             |         |
 /// | debug.fail_realization         | test only: this realization fails ...               | -1      |
 /// | debug.fail_time                | ... at the first sample at or after this time       | 0       |
@@ -83,6 +85,9 @@ struct OutputSettings {
     double vtk_interval = 0;
     double thermo_interval = 0;
     bool overwrite = false;  ///< a new run may replace an earlier run's files of the same prefix
+    /// bed.write: where each realization's bed is kept once built and settled (empty: not
+    /// kept); realization r writes dem::realization_file(bed_write, r). Not by a restart.
+    std::filesystem::path bed_write;
 };
 
 struct RunSettings {

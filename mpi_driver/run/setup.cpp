@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/version.hpp"
+#include "dem/io/lammps_data.hpp"
 #include "dem/realization_builder.hpp"
 #include "dem/scene.hpp"
 #include "mpi_driver/checkpoint/restart_check.hpp"
@@ -72,6 +73,10 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
                                      "micro states in memory that a checkpoint does not hold)",
                                      options.restart, settings.mode_name()));
     const bool skip_settling = out.check || !options.restart.empty();
+    // bed.write: each rank keeps its beds as built, and writes them once the output guard has
+    // passed (set_up, write_beds); a restart's beds are placeholders and are not written.
+    const bool keep_beds =
+        !out.check && options.restart.empty() && !settings.output.bed_write.empty();
     // The run's header before the beds are built: settling a large bed takes minutes, and the
     // user should see at once what runs where.
     if (!out.check && mpi.is_root())
@@ -81,8 +86,15 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
                   options.restart.empty() ? "" : fmt::format("; continuing {}", options.restart));
     for (int j = 0; j < k; ++j) {
         const long realization = out.check ? 0 : static_cast<long>(mpi.rank()) * k + j;
-        out.systems.push_back(
-            dem::build_system(root, {settings.seed, realization, skip_settling}, settling));
+        out.systems.push_back(dem::build_system(
+            root, {settings.seed, realization, skip_settling, !options.restart.empty()}, settling,
+            keep_beds ? &out.beds.emplace_back() : nullptr));
+    }
+    // --check builds realization 0 only: the other realizations' kept beds must be there too.
+    if (out.check && options.restart.empty()) {
+        const dem::BedSpec bed = dem::BedSpec::from_params(root.scope("bed"), scene);
+        for (long r = 1; r < static_cast<long>(out.ranks) * settings.realizations_per_rank; ++r)
+            dem::check_kept_bed_exists(bed, root.scope("bed"), r);
     }
     out.table->check_all_used(
         [&](const ParamEntry& e) { return dem::unused_key_hint(e, scene.effect_names); });
@@ -98,6 +110,9 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
             out.lock.emplace(root, settings.output.directory, settings.output.prefix);
         }
         check_output_is_free(root, settings, !options.restart.empty());
+        check_bed_write_is_free(root, settings,
+                                static_cast<long>(out.ranks) * settings.realizations_per_rank,
+                                !options.restart.empty());
 #if EFDEM_HAVE_HDF5
         if (!options.restart.empty()) {
             // Read once here. A checkpoint that cannot be read: --check says why now; a run
@@ -150,6 +165,42 @@ Agreement replace_earlier_run(const MpiSession& mpi, const RunSettings& settings
     return agree_on_failure(mpi.comm(), removal, why);
 }
 
+/// bed.write: every rank writes its realizations' beds as built (and settled), one LAMMPS data
+/// file each, and drops its copies. Collective; a file that cannot be written ends the set-up
+/// (exit 3), naming it.
+Agreement write_beds(const MpiSession& mpi, const RunSettings& settings, SetUp& out) {
+    int code = kExitOk;
+    std::string why;
+    const int k = settings.realizations_per_rank;
+    try {
+        for (std::size_t j = 0; j < out.beds.size(); ++j) {
+            const long r = static_cast<long>(mpi.rank()) * k + static_cast<long>(j);
+            dem::write_lammps_data(
+                dem::realization_file(settings.output.bed_write, r), out.beds[j],
+                out.systems[j].species(), out.systems[j].domain(),
+                fmt::format("efdem {} bed of realization {}, seed {}, scene {} (bed.write; "
+                            "LAMMPS atom_style sphere)",
+                            version(), r, settings.seed, out.table->file()));
+        }
+    } catch (const RuntimeFailure& e) {
+        code = kExitRuntimeFailure;
+        why = e.what();
+    }
+    out.beds.clear();
+    const Agreement agreed = agree_on_failure(mpi.comm(), code, why);
+    const long realizations = static_cast<long>(mpi.size()) * k;
+    if (agreed.exit_code == kExitOk && mpi.is_root())
+        log::info("bed.write: the beds of the {} realization(s) are in {}{}", realizations,
+                  dem::realization_file(settings.output.bed_write, 0).string(),
+                  realizations > 1
+                      ? fmt::format(" .. {}", dem::realization_file(settings.output.bed_write,
+                                                                    realizations - 1)
+                                                  .filename()
+                                                  .string())
+                      : std::string());
+    return agreed;
+}
+
 }  // namespace
 
 Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wall, SetUp& out) {
@@ -188,6 +239,9 @@ Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wa
     Agreement done = agreed;
     if (!out.check && out.settings->output.overwrite && options.restart.empty())
         done = replace_earlier_run(mpi, *out.settings);
+    if (done.exit_code == kExitOk && !out.check && options.restart.empty() &&
+        !out.settings->output.bed_write.empty())
+        done = write_beds(mpi, *out.settings, out);
     return done;
 }
 

@@ -43,13 +43,18 @@ struct SetUp {
     std::optional<ParamTable> table;
     std::optional<RunSettings> settings;
     std::vector<dem::System> systems;  ///< this rank's realizations' beds
+    /// With bed.write (a new run, not --check): this rank's beds as built and settled, in the
+    /// order of `systems`, until set_up has written them.
+    std::vector<dem::Particles> beds;
     bool check = false;
     int ranks = 1;                   ///< the ranks the run is for (--ranks=N with --check)
     std::optional<OutputLock> lock;  ///< the root's, for the whole run (not with --check)
 };
 
 /// Collective: reads the scene of `options`, builds this rank's beds into `out` and records the
-/// settling's wall time in `wall`. The agreement's exit code is 0 when `out` is ready.
+/// settling's wall time in `wall`; with bed.write, once the output guard has passed, every rank
+/// writes its realizations' beds (dem::write_lammps_data, one file each). The agreement's exit
+/// code is 0 when `out` is ready.
 Agreement set_up(const MpiSession& mpi, const RunOptions& options, SetupWall& wall, SetUp& out);
 
 /// Root, once the run can start (set up, and a restart's states restored): the run's log,

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "dem/io/lammps_data.hpp"
 #include "tests/support/dem_fixtures.hpp"
@@ -143,5 +144,88 @@ TEST_CASE("broken LAMMPS data files are input errors naming the file and the lin
         std::filesystem::resize_file(path, size / 2);
         const auto e = error_of(path, Domain{15, 15, 150});
         CHECK(e.where().file == path.string());
+    }
+}
+
+TEST_CASE("a written bed reads back bit for bit: positions (wrapped), velocities, spins, species",
+          "[unit][io]") {
+    const auto species = test::binary_species();
+    const Domain d{4, 4, 20};
+    Particles p = test::random_particles(50, 4, 0.5, 10, 7);
+    // Tags out of order (the neighbour list sorts particles in space) and spins of any size;
+    // two particles slightly outside the periodic box, as between neighbour-list rebuilds.
+    for (std::size_t i = 0; i < p.size(); ++i)
+        p.omega()[i] = {1e-17 * static_cast<double>(i), -3.0 / static_cast<double>(i + 1), 0.1};
+    p.x()[3].x = -1e-3;
+    p.x()[4].y = 4 + 2e-3;
+    std::vector<Index> reverse(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) reverse[i] = static_cast<Index>(p.size() - 1 - i);
+    p.permute(reverse);
+    for (const std::string name : {"efdem_roundtrip.data", "efdem_roundtrip.data.gz"}) {
+        const auto path = std::filesystem::temp_directory_path() / name;
+        write_lammps_data(path, p, species, d, "round trip");
+        const Particles q = read_lammps_data(path, species, d);
+        REQUIRE(q.size() == p.size());
+        for (std::size_t k = 0; k < q.size(); ++k) {
+            const std::size_t i = p.size() - 1 - k;  // q is in tag order
+            INFO(name << ": tag " << q.tag()[k]);
+            REQUIRE(q.tag()[k] == p.tag()[i]);
+            // Exact: 17 significant digits give every double back (std::stod rounds correctly).
+            const Vec3 x = d.wrap(p.x()[i]);
+            CHECK(q.x()[k].x == x.x);
+            CHECK(q.x()[k].y == x.y);
+            CHECK(q.x()[k].z == x.z);
+            CHECK(q.v()[k].x == p.v()[i].x);
+            CHECK(q.v()[k].y == p.v()[i].y);
+            CHECK(q.v()[k].z == p.v()[i].z);
+            CHECK(q.omega()[k].x == p.omega()[i].x);
+            CHECK(q.omega()[k].y == p.omega()[i].y);
+            CHECK(q.species()[k] == p.species()[i]);
+        }
+        CHECK(std::filesystem::exists(path));
+        CHECK(!std::filesystem::exists(path.string() + ".tmp"));
+    }
+}
+
+TEST_CASE("a written bed names its species; another species table is refused", "[unit][io]") {
+    const auto species = test::binary_species();
+    const auto path = std::filesystem::temp_directory_path() / "efdem_labels.data";
+    write_lammps_data(path, test::random_particles(4, 4, 0.5, 3, 1), species, Domain{4, 4},
+                      "labels");
+    auto problem = [&](const SpeciesTable& other) {
+        try {
+            read_lammps_data(path, other, Domain{4, 4});
+        } catch (const InputError& e) {
+            CHECK(e.where().file == path.string());
+            return e.problem();
+        }
+        return std::string("accepted");
+    };
+    // Same densities and diameters under other names: only the labels tell them apart.
+    CHECK(problem(SpeciesTable({{"heavy", 1.0, 1.0}, {"light", 2.0, 1.0}})) ==
+          "atom type 1 is labelled 'light', but the scene's species 1 is 'heavy' "
+          "(species.names: type t is the t-th name)");
+    CHECK(problem(SpeciesTable({{"light", 1.0, 1.0}, {"heavy", 2.0, 1.0}, {"third", 3.0, 1.0}})) ==
+          "the file has 2 atom types (species), but species.names lists 3");
+    CHECK(problem(species) == "accepted");
+}
+
+TEST_CASE("bed files per realization: _rNNNN before the extension", "[unit][io]") {
+    CHECK(realization_file("runs/beds.data", 7) == std::filesystem::path("runs/beds_r0007.data"));
+    CHECK(realization_file("beds.data.gz", 12) == std::filesystem::path("beds_r0012.data.gz"));
+    CHECK(realization_file("/a/b.c/beds", 0) == std::filesystem::path("/a/b.c/beds_r0000"));
+    CHECK(realization_file("beds.data", 12345) == std::filesystem::path("beds_r12345.data"));
+}
+
+TEST_CASE("a bed file that cannot be written is a runtime failure naming it", "[unit][io]") {
+    const auto blocker = std::filesystem::temp_directory_path() / "efdem_not_a_folder";
+    std::ofstream(blocker) << "x";
+    const auto path = blocker / "beds.data";
+    try {
+        write_lammps_data(path, test::random_particles(2, 4, 0.5, 3, 1), test::binary_species(),
+                          Domain{4, 4}, "t");
+        FAIL("expected a RuntimeFailure");
+    } catch (const RuntimeFailure& e) {
+        CHECK(std::string(e.what()).find(path.string()) != std::string::npos);
     }
 }

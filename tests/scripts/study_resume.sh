@@ -58,4 +58,24 @@ if not run():
 if subprocess.call(["/usr/bin/python3", compare, ref, sr.run_file(work, "d")]) != 0:
     fail("the run started again differs from the reference")
 print("PASS: a refused checkpoint makes the study run start again")
+
+# Settled beds reused: the first run of the bed kept them (bed.write), and the runs after it start
+# from them: the attempt started again above, and a run of the same bed in another folder (same
+# seed and bed keys), which is the same run.
+kept = glob.glob(os.path.join(work, "beds", "*", "bed_r000[01].data"))
+if len(kept) != 2:
+    fail(f"expected the 2 realizations' beds under {work}/beds, found {kept}")
+if "bed.read" not in open(os.path.join(work, "d", "command.txt")).read():
+    fail("the run started again did not start from the beds its first attempt kept")
+if not sr.run_case(efdem, 2, scene, work, "d2", "direct", dict(over, **{"observe.bed": "false"})):
+    fail("the run from the kept beds did not complete")
+if "bed: starting from the settled bed" not in open(os.path.join(work, "d2", "d2.log")).read():
+    fail("the second run of the bed did not start from the kept beds")
+if subprocess.call(["/usr/bin/python3", compare, ref, sr.run_file(work, "d2")]) != 0:
+    fail("the run from the kept beds differs from the run that kept them")
+if not sr.run_case(efdem, 2, scene, work, "d3", "direct", dict(over, seed=6)):
+    fail("a run of another seed did not complete")
+if "bed.write" not in open(os.path.join(work, "d3", "command.txt")).read():
+    fail("a run of another seed (another bed) did not settle its own")
+print("PASS: a study keeps a bed once and starts its later runs of that bed from it")
 PY
