@@ -361,6 +361,7 @@ void EnsembleStepper::do_lift(double new_time, bool top_half, const Eigen::Vecto
 
 std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const CheckpointHeader* header,
                                                      bool at_resume_point) {
+    const double start = MPI_Wtime();
     try {
         if (at_resume_point) {
             const EnsembleSnapshot& resume = snapshots_.get(Use::resume);
@@ -371,6 +372,7 @@ std::filesystem::path EnsembleStepper::do_checkpoint(long sequence, const Checkp
             last_checkpoint_ = writer_->write(sequence, states, header);
             last_checkpoint_time_ = time();
         }
+        last_checkpoint_seconds_ = MPI_Wtime() - start;
         return last_checkpoint_;
     } catch (const CheckpointWriteError& e) {
         // Every rank knows it at once: they end together, and the root marks the run file.

@@ -137,6 +137,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
         periodic_checkpoints_ = periodic;
     }
     bool can_checkpoint() const { return writer_ != nullptr; }
+    /// Wall seconds the newest checkpoint took to write (every rank: each measures its own).
+    double last_checkpoint_seconds() const { return last_checkpoint_seconds_; }
     /// The coarse layer's state (root: all of it; elsewhere the counters), and its restoration
     /// on a restart (every rank; the lifting streams and warm starts matter on the root only).
     StepperState saved_state() const;
@@ -297,6 +299,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     bool periodic_checkpoints_ = false;
     std::filesystem::path last_checkpoint_;  ///< every rank: the newest checkpoint written
     double last_checkpoint_time_ = 0;
+    double last_checkpoint_seconds_ = 0;
     long samples_taken_ = 0;  ///< every rank
     /// Root: end_state_since(); forgotten when a state is gone back to (re-judged from the next
     /// sample on: a bed at rest stays so).

@@ -80,7 +80,7 @@ RunSummary run_direct(EnsembleStepper& stepper, const RunSettings& s, Progress& 
             if (every > 0 && done % every == 0 && done < total) {
                 const auto path = stepper.checkpoint(done, state);
                 progress.note_checkpoint(
-                    fmt::format("checkpoint {} (t = {:.6g})", path.string(), stepper.time()));
+                    fmt::format("checkpoint {})", describe_checkpoint(path, stepper)));
             }
         }
     } catch (const RunInterrupted&) {
