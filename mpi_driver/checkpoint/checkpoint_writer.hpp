@@ -16,7 +16,7 @@
 /// The root writes alone because a write that failed on one rank inside a collective MPI-IO call
 /// could not be agreed on: that rank had to abort the job, leaving the run file `running`. The
 /// price is the root's file system bandwidth for the whole ensemble (measured in
-/// docs/reliability.md); the root holds one realization's state at a time.
+/// docs/performance.md); the root holds one realization's state at a time.
 ///
 /// A job killed at any moment therefore leaves the previous checkpoints untouched and at most
 /// a `.tmp` file, which restart never picks (and which says it is incomplete if given).
