@@ -19,7 +19,8 @@ namespace efdem::dem {
 
 /// The initial particles of one realization according to `bed`: the lattice, settled unless
 /// bed.settle = false or spec.skip_settling; or the settled bed bed.read names (its counts
-/// checked against bed.count; a restart's placeholder is the unsettled lattice instead), with
+/// checked against bed.count; a restart builds the unsettled lattice, which its checkpoint
+/// overwrites, instead), with
 /// bed.read.velocity_rms added; or the LAMMPS data file; then the species permutation when
 /// bed.permute_species is set. `settling`: told how the settling goes (if it runs). `built`:
 /// if given, receives the bed before what follows the settling (velocities added to a read

@@ -53,8 +53,8 @@ struct RealizationSpec {
     long realization = 0;    ///< global realization index
     bool skip_settling =
         false;  ///< read every key but do not run the settling (efdem --check, a restart)
-    /// A restart: the bed is a placeholder the checkpoint replaces, so bed.read's files are not
-    /// read either (the unsettled lattice stands in; a restart needs no bed file).
+    /// A restart: the checkpoint overwrites whatever bed is built, so bed.read's files are not
+    /// read either (the unsettled lattice is built; a restart needs no bed file).
     bool restart = false;
 };
 

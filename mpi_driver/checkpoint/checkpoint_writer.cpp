@@ -281,8 +281,8 @@ std::filesystem::path CheckpointWriter::write(long sequence,
                                               const CheckpointHeader* header) const {
     const std::filesystem::path final_path =
         settings_.directory / checkpoint_file_name(prefix_, sequence);
-    ensure_space(final_path, local);
     const RowCounts counts = count_rows(local);
+    ensure_space(final_path, counts);
     // Every byte is written by the root, so that whatever fails is known to one rank that can
     // tell all the others (a failed collective MPI-IO write could not be agreed on).
     std::string failure;
@@ -372,19 +372,16 @@ std::string CheckpointWriter::write_on_root(const std::filesystem::path& final_p
 }
 
 void CheckpointWriter::ensure_space(const std::filesystem::path& path,
-                                    const std::vector<RealizationState>& local) const {
-    // A collective write that runs out of space can leave ranks waiting for each other in MPI-IO;
-    // so the space is looked at first, and every rank gives up together if it is short.
-    double bytes = 0;  // what this rank's rows take (x, v, omega, force, torque, reference, walls,
-                       // tag, species; pairs)
-    for (const auto& s : local)
-        bytes += static_cast<double>(s.particles()) * (8 * sizeof(Vec3) + sizeof(dem::Tag) + 1) +
-                 static_cast<double>(s.pairs.size()) * sizeof(dem::PairHistoryRecord);
-    double total = 0;
-    MPI_Allreduce(&bytes, &total, 1, MPI_DOUBLE, MPI_SUM, layout_.mpi().comm());
+                                    const RowCounts& counts) const {
+    // The space is looked at first, so that every rank gives up together, with nothing written,
+    // when it is short.
     double verdict[2] = {1.0, 0.0};  // ok, bytes free
     if (layout_.is_root()) {
-        std::error_code ec;
+        // The rows (x, v, omega, force, torque, reference, walls, tag, species; pairs) ...
+        double total =
+            static_cast<double>(counts.particles) * (8 * sizeof(Vec3) + sizeof(dem::Tag) + 1) +
+            static_cast<double>(counts.pairs) * sizeof(dem::PairHistoryRecord);
+        std::error_code ec;  // ... and the output files stored with them
         for (const auto& p : outputs_) {
             const auto size = std::filesystem::file_size(p, ec);
             if (!ec) total += static_cast<double>(size);

@@ -48,14 +48,13 @@ class CheckpointWriter final : public CheckpointSink {
                                 const CheckpointHeader* header) const override;
 
   private:
-    /// Collective: CheckpointSpaceError on every rank when the directory has too little space.
-    void ensure_space(const std::filesystem::path& path,
-                      const std::vector<RealizationState>& local) const;
     struct RowCounts {
         hsize_t particles = 0, pairs = 0;
     };
     /// Collective: the ensemble's particles and pair springs (known on the root only).
     RowCounts count_rows(const std::vector<RealizationState>& local) const;
+    /// Collective: CheckpointSpaceError on every rank when the directory has too little space.
+    void ensure_space(const std::filesystem::path& path, const RowCounts& counts) const;
     /// Root: receives every other rank's states and writes the whole checkpoint; returns the
     /// first failure's message (empty: written, renamed, older ones pruned).
     std::string write_on_root(const std::filesystem::path& final_path, long sequence,

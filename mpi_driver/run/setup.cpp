@@ -74,7 +74,7 @@ void read_and_build(const MpiSession& mpi, const RunOptions& options, SetUp& out
                                      options.restart, settings.mode_name()));
     const bool skip_settling = out.check || !options.restart.empty();
     // bed.write: each rank keeps its beds as built, and writes them once the output guard has
-    // passed (set_up, write_beds); a restart's beds are placeholders and are not written.
+    // passed (set_up, write_beds); a restart's beds (overwritten by its checkpoint) are not.
     const bool keep_beds =
         !out.check && options.restart.empty() && !settings.output.bed_write.empty();
     // The run's header before the beds are built: settling a large bed takes minutes, and the

@@ -123,7 +123,7 @@ TEST_CASE("a kept bed that does not fit the scene is refused, naming bed.read or
         CHECK(refusal({"bed.read.velocity_rms=0.1"}).key() == "bed.read.velocity_rms");
         CHECK(refusal({read, "bed.source=lammps_data", "bed.file=x.data"}).key() == "bed.read");
     }
-    SECTION("a restart's placeholder bed does not need the file") {
+    SECTION("a restart, whose bed the checkpoint overwrites, does not need the file") {
         auto t = table({"bed.read=/nonexistent/beds.data"});
         CHECK_NOTHROW(build_system(t.root(), {3, 0, true, true}));
     }
