@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "coarse/demixing/quantiles.hpp"
+#include "coarse/demixing/whole_bed_profile.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {
@@ -37,6 +38,18 @@ Eigen::VectorXd top_half_icdf(const dem::Particles& p, const ProbabilityGrid& gr
     std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(p.size() - half), z.end());
     std::vector<double> top(z.begin() + static_cast<std::ptrdiff_t>(p.size() - half), z.end());
     return quantiles(top, grid);
+}
+
+Eigen::VectorXd whole_bed_profile(const dem::Particles& p) {
+    EFDEM_EXPECTS(p.size() >= 1);
+    std::vector<double> z(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) z[i] = p.x()[i].z;
+    std::sort(z.begin(), z.end());
+    Eigen::VectorXd out(kWholeBedNodes);
+    out[0] = z.front();
+    out.segment(1, kWholeBedNodes - 2) = quantiles_sorted(z, whole_bed_interior_grid());
+    out[kWholeBedNodes - 1] = z.back();
+    return out;
 }
 
 double centre_of_mass_height(const dem::Particles& p) {

@@ -30,6 +30,10 @@ Eigen::VectorXd species_icdf(const dem::Particles& particles, dem::SpeciesId spe
 /// bound Q_top >= Q_L holds node by node when the light species has N/2 particles.
 Eigen::VectorXd top_half_icdf(const dem::Particles& particles, const ProbabilityGrid& grid);
 
+/// The whole bed's profile (coarse/demixing/whole_bed_profile.hpp): the lowest particle centre,
+/// the ICDF of all heights at p = 0.01..0.99, the highest. \pre at least one particle.
+Eigen::VectorXd whole_bed_profile(const dem::Particles& particles);
+
 /// Height of the centre of mass of all particles [d_p]: the travelling-wave phase signal (§7).
 double centre_of_mass_height(const dem::Particles& particles);
 

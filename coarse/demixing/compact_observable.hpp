@@ -28,7 +28,7 @@ class CompactObservable final : public EnsembleObservable {
     std::string_view name() const override { return "compact"; }
     std::string_view label() const override { return "compact (A,B,C,D)"; }
     Eigen::Index dimension() const override { return 4; }
-    bool needs_top_half() const override { return true; }
+    ReferenceIcdf reference() const override { return ReferenceIcdf::top_half; }
     Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf,
                                       const Eigen::MatrixXd& top) override;
     Eigen::VectorXd lift_target(const Eigen::VectorXd& x,

@@ -4,9 +4,11 @@
 /// projective integrator sees, and how it turns a projected X back into each realization's
 /// lifting target (the ICDF of the observed species that colour lifting must meet).
 ///
-/// Inputs are per-realization ICDFs on the p-grid (R x m matrices, row r = realization r):
-/// `icdf` of the observed species (Q_L) and, when needs_top_half(), `top` of the N/2 highest
-/// particles (Q_top, physics.md §8). Heights in d_p. Generic: no DEM, no MPI.
+/// Inputs are per-realization ICDFs (matrices, row r = realization r): `icdf` of the observed
+/// species (Q_L) on the p-grid (R x m) and the reference ICDF the observable asks for with
+/// reference(): none; the top half (`top`, R x m, the ICDF of the N/2 highest particles, Q_top
+/// of physics.md §8); or the whole bed (R x kWholeBedNodes, whole_bed_profile.hpp). Heights in
+/// d_p. Generic: no DEM, no MPI.
 
 #include <functional>
 #include <string>
@@ -21,6 +23,13 @@
 
 namespace efdem::coarse {
 
+/// The ICDF of ALL particles (whatever their species) an observable reads next to Q_L.
+enum class ReferenceIcdf {
+    none,
+    top_half,   ///< of the N/2 highest particles, on the p-grid (the compact observable)
+    whole_bed,  ///< of every particle, at the kWholeBedNodes ranks (the rank observable)
+};
+
 class EnsembleObservable {
   public:
     virtual ~EnsembleObservable() = default;
@@ -29,7 +38,8 @@ class EnsembleObservable {
     /// What it is, for messages, e.g. "full ICDF".
     virtual std::string_view label() const = 0;
     virtual Eigen::Index dimension() const = 0;
-    virtual bool needs_top_half() const = 0;
+    /// Which reference ICDF restrict_*() and lift_target() read (their `top` argument).
+    virtual ReferenceIcdf reference() const = 0;
     /// X of one sample. May carry state (e.g. a warm start); call once per sample, in time order.
     /// Returns a vector of NaN when X cannot be formed (the integrator then rejects the burst);
     /// status() says why.
@@ -47,7 +57,7 @@ class EnsembleObservable {
         return {};
     }
     /// The observed-species ICDF target for one realization, from the projected X and that
-    /// realization's own top-half ICDF (ignored when !needs_top_half()).
+    /// realization's own reference ICDF (ignored when reference() is none).
     virtual Eigen::VectorXd lift_target(const Eigen::VectorXd& x,
                                         const Eigen::VectorXd& top) const = 0;
     /// 0 when the last restrict_ensemble() succeeded; a message otherwise.
@@ -81,7 +91,7 @@ class IcdfObservable final : public EnsembleObservable {
     std::string_view name() const override { return "icdf"; }
     std::string_view label() const override { return "full ICDF"; }
     Eigen::Index dimension() const override { return m_; }
-    bool needs_top_half() const override { return false; }
+    ReferenceIcdf reference() const override { return ReferenceIcdf::none; }
     Eigen::VectorXd restrict_ensemble(const Eigen::MatrixXd& icdf,
                                       const Eigen::MatrixXd& top) override;
     Eigen::VectorXd lift_target(const Eigen::VectorXd& x,

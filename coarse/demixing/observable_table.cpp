@@ -3,12 +3,16 @@
 #include <memory>
 
 #include "coarse/demixing/compact_observable.hpp"
+#include "coarse/demixing/rank_observable.hpp"
 
 namespace efdem::coarse {
 
 namespace {
 std::unique_ptr<EnsembleObservable> make_icdf(const ProbabilityGrid& grid) {
     return std::make_unique<IcdfObservable>(grid.size());
+}
+std::unique_ptr<EnsembleObservable> make_ranks(const ProbabilityGrid& grid) {
+    return std::make_unique<RankObservable>(grid.size());
 }
 std::unique_ptr<EnsembleObservable> make_compact(const ProbabilityGrid& grid) {
     return std::make_unique<CompactObservable>(grid);
@@ -21,6 +25,9 @@ constexpr ObservableTable::Entry kObservables[] = {
     {"compact", &make_compact,
      "(A, B, C, D) of y = Q_top - Q_L ~ max[A p + B + C e^(D p), 0] (paper Eq. 3), fitted per "
      "sample"},
+    {"ranks", &make_ranks,
+     "each light quantile's rank among all particles of its realization, as a height in the "
+     "run's first ensemble-mean bed (m nodes): a shift or expansion of the whole bed cancels"},
 };
 constexpr ObservableTable kTable{kObservables};
 }  // namespace

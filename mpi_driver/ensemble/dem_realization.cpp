@@ -26,11 +26,13 @@ DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem:
     if (!restarting) after_sample(0);
 }
 
-Observation DemRealization::observe(const coarse::ProbabilityGrid& grid, bool top_half) const {
+Observation DemRealization::observe(const coarse::ProbabilityGrid& grid,
+                                    ReferenceNeeds needs) const {
     const dem::Particles& p = system_.particles();
     Observation o;
     o.icdf = coarse::species_icdf(p, observed_, grid);
-    if (top_half) o.top = coarse::top_half_icdf(p, grid);
+    if (needs.top_half) o.top = coarse::top_half_icdf(p, grid);
+    if (needs.whole_bed) o.whole_bed = coarse::whole_bed_profile(p);
     o.com = coarse::centre_of_mass_height(p);
     o.z_min = std::numeric_limits<double>::infinity();
     o.z_max = -o.z_min;

@@ -51,7 +51,7 @@ class DemRealization final : public Realization {
     /// How often a stop is asked for: 100 steps of a paper-size bed (12,500 spheres) take about
     /// 0.1-0.2 s of one core, well inside Open MPI's 1 s between its SIGTERM and SIGKILL.
     static constexpr long kStopCheckSteps = 100;
-    Observation observe(const coarse::ProbabilityGrid& grid, bool top_half) const override;
+    Observation observe(const coarse::ProbabilityGrid& grid, ReferenceNeeds needs) const override;
     LiftPayload lift_input() const override;
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
     void apply_lift(const LiftPayload& lifted) override;

@@ -7,6 +7,7 @@
 #include <mpi.h>
 
 #include "core/contracts.hpp"
+#include "mpi_driver/ensemble/reference_rows.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -70,7 +71,9 @@ constexpr const char* kHeld = "at rest: left where it is";
 void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
                            coarse::EnsembleObservable& observable, const Request& request) {
     const double start = MPI_Wtime();
-    const bool top = request.top_half, members = request.members;
+    const bool members = request.members;
+    const coarse::ReferenceIcdf kind = request.reference;
+    const bool reference = kind != coarse::ReferenceIcdf::none;
     const std::vector<char>* only = request.only;
     const Eigen::VectorXd* target = request.target;
     const bool hold = request.hold_at_rest && !only;
@@ -87,7 +90,8 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
     const bool own_needed = members || hold;
     std::vector<std::vector<double>> reals;
     std::vector<std::vector<std::uint8_t>> bytes, rest_flag;
-    std::vector<Eigen::VectorXd> top_icdf, own_icdf;
+    std::vector<Eigen::VectorXd> own_icdf;
+    ReferenceRows references(ReferenceNeeds::of(kind), m);
     std::vector<std::size_t> out_reals, out_bytes;
     for (const auto& r : local) {
         const bool lifted = lifted_here(r->index());
@@ -97,7 +101,7 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             // Dropped, or not among `only`: nothing sent, nothing changed.
             reals.emplace_back();
             bytes.emplace_back();
-            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            references.add_missing();
             if (own_needed) own_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
             out_reals.push_back(0);
             out_bytes.push_back(0);
@@ -111,9 +115,9 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             reals.push_back(std::move(in.reals));
             bytes.push_back(std::move(in.bytes));
         }
-        if (top || own_needed) {
-            Observation o = r->observe(grid_, top);
-            if (top) top_icdf.push_back(std::move(o.top));
+        if (reference || own_needed) {
+            Observation o = r->observe(grid_, ReferenceNeeds::of(kind));
+            references.add(o);
             if (own_needed) own_icdf.push_back(std::move(o.icdf));
         }
         const auto [nr, nb] =
@@ -124,7 +128,8 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
     const auto all_reals = layout_.gather_arrays(reals);
     const auto all_bytes = layout_.gather_arrays(bytes);
     const auto all_rest = layout_.gather_arrays(rest_flag);
-    const Eigen::MatrixXd all_top = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+    references.gather(layout_);
+    const Eigen::MatrixXd& all_reference = references.rows(kind);
     const Eigen::MatrixXd all_own = own_needed ? layout_.gather_rows(own_icdf) : Eigen::MatrixXd();
 
     std::vector<std::vector<double>> lifted_reals;
@@ -143,7 +148,7 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
         std::vector<char> moving;  // per lifted realization, in order
         long held_count = 0;
         if (own_needed) {
-            own = observable.restrict_members(all_own, all_top);
+            own = observable.restrict_members(all_own, all_reference);
             EFDEM_ASSERT(own.rows() == layout_.size() && own.cols() == target->size());
             Eigen::VectorXd sum = Eigen::VectorXd::Zero(target->size());
             Eigen::VectorXd sum_held = sum;
@@ -195,7 +200,8 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             }
             ++k;
             const Eigen::VectorXd goal = observable.lift_target(
-                x, top ? Eigen::VectorXd(all_top.row(r).transpose()) : Eigen::VectorXd());
+                x,
+                reference ? Eigen::VectorXd(all_reference.row(r).transpose()) : Eigen::VectorXd());
             LiftOutcome res = lifter_.lift(goal, {all_reals[r], all_bytes[r]}, grid_,
                                            streams_[static_cast<std::size_t>(r)]);
             last_.changed.push_back(res.changed);

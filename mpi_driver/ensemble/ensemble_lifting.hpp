@@ -51,9 +51,10 @@ class EnsembleLifting {
 
     /// What one lift does (the same on every rank, except `target`).
     struct Request {
-        double new_time = 0;    ///< every lifted realization's clock afterwards
-        bool top_half = false;  ///< the observable's lifting target needs the top-half ICDF
-        bool members = false;   ///< cpi.lift = members (not with `only`)
+        double new_time = 0;  ///< every lifted realization's clock afterwards
+        /// The reference ICDF the observable's lifting target (and restrict_members) reads.
+        coarse::ReferenceIcdf reference = coarse::ReferenceIcdf::none;
+        bool members = false;  ///< cpi.lift = members (not with `only`)
         /// cpi.at_rest = hold: realizations at rest are not lifted (not with `only`); needs an
         /// observable that restricts members (their own X_r).
         bool hold_at_rest = false;

@@ -5,6 +5,7 @@
 #include <mpi.h>
 
 #include "core/contracts.hpp"
+#include "mpi_driver/ensemble/reference_rows.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -52,14 +53,14 @@ EnsembleSampler::EnsembleSampler(const EnsembleLayout& layout, const SamplingSet
                                  coarse::EnsembleObservable& observable)
     : layout_(layout), settings_(settings), observable_(&observable), grid_(settings.quantiles) {}
 
-bool EnsembleSampler::needs_top_half() const {
-    return observable_->needs_top_half() ||
-           (settings_.recorded && settings_.recorded->needs_top_half());
+ReferenceNeeds EnsembleSampler::needs() const {
+    const ReferenceNeeds own = ReferenceNeeds::of(observable_->reference());
+    return settings_.recorded ? own | ReferenceNeeds::of(settings_.recorded->reference()) : own;
 }
 
 const SampleRecord* EnsembleSampler::take(const Realizations& local,
-                                          const std::vector<char>& active, double time, bool top,
-                                          coarse::BurstSamples* out) {
+                                          const std::vector<char>& active, double time,
+                                          ReferenceNeeds needs, coarse::BurstSamples* out) {
     EFDEM_EXPECTS(static_cast<int>(active.size()) == layout_.size());
     const double start = MPI_Wtime();
     const auto m = static_cast<Eigen::Index>(grid_.values().size());
@@ -67,19 +68,20 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
     const auto bed_width =
         settings_.bed ? static_cast<Eigen::Index>(dem::BedObservation::packed_size(*settings_.bed))
                       : 0;
-    std::vector<Eigen::VectorXd> icdf, top_icdf, scalars, bed;
+    std::vector<Eigen::VectorXd> icdf, scalars, bed;
+    ReferenceRows references(needs, m);
     for (const auto& r : local) {
         if (!active[static_cast<std::size_t>(r->index())]) {
             // Dropped: a row of NaN in the record, not in the means.
             icdf.push_back(Eigen::VectorXd::Constant(m, nan));
-            if (top) top_icdf.push_back(Eigen::VectorXd::Constant(m, nan));
+            references.add_missing();
             scalars.push_back(Eigen::VectorXd::Constant(kScalars, nan));
             if (bed_width > 0) bed.push_back(Eigen::VectorXd::Constant(bed_width, nan));
             continue;
         }
-        Observation o = r->observe(grid_, top);
+        Observation o = r->observe(grid_, needs);
         icdf.push_back(std::move(o.icdf));
-        if (top) top_icdf.push_back(std::move(o.top));
+        references.add(o);
         Eigen::VectorXd row(kScalars);
         const ThermoNumbers& th = o.thermo;
         row << o.com, o.z_min, o.z_max, o.mean_height, r->at_rest() ? 1.0 : 0.0, th.ke_per_particle,
@@ -91,7 +93,7 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
         }
     }
     const Eigen::MatrixXd all_icdf = layout_.gather_rows(icdf);
-    const Eigen::MatrixXd all_top_rows = top ? layout_.gather_rows(top_icdf) : Eigen::MatrixXd();
+    references.gather(layout_);
     const Eigen::MatrixXd all_scalar_rows = layout_.gather_rows(scalars);
     const Eigen::MatrixXd all_bed_rows =
         bed_width > 0 ? layout_.gather_rows(bed) : Eigen::MatrixXd();
@@ -104,7 +106,11 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
     for (std::size_t r = 0; r < active.size(); ++r)
         if (active[r]) in.push_back(static_cast<Eigen::Index>(r));
     const Eigen::MatrixXd used_icdf = rows_of(all_icdf, in);
-    const Eigen::MatrixXd all_top = rows_of(all_top_rows, in);
+    // The reference rows of the realizations in use, for `observable` (rows of nothing for none).
+    auto reference_of = [&](const coarse::EnsembleObservable& observable) {
+        return rows_of(references.rows(observable.reference()), in);
+    };
+    const Eigen::MatrixXd all_top = rows_of(references.rows(coarse::ReferenceIcdf::top_half), in);
     const Eigen::MatrixXd all_scalars = rows_of(all_scalar_rows, in);
 
     SampleRecord& rec = last_;
@@ -121,14 +127,19 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
         rec.bed_mean = bed_record(coarse::ensemble_mean(rows_of(all_bed_rows, in)).transpose(),
                                   *settings_.bed);
     }
-    rec.top_mean = top ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
+    rec.top_mean = needs.top_half ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
-    const Eigen::VectorXd x = observable_->restrict_ensemble(used_icdf, all_top);
+    const Eigen::MatrixXd own_reference = reference_of(*observable_);
+    const Eigen::VectorXd x = observable_->restrict_ensemble(used_icdf, own_reference);
     last_x_ = x;
-    rec.compact = observable_->needs_top_half() ? x : Eigen::VectorXd();
-    rec.compact_status = observable_->status();
-    if (!observable_->needs_top_half() && settings_.recorded) {
-        rec.compact = settings_.recorded->restrict_ensemble(used_icdf, all_top);
+    // The compact fit is recorded: the integrator's X when it is the compact one, else the
+    // recorded observable's.
+    const bool compact = observable_->reference() == coarse::ReferenceIcdf::top_half;
+    rec.compact = compact ? x : Eigen::VectorXd();
+    rec.compact_status = compact ? observable_->status() : 0;
+    if (!compact && settings_.recorded) {
+        rec.compact =
+            settings_.recorded->restrict_ensemble(used_icdf, reference_of(*settings_.recorded));
         rec.compact_status = settings_.recorded->status();
     }
     if (out) {
@@ -139,7 +150,7 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
         out->member_expansion.push_back(all_scalars.col(3));
         // Rows in global realization order, as gathered: independent of the layout.
         if (observable_->restricts_members())
-            out->members.push_back(observable_->restrict_members(used_icdf, all_top));
+            out->members.push_back(observable_->restrict_members(used_icdf, own_reference));
     }
     seconds_ += MPI_Wtime() - start;
     ++count_;

@@ -44,11 +44,11 @@ class EnsembleSampler {
                     coarse::EnsembleObservable& observable);
 
     /// Collective: one sample of every realization at `time`. `active` (every rank, per global
-    /// realization): 1 in the ensemble. `top_half`: also gather the top-half ICDF (the same on
+    /// realization): 1 in the ensemble. `needs`: the reference ICDFs to gather too (the same on
     /// every rank). Root: returns the record (also last()) and appends the sample to `out`
     /// (may be null); elsewhere returns null.
     const SampleRecord* take(const Realizations& local, const std::vector<char>& active,
-                             double time, bool top_half, coarse::BurstSamples* out);
+                             double time, ReferenceNeeds needs, coarse::BurstSamples* out);
 
     /// Root: the last sample and its coarse vector (empty before the first sample).
     const SampleRecord& last() const { return last_; }
@@ -64,9 +64,8 @@ class EnsembleSampler {
 
     coarse::EnsembleObservable& observable() const { return *observable_; }
     void set_observable(coarse::EnsembleObservable& observable) { observable_ = &observable; }
-    /// Root: whether samples need the top-half ICDF (the integrator's or the recorded
-    /// observable's).
-    bool needs_top_half() const;
+    /// Root: the reference ICDFs samples need (the integrator's and the recorded observable's).
+    ReferenceNeeds needs() const;
     const coarse::ProbabilityGrid& grid() const { return grid_; }
 
     /// Its part of the stepper's state: the height range (every rank) and the warm starts of

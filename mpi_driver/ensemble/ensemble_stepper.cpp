@@ -29,6 +29,13 @@ SamplingSettings sampling(const StepperSettings& s) {
     out.recorded = s.recorded;
     return out;
 }
+
+/// The one reference ICDF a lift command asked for (it asks for its observable's only).
+coarse::ReferenceIcdf lift_reference(ReferenceNeeds needs) {
+    EFDEM_ASSERT(!(needs.top_half && needs.whole_bed));
+    if (needs.top_half) return coarse::ReferenceIcdf::top_half;
+    return needs.whole_bed ? coarse::ReferenceIcdf::whole_bed : coarse::ReferenceIcdf::none;
+}
 }  // namespace
 
 EnsembleStepper::EnsembleStepper(const EnsembleLayout& layout, Realizations local,
@@ -84,20 +91,21 @@ void EnsembleStepper::agree_on_stage(const std::string& local_failure, long real
 }
 
 EnsembleStepper::Message EnsembleStepper::broadcast(Message m) const {
-    double buf[4] = {static_cast<double>(static_cast<int>(m.command)), m.value,
-                     m.top_half ? 1.0 : 0.0, m.hold_at_rest ? 1.0 : 0.0};
+    double buf[4] = {static_cast<double>(static_cast<int>(m.command)), m.value, m.needs.code(),
+                     m.hold_at_rest ? 1.0 : 0.0};
     MPI_Bcast(buf, 4, MPI_DOUBLE, 0, layout_.mpi().comm());
-    return {static_cast<Command>(static_cast<int>(buf[0])), buf[1], buf[2] != 0.0, buf[3] != 0.0};
+    return {static_cast<Command>(static_cast<int>(buf[0])), buf[1],
+            ReferenceNeeds::from_code(buf[2]), buf[3] != 0.0};
 }
 
 // --- the root's side of the commands --------------------------------------------------------
 
 void EnsembleStepper::run(double duration, coarse::BurstSamples& out) {
     if (interrupted_) throw RunInterrupted(interrupted_, time());
-    const bool top = needs_top_half();
-    broadcast({Command::run, duration, top});
+    const ReferenceNeeds wanted_icdfs = needs();
+    broadcast({Command::run, duration, wanted_icdfs});
     const long wanted = std::lround(duration / settings_.sample_interval);
-    const long got = do_run(wanted, top, &out);
+    const long got = do_run(wanted, wanted_icdfs, &out);
     if (failures_.pending()) throw EnsembleChanged();
     if (got < wanted) throw RunInterrupted(interrupted_, time());
 }
@@ -118,13 +126,13 @@ void EnsembleStepper::lift_apart(const Eigen::VectorXd& target, const Eigen::Mat
 
 void EnsembleStepper::root_lift(const Eigen::VectorXd& target, const Eigen::MatrixXd* member_steps,
                                 double new_time) {
-    const bool top = observable().needs_top_half();
+    const ReferenceNeeds lift_icdfs = ReferenceNeeds::of(observable().reference());
     const bool members =
         lifts_apart();  // cpi.lift = members or own, and an observable with members
     // Holding needs each realization's own coarse vector: only with an observable that has them.
     const bool hold = settings_.hold_at_rest && observable().restricts_members();
-    broadcast({members ? Command::lift_members : Command::lift, new_time, top, hold});
-    do_lift(new_time, top, &target, members, hold, member_steps);
+    broadcast({members ? Command::lift_members : Command::lift, new_time, lift_icdfs, hold});
+    do_lift(new_time, lift_icdfs, &target, members, hold, member_steps);
 }
 
 void EnsembleStepper::finish(int exit_code) {
@@ -182,25 +190,25 @@ std::filesystem::path EnsembleStepper::checkpoint_resume_point() {
 
 void EnsembleStepper::rebuild_after_failure() {
     EFDEM_EXPECTS(failures_.pending() && has_resume_point());
-    const bool top = observable().needs_top_half();
-    broadcast({Command::rebuild, 0.0, top});
-    do_rebuild(top);
+    const ReferenceNeeds lift_icdfs = ReferenceNeeds::of(observable().reference());
+    broadcast({Command::rebuild, 0.0, lift_icdfs});
+    do_rebuild(lift_icdfs);
 }
 
 // --- the other ranks: the command loop ------------------------------------------------------
 
 void EnsembleStepper::serve() {
     while (true) {
-        const Message m = broadcast({Command::finish, 0.0, false});
+        const Message m = broadcast({Command::finish, 0.0, {}});
         switch (m.command) {
             case Command::run:
-                do_run(std::lround(m.value / settings_.sample_interval), m.top_half, nullptr);
+                do_run(std::lround(m.value / settings_.sample_interval), m.needs, nullptr);
                 break;
             case Command::lift:
-                do_lift(m.value, m.top_half, nullptr, false, m.hold_at_rest);
+                do_lift(m.value, m.needs, nullptr, false, m.hold_at_rest);
                 break;
             case Command::lift_members:
-                do_lift(m.value, m.top_half, nullptr, true, m.hold_at_rest);
+                do_lift(m.value, m.needs, nullptr, true, m.hold_at_rest);
                 break;
             case Command::checkpoint:
                 do_checkpoint(std::lround(m.value), nullptr, false);
@@ -221,7 +229,7 @@ void EnsembleStepper::serve() {
                 do_checkpoint(std::lround(m.value), nullptr, true);
                 break;
             case Command::rebuild:
-                do_rebuild(m.top_half);
+                do_rebuild(m.needs);
                 break;
             case Command::set_parameter:
                 do_set_parameter(m.value);
@@ -235,7 +243,7 @@ void EnsembleStepper::serve() {
 
 // --- what every rank does for a command -----------------------------------------------------
 
-long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* out) {
+long EnsembleStepper::do_run(long samples, ReferenceNeeds needs, coarse::BurstSamples* out) {
     const InjectedFailure& inject = settings_.failure;
     const bool can_redo = has_resume_point();
     // A stop signal need not wait for the end of a sample (a paper-size bed's takes seconds,
@@ -299,7 +307,7 @@ long EnsembleStepper::do_run(long samples, bool top_half, coarse::BurstSamples* 
                            (total_particles_ - static_cast<double>(paused));
         if (failures_.pending()) return s;  // cpi: the step is redone from its resume point
         if (const SampleRecord* rec =
-                sampler_.take(local_, failures_.active(), time(), top_half, out)) {
+                sampler_.take(local_, failures_.active(), time(), needs, out)) {
             const double start = MPI_Wtime();
             note_rest(*rec);
             snapshots_.record(*rec);
@@ -347,12 +355,12 @@ void EnsembleStepper::note_rest(const SampleRecord& rec) {
         at_rest_since_ = rec.time;
 }
 
-void EnsembleStepper::do_lift(double new_time, bool top_half, const Eigen::VectorXd* target,
+void EnsembleStepper::do_lift(double new_time, ReferenceNeeds needs, const Eigen::VectorXd* target,
                               bool members, bool hold, const Eigen::MatrixXd* member_steps) {
     EnsembleLifting::Request request;
     request.hold_at_rest = hold;
     request.new_time = new_time;
-    request.top_half = top_half;
+    request.reference = lift_reference(needs);
     request.members = members;
     request.target = target;
     request.member_steps = member_steps;
@@ -445,7 +453,7 @@ void EnsembleStepper::do_set_parameter(double value) {
     for (auto& r : local_) r->set_parameter(settings_.parameter, value);
 }
 
-void EnsembleStepper::do_rebuild(bool top_half) {
+void EnsembleStepper::do_rebuild(ReferenceNeeds needs) {
     EFDEM_EXPECTS(failures_.pending() && has_resume_point());
     // 1. Every realization back to where the interrupted coarse step began; the samples since
     //    then are dropped.
@@ -469,7 +477,7 @@ void EnsembleStepper::do_rebuild(bool top_half) {
     if (plan.replace && lift_flag) {
         EnsembleLifting::Request request;
         request.new_time = resume.time;
-        request.top_half = top_half;
+        request.reference = lift_reference(needs);
         request.target = layout_.is_root() ? &resume.coarse : nullptr;
         request.only = &plan.rebuilt;
         lifting_.lift(local_, failures_.active(), observable(), request);

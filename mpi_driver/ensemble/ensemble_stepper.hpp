@@ -204,9 +204,9 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     /// Root: the coarse observable in use (its status_message() says why a sample failed).
     const coarse::EnsembleObservable& observable() const { return sampler_.observable(); }
     coarse::EnsembleObservable& observable() { return sampler_.observable(); }
-    /// Root: whether samples need the top-half ICDF (for the integrator's or the recorded
+    /// Root: the reference ICDFs samples need (for the integrator's and the recorded
     /// observable).
-    bool needs_top_half() const { return sampler_.needs_top_half(); }
+    ReferenceNeeds needs() const { return sampler_.needs(); }
 
     /// Wall time spent in the ensemble-level work of the coarse loop (not in the DEM), summed
     /// so far [s]: restriction (observe, gather, average, record) and lifting (gather heights
@@ -237,13 +237,13 @@ class EnsembleStepper final : public coarse::CoarseStepper {
         set_parameter = 11,
         lift_members = 12  ///< a lift that moves each realization by the same increment
     };
-    /// The root's command, its argument, and whether the top-half ICDF is gathered (the
+    /// The root's command, its argument, and which reference ICDFs are gathered (the
     /// observable lives on the root only and may change during a run: the workers must join
     /// exactly the collectives the root joins).
     struct Message {
         Command command;
         double value;
-        bool top_half;
+        ReferenceNeeds needs;
         bool hold_at_rest = false;  ///< a lift: leave the realizations at rest where they are
     };
     Message broadcast(Message m) const;
@@ -252,7 +252,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     // serve()).
     /// Returns the samples taken (fewer than `samples` when a stop was agreed; a sample in which
     /// a rank stopped on the signal is not taken).
-    long do_run(long samples, bool top_half, coarse::BurstSamples* out);
+    long do_run(long samples, ReferenceNeeds needs, coarse::BurstSamples* out);
     /// Collective: this rank's realizations back to `states` (the kept state, the resume point,
     /// a sample's start); a failure on any rank ends the run on all ("going back to WHERE").
     void restore_agreed(const std::vector<RealizationState>& states, const char* where);
@@ -261,7 +261,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     /// lift() and lift_apart() on the root: the command to the other ranks, then do_lift().
     void root_lift(const Eigen::VectorXd& target, const Eigen::MatrixXd* member_steps,
                    double new_time);
-    void do_lift(double new_time, bool top_half, const Eigen::VectorXd* target, bool members,
+    void do_lift(double new_time, ReferenceNeeds needs, const Eigen::VectorXd* target, bool members,
                  bool hold, const Eigen::MatrixXd* member_steps = nullptr);
     std::filesystem::path do_checkpoint(long sequence, const CheckpointHeader* header,
                                         bool at_resume_point);
@@ -270,7 +270,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     void do_confirm();
     /// `driver`: the loop's state (root; the workers keep none).
     void do_mark_resume_point(const DriverState& driver);
-    void do_rebuild(bool top_half);
+    void do_rebuild(ReferenceNeeds needs);
     void do_set_parameter(double value);
 
     /// Every rank: the snapshot of everything now (a failure to save on any rank ends the run

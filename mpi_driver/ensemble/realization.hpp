@@ -17,7 +17,9 @@
 
 #include <Eigen/Core>
 
+#include "coarse/demixing/ensemble_observable.hpp"  // ReferenceIcdf
 #include "coarse/demixing/probability_grid.hpp"
+#include "core/contracts.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "mpi_driver/checkpoint_data/realization_state.hpp"
@@ -33,11 +35,38 @@ struct ThermoNumbers {
     double neighbor_builds = nan;        ///< neighbour-list builds so far
 };
 
+/// Which reference ICDFs of all particles a sample or a lift asks the realizations for (what
+/// the observables' reference() say; the same on every rank).
+struct ReferenceNeeds {
+    bool top_half = false;
+    bool whole_bed = false;
+    static ReferenceNeeds of(coarse::ReferenceIcdf kind) {
+        return {kind == coarse::ReferenceIcdf::top_half, kind == coarse::ReferenceIcdf::whole_bed};
+    }
+    ReferenceNeeds operator|(ReferenceNeeds o) const {
+        return {top_half || o.top_half, whole_bed || o.whole_bed};
+    }
+    bool any() const { return top_half || whole_bed; }
+    /// As one number, for the root's command broadcast.
+    double code() const { return (top_half ? 1.0 : 0.0) + (whole_bed ? 2.0 : 0.0); }
+    static ReferenceNeeds from_code(double code) {
+        const int c = static_cast<int>(code);
+        return {(c & 1) != 0, (c & 2) != 0};
+    }
+};
+
 /// What a realization reports at one sample (heights in d_p).
 struct Observation {
     Eigen::VectorXd icdf;  ///< ICDF of the observed species on the p-grid
     Eigen::VectorXd top;   ///< ICDF of the top half (only when asked for)
-    double com = 0;        ///< centre-of-mass height: the travelling-wave phase signal
+    /// The whole bed's profile (coarse/demixing/whole_bed_profile.hpp; only when asked for).
+    Eigen::VectorXd whole_bed;
+    /// `top` or `whole_bed`. \pre kind is not none.
+    Eigen::VectorXd& reference(coarse::ReferenceIcdf kind) {
+        EFDEM_EXPECTS(kind != coarse::ReferenceIcdf::none);
+        return kind == coarse::ReferenceIcdf::top_half ? top : whole_bed;
+    }
+    double com = 0;  ///< centre-of-mass height: the travelling-wave phase signal
     /// Number-weighted mean particle height: the bed's expansion, which (unlike the mass-weighted
     /// centre of mass) demixing of equal spheres leaves unchanged.
     double mean_height = 0;
@@ -80,7 +109,8 @@ class Realization {
     /// when `stop` cut the steps short: the realization then stands inside the sample, and the
     /// caller restores a saved state. A model may also ignore `stop` and always return true.
     virtual bool advance_unless_stopped(long steps, const StopCheck& stop) = 0;
-    virtual Observation observe(const coarse::ProbabilityGrid& grid, bool top_half) const = 0;
+    virtual Observation observe(const coarse::ProbabilityGrid& grid,
+                                ReferenceNeeds needs) const = 0;
     /// What the root needs to lift this realization.
     virtual LiftPayload lift_input() const = 0;
     /// Sizes (reals, bytes) of the payload apply_lift() expects.

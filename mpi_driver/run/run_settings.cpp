@@ -78,7 +78,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                  "= " + lift +
                      " moves each realization from its own coarse state, and cpi.observable = " +
                      s.observable + " cannot restrict a realization on its own",
-                 "mean, or " + lift + " with cpi.observable = icdf");
+                 "mean, or " + lift + " with cpi.observable = icdf or ranks");
     // A realization the gas no longer moves is in a state the DEM never leaves (U_s = 0.19: the
     // heavy spheres gather at the bottom and the bed defluidizes); a lift would move it on with
     // the others. hold leaves it where it is (EnsembleLifting), which needs its own coarse state.
@@ -89,7 +89,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                  "= hold leaves a realization at rest where it is and moves the others by the "
                  "ensemble's increment, and cpi.observable = " +
                      s.observable + " cannot restrict a realization on its own",
-                 "lift, or hold with cpi.observable = icdf");
+                 "lift, or hold with cpi.observable = icdf or ranks");
     s.hold_at_rest = at_rest == "hold";
     // Where a bed has partly come to rest, a relabelling there kicks it back into motion
     // (bench/lift_restart.py): moving relabels the moving particles of each height interval first.
@@ -129,11 +129,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                 return root.scope(std::string(p.effect))
                     .get<double>(std::string(p.parameter.key), p.parameter.bounds);
             });
-        if (s.steady.gap_coordinates && s.observable != "icdf")
+        if (s.steady.gap_coordinates && s.observable != "icdf" && s.observable != "ranks")
             root.scope("steady").fail(
                 "coordinates",
                 "= gaps are coordinates of an ICDF, and cpi.observable is " + s.observable,
-                "heights, or gaps with cpi.observable = icdf");
+                "heights, or gaps with cpi.observable = icdf or ranks");
     }
     if (s.lifts()) {
         // After cpi.warmup and one burst something must be left to jump over: a run of exactly
@@ -274,7 +274,7 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
                 fmt::format("cannot restrict a realization on its own, and mode = {} measures the "
                             "noise of F from the realizations' spread",
                             mode_name()),
-                "icdf with mode = steady or continuation");
+                "icdf or ranks with mode = steady or continuation");
     }
     if (!spread) return;
     const Params c = root.scope("cpi");
@@ -291,7 +291,7 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
             "observable",
             "cannot restrict a realization on its own, and cpi.projection = adaptive needs every "
             "realization's own slope",
-            "icdf with cpi.projection = adaptive");
+            "icdf or ranks with cpi.projection = adaptive");
 }
 
 }  // namespace efdem::mpi_driver

@@ -9,6 +9,8 @@
 
 #include "coarse/dem_adapters/realization_observables.hpp"
 #include "coarse/demixing/ensemble_observable.hpp"
+#include "coarse/demixing/rank_observable.hpp"
+#include "coarse/demixing/whole_bed_profile.hpp"
 #include "core/rng.hpp"
 #include "dem/system.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
@@ -23,7 +25,7 @@ constexpr int kLight = 600;
 /// A column of 2 x kLight particles at random heights in [0.5, 20.5] (no effects: lifting only
 /// needs positions). Continuous heights make the lifting resolution the spacing of the light
 /// heights, ~20/600 = 0.03 d_p (a lattice bed would quantize heights in 1.07 d_p layers).
-dem::System random_column(long realization) {
+dem::System random_column(long realization, double base = 0.5) {
     const dem::SpeciesTable species({{"light", 1.0, 1.0}, {"heavy", 2.0, 1.0}});
     RandomStream rng(5, static_cast<std::uint64_t>(realization), "test");
     std::vector<dem::SpeciesId> labels(2 * kLight, 1);
@@ -31,7 +33,7 @@ dem::System random_column(long realization) {
     rng.shuffle(labels.begin(), labels.end());
     dem::Particles p;
     for (int i = 0; i < 2 * kLight; ++i)
-        p.add(i + 1, {rng.uniform(0, 5), rng.uniform(0, 5), rng.uniform(0.5, 20.5)},
+        p.add(i + 1, {rng.uniform(0, 5), rng.uniform(0, 5), rng.uniform(base, base + 20.0)},
               {rng.normal(), rng.normal(), rng.normal()}, labels[static_cast<std::size_t>(i)],
               species);
     dem::SystemOptions o;
@@ -42,11 +44,14 @@ dem::System random_column(long realization) {
 /// This rank's share of the four random columns on MPI_COMM_WORLD (4 / ranks each), each passed
 /// to `prepare` (if any) first.
 struct Columns {
-    explicit Columns(const std::function<void(DemRealization&, long)>& prepare = {}) {
+    /// `rise`: column r stands r x rise d_p higher.
+    explicit Columns(const std::function<void(DemRealization&, long)>& prepare = {},
+                     double rise = 0.0) {
         for (int j = 0; j < layout.per_rank(); ++j) {
             const long index = layout.first_index() + j;
-            auto r =
-                std::make_unique<DemRealization>(random_column(index), 0, 1, RealizationOutput{});
+            auto r = std::make_unique<DemRealization>(
+                random_column(index, 0.5 + rise * static_cast<double>(index)), 0, 1,
+                RealizationOutput{});
             if (prepare) prepare(*r, index);
             dem.push_back(r.get());
             local.push_back(std::move(r));
@@ -125,6 +130,59 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
             coarse::species_icdf(dem.front()->system().particles(), 0, grid);
         CHECK(achieved[9] == Approx(11.0).margin(0.15));
         CHECK(std::abs(before[9] - 11.0) > 0.2);  // and it was not there before
+    }
+}
+
+TEST_CASE(
+    "a rank lift puts each realization's light quantiles at the target's ranks in its own bed",
+    "[mpi][lifting]") {
+    // Four columns standing 2 d_p apart (column r on [0.5 + 2r, 20.5 + 2r]). One sample fixes
+    // the rank observable's reference (their mean bed); the lift then asks for light ranks
+    // u_i = 0.1 + 0.8 p_i (the light species gathered towards the middle of every bed: 5 of every
+    // 8 particles there light, a target every 0.8 d_p cell can meet).
+    Columns columns({}, 2.0);
+    REQUIRE(4 % columns.world.size() == 0);
+    const MpiComm& world = columns.world;
+    std::vector<DemRealization*>& dem = columns.dem;
+    StepperSettings ss;
+    ss.sample_interval = 0.01;
+    ss.steps_per_sample = 1;  // the free flight of one 1e-4 step moves nothing that matters
+    coarse::RankObservable observable(19);
+    const ColourLifter lifter;
+    EnsembleStepper stepper(columns.layout, std::move(columns.local), ss, observable, lifter,
+                            nullptr, nullptr);
+    const coarse::ProbabilityGrid grid(19);
+    const Eigen::VectorXd u = (0.1 + 0.8 * grid.values().array()).matrix();
+    if (world.is_root()) {
+        coarse::BurstSamples burst;
+        stepper.run(0.01, burst);
+        const std::vector<double> state = observable.saved_state();
+        REQUIRE(static_cast<Eigen::Index>(state.size()) == coarse::kWholeBedNodes);
+        const Eigen::VectorXd reference =
+            Eigen::Map<const Eigen::VectorXd>(state.data(), coarse::kWholeBedNodes);
+        const Eigen::VectorXd target = coarse::heights_at(u, reference);
+        stepper.lift(target, 1.0);
+        stepper.finish();
+    } else {
+        stepper.serve();
+    }
+    // Measured on each realization itself: its light ICDF's ranks in its own whole bed are u,
+    // to the lifting's resolution: a node misses its target height by up to 0.15 d_p (the test
+    // above), 0.0075 in rank at 60 particles per d_p of a 1,200-particle column, and the
+    // column's own profile interpolates linearly over 12 particles (~0.2 d_p). 0.02 bounds both
+    // (0.012 measured at 1, 2 and 4 ranks); an ICDF lift would miss by 0.1 (columns 2 d_p apart).
+    for (auto* d : dem) {
+        const auto& p = d->system().particles();
+        const Eigen::VectorXd ranks =
+            coarse::ranks_in(coarse::species_icdf(p, 0, grid), coarse::whole_bed_profile(p));
+        INFO("realization " << d->index());
+        CHECK((ranks - u).cwiseAbs().maxCoeff() < 0.02);
+        // The light median (rank 0.5) sits at its own column's median, about 10.5 + 2r (1,200
+        // uniform heights sample it to ~0.3 d_p), not at a height common to all columns as an
+        // ICDF lift would put it. 0.15 d_p: the lifting's resolution (the test above).
+        const Eigen::VectorXd bed = coarse::whole_bed_profile(p);
+        CHECK(coarse::species_icdf(p, 0, grid)[9] == Approx(bed[50]).margin(0.15));
+        CHECK(bed[50] == Approx(10.5 + 2.0 * static_cast<double>(d->index())).margin(1.0));
     }
 }
 

@@ -105,7 +105,7 @@ TEST_CASE("sampling gathers in realization order: the mean has the same bits on 
     coarse::IcdfObservable observable(3);
     EnsembleSampler sampler(layout, sampling3(), observable);
     coarse::BurstSamples burst;
-    const SampleRecord* rec = sampler.take(local, everyone(), 0.0, false, &burst);
+    const SampleRecord* rec = sampler.take(local, everyone(), 0.0, {}, &burst);
     if (!world.is_root()) {
         CHECK(rec == nullptr);
         CHECK(burst.t.empty());
@@ -142,7 +142,7 @@ TEST_CASE("sampling leaves a dropped realization out of the means, as a row of N
     EnsembleSampler sampler(layout, sampling3(), observable);
     std::vector<char> active = everyone();
     active[1] = 0;
-    const SampleRecord* rec = sampler.take(local, active, 0.0, false, nullptr);
+    const SampleRecord* rec = sampler.take(local, active, 0.0, {}, nullptr);
     if (!world.is_root()) return;
     REQUIRE(rec != nullptr);
     CHECK(rec->realizations_used == 3);
@@ -292,7 +292,7 @@ TEST_CASE("a snapshot taken and restored gives the same samples bit for bit",
         coarse::BurstSamples out;
         for (int s = 0; s < 3; ++s) {
             for (auto& r : local) r->advance(5);
-            sampler.take(local, everyone(), local.front()->time(), false, &out);
+            sampler.take(local, everyone(), local.front()->time(), {}, &out);
         }
         return out;
     };

@@ -28,7 +28,8 @@ class ToyRealization final : public mpi_driver::Realization {
         steps_ += steps;
         return true;  // a toy sample is short: it never stops inside one
     }
-    mpi_driver::Observation observe(const coarse::ProbabilityGrid&, bool) const override {
+    mpi_driver::Observation observe(const coarse::ProbabilityGrid&,
+                                    mpi_driver::ReferenceNeeds) const override {
         mpi_driver::Observation o;
         o.icdf = x_;
         o.com = x_[0];

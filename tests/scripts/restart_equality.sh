@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A restarted run's output equals the uninterrupted run's bit for bit, in direct and cpi mode
-# (ICDF and compact observables; adaptive Adams-Bashforth 2 with a rejection before
+# (ICDF, compact and rank observables; adaptive Adams-Bashforth 2 with a rejection before
 # the checkpoint, whose controller state is in it; adaptive forward Euler from pooled slopes,
 # whose slope pool, evidence-sized healing and window, trajectory budget (cpi.accuracy) and, with
 # cpi.lift = own, each realization's own slope deviation are in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
@@ -33,9 +33,11 @@ same_output() {  # same_output PREFIX_A PREFIX_B
 }
 
 # name, checkpoint.interval (coarse steps / samples), checkpoint to restart from, rank counts,
-# scene overrides. cpi-compact: the compact fit's warm start is part of the state.
+# scene overrides. cpi-compact: the compact fit's warm start is part of the state; ranks: the
+# rank observable's reference bed (fixed at the first sample) is.
 for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi" \
             "compact 1 00000002 4 mode=cpi,cpi.observable=compact,run.duration=8" \
+            "ranks 1 00000002 2 mode=cpi,cpi.observable=ranks,cpi.lift=members,run.duration=8" \
             "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
             "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.accuracy=4,cpi.dt_min=0.5,run.duration=24" \
             "warmup 1 00000000 1,2 mode=cpi,cpi.warmup=4,run.duration=12" \
