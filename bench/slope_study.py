@@ -29,6 +29,7 @@ estimator's and the lift's, not the seeds'):
   quiet_h10w10     burst_h10w10 with cpi.noisy_curvature = ignored (every other run: counted, what
                    the runs made before the key did)
   own_h10w10       burst_h10w10 with cpi.lift = own (each realization jumps with its own slope)
+  ranks_h10w10     burst_h10w10 with cpi.observable = ranks (each light node's rank in its own bed)
  U_s = 0.41 (tolerance 0.32 d_p per jump, the one that jumps at all in bench/adaptive_study.py;
  healing 2 + window 20: two wave periods, T ~ 9):
   burst_h2w20, pooled_h2w20, members_h2w20, members_pooled_h2w20
@@ -85,6 +86,7 @@ CPI_BY_US = {
         ("autowindow_h10w10", {**SLOW, "cpi.healing_auto": "true", "cpi.window_auto": "true"}),
         ("quiet_h10w10", {**SLOW, "cpi.noisy_curvature": "ignored"}),
         ("own_h10w10", {**SLOW, "cpi.lift": "own"}),
+        ("ranks_h10w10", {**SLOW, "cpi.observable": "ranks"}),
     ),
     0.41: (
         ("burst_h2w20", WAVES),
@@ -99,8 +101,9 @@ CPI_BY_US = {
 # informative pair), the second and third direct ensembles (the floor with an error bar), pooled,
 # evidence-sized healing, the members' lift. At 0.41: the directs first, then the CPI runs.
 ORDER_BY_US = {
-    0.19: ("direct_a", "burst_h2w18", "burst_h10w10", "direct_b", "direct_c", "pooled_h10w10", "auto_h10w10",
-           "members_h10w10", "members_pooled_h10w10", "autowindow_h10w10", "quiet_h10w10", "own_h10w10"),
+    0.19: ("direct_a", "burst_h2w18", "burst_h10w10", "ranks_h10w10", "direct_b", "direct_c", "pooled_h10w10",
+           "auto_h10w10", "members_h10w10", "members_pooled_h10w10", "autowindow_h10w10", "quiet_h10w10",
+           "own_h10w10"),
     0.41: ("direct_a", "direct_b", "direct_c", "burst_h2w20", "pooled_h2w20", "members_h2w20",
            "members_pooled_h2w20", "autowindow_h2w20", "quiet_h2w20"),
 }

@@ -96,6 +96,10 @@ class CoarseStepper {
      * there.
      */
     virtual double end_state_since() const { return std::numeric_limits<double>::quiet_NaN(); }
+    /// Whether some realization was at rest at the last sample (default: never). A partly
+    /// stopped ensemble is not judged steady from its slope: the stopped members' zero slopes
+    /// would hide the others' drift in their spread.
+    virtual bool any_at_rest() const { return false; }
 
     /// \name Going back: reject-and-redo of adaptive projective integration.
     /// keep_state() keeps the whole micro state (every realization, the random streams, the

@@ -1,6 +1,7 @@
 #include "mpi_driver/checkpoint/checkpoint_reader.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -217,6 +218,15 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
             h.driver.warmup_done = done[0];
         }
         if (f.exists("/driver/warmup_tail")) h.driver.warmup_tail = read_warmup_tail(f, path);
+        if (f.exists("/driver/drift")) {  // cpi.finish = steady's pool (DriftTest::save())
+            h.driver.drift = f.read_doubles("/driver/drift");
+            const std::vector<double>& d = h.driver.drift;
+            // [quiet checks, components, then per burst tau, slope, se]
+            auto count = [](double v) { return v >= 0 && v <= 1e6 && v == std::floor(v); };
+            if (d.size() < 2 || !count(d[0]) || !count(d[1]) || d[1] < 1 ||
+                (d.size() - 2) % (1 + 2 * static_cast<std::size_t>(d[1])) != 0)
+                refuse(path, "has a malformed /driver/drift dataset");
+        }
         const auto lifting = f.read_integers("/driver/lifting");
         if (lifting.size() != static_cast<std::size_t>(4 * h.realizations))
             refuse(path, "has a malformed /driver/lifting dataset");

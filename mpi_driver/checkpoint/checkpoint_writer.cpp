@@ -431,6 +431,8 @@ void CheckpointWriter::write_header(H5File& f, long sequence, const CheckpointHe
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
     const std::vector<double> warmup_done{h.driver.warmup_done};
     f.write("/driver/warmup_done", std::span<const double>(warmup_done), {1});
+    if (!h.driver.drift.empty())
+        f.write("/driver/drift", std::span<const double>(h.driver.drift), {h.driver.drift.size()});
     write_warmup_tail(f, h.driver.warmup_tail);
     std::vector<std::int64_t> lifting;
     for (const auto& st : s.lifting)

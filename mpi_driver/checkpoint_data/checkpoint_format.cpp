@@ -117,6 +117,11 @@ std::uint64_t CheckpointHeader::checksum() const {
             for (const Eigen::VectorXd& v : *series) h = hash_vector(v, h);
         }
     }
+    // Likewise the drift test's pool (cpi.finish = steady, only once it holds a burst).
+    if (!driver.drift.empty()) {
+        h = hash_value(static_cast<std::uint64_t>(driver.drift.size()), h);
+        for (double v : driver.drift) h = hash_value(v, h);
+    }
     if (format_version >= 3) {
         h = hash_value(driver.warmed_up ? 1L : 0L, h);
         h = fnv1a_array(s.active, h);

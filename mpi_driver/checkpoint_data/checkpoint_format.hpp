@@ -15,6 +15,8 @@
 ///   /driver/warmup_tail/    only at a safe point inside a warm-up until steady: the samples its
 ///                           next drift test reads, t (n) and phase, expansion (n x R, each
 ///                           where the samples have it)
+///   /driver/drift           cpi.finish = steady: the drift test's pool (DriftTest::save();
+///                           absent when empty and in older files)
 ///   /driver/lifting         R x 4: each realization's lifting random stream (xoshiro state)
 ///   /driver/observable, /driver/recorded   warm starts of the coarse observables
 ///   /driver/integrator/     the multistep integrator's state by name (format 4; absent for the

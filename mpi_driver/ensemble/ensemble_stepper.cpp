@@ -347,8 +347,11 @@ void EnsembleStepper::restore_agreed(const std::vector<RealizationState>& states
 
 void EnsembleStepper::note_rest(const SampleRecord& rec) {
     bool all = rec.realizations_used > 0;
-    for (Eigen::Index r = 0; r < rec.at_rest.size(); ++r)
+    any_at_rest_ = false;
+    for (Eigen::Index r = 0; r < rec.at_rest.size(); ++r) {
         if (!std::isnan(rec.at_rest[r]) && rec.at_rest[r] != 1.0) all = false;
+        if (rec.at_rest[r] == 1.0) any_at_rest_ = true;
+    }
     if (!all)
         at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
     else if (std::isnan(at_rest_since_))

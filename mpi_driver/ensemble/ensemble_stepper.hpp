@@ -147,6 +147,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     /// Root: the first sample from which every realization in the ensemble has been at rest
     /// (Realization::at_rest), up to the last; NaN when one moves (or none is left).
     double end_state_since() const override { return at_rest_since_; }
+    /// Root: some realization in the ensemble was at rest at the last sample.
+    bool any_at_rest() const override { return any_at_rest_; }
 
     /// Non-root ranks: execute the root's commands until finish(). Collective.
     void serve();
@@ -304,6 +306,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     /// Root: end_state_since(); forgotten when a state is gone back to (re-judged from the next
     /// sample on: a bed at rest stays so).
     double at_rest_since_ = std::numeric_limits<double>::quiet_NaN();
+    bool any_at_rest_ = false;  ///< root: any_at_rest()
     double particle_steps_ = 0;
     double micro_time_ = 0;
     double total_particles_ = 0;

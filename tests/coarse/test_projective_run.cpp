@@ -644,6 +644,78 @@ TEST_CASE("a direct run reads the cpi block without checking it against the samp
     }
 }
 
+TEST_CASE("cpi.finish = steady ends a moving ensemble's run once its pooled slope is noise",
+          "[unit][coarse][run]") {
+    // Eight OU members relax from 10 to 0 at rate 0.1 with stationary s.d. 0.67: the mean drifts
+    // by e^(-0.1 t) per unit time. A burst's slope (window 1, healing 1) has a standard error of
+    // ~0.4 per node, so the pool of 4 is steady once the drift is below about 2 x 0.2: after
+    // t ~ 10, long before the 400 units of the run. The end state is the fixed point 0 within a
+    // few stationary standard errors (0.67 / sqrt(8) = 0.24); without the key the run goes on.
+    for (const bool finish : {true, false}) {
+        test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(3, 0.1), 0.3, 8, 0.05,
+                                    Eigen::VectorXd::Constant(3, 10.0), 7);
+        CpiSettings settings = fixed_settings();
+        settings.fixed.dt = 4.0;
+        settings.finish_at_end_state = finish;
+        ProjectiveRun run(settings, toy, variable("ou"));
+        const ProjectiveRunOutcome out = run.run(400.0);
+        INFO(out.end_status);
+        if (!finish) {
+            CHECK(toy.time() == Approx(400.0).margin(1e-9));
+            CHECK(std::isnan(out.end_state_time));
+            continue;
+        }
+        CHECK(out.end_status.find("statistically steady") != std::string::npos);
+        CHECK(out.end_state_time > 5.0);  // the drift (>= 0.6 per unit before t = 5) is seen
+        CHECK(toy.time() < 150.0);
+        CHECK(toy.mean().cwiseAbs().maxCoeff() < 1.0);
+    }
+}
+
+TEST_CASE("a run resumed with the drift test's pool ends where the uninterrupted one does",
+          "[unit][coarse][run]") {
+    // The state saved between coarse steps 5 and 6 holds the pool of the bursts so far: resumed
+    // from it (on a copy of the toy at that point) the run ends at the same step, time and state,
+    // bit for bit. Resumed without the pool it has to fill it again and ends later.
+    struct Inside final : ProjectiveRunObserver {
+        const test::OuEnsembleStepper* stepper = nullptr;
+        std::optional<test::OuEnsembleStepper> copy;
+        std::optional<ProjectiveRunState> state;
+        void between_steps(const ProjectiveRun& r) override {
+            if (r.state().coarse_steps != 5) return;
+            copy.emplace(*stepper);
+            state = r.state();
+        }
+    };
+    CpiSettings settings = fixed_settings();
+    settings.fixed.dt = 4.0;
+    settings.finish_at_end_state = true;
+    test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(3, 0.1), 0.3, 8, 0.05,
+                                Eigen::VectorXd::Constant(3, 10.0), 7);
+    ProjectiveRun run(settings, toy, variable("ou"));
+    Inside seen;
+    seen.stepper = &toy;
+    run.add_observer(seen);
+    const ProjectiveRunOutcome whole = run.run(400.0);
+    REQUIRE(!std::isnan(whole.end_state_time));
+    REQUIRE(seen.state);
+    REQUIRE_FALSE(seen.state->drift.empty());
+    const auto resume = [&](const ProjectiveRunState& state) {
+        test::OuEnsembleStepper copy = *seen.copy;
+        ProjectiveRun resumed(settings, copy, variable("ou"));
+        const ProjectiveRunOutcome rest = resumed.run(400.0, state);
+        return std::pair{rest, copy};
+    };
+    const auto [rest, end] = resume(*seen.state);
+    CHECK(rest.end_state_time == whole.end_state_time);
+    CHECK(rest.coarse_steps == whole.coarse_steps);
+    CHECK(end.time() == toy.time());
+    CHECK(end.mean() == toy.mean());  // bit for bit
+    ProjectiveRunState bare = *seen.state;
+    bare.drift.clear();
+    CHECK(resume(bare).first.coarse_steps > whole.coarse_steps);
+}
+
 TEST_CASE("cpi.finish = steady ends the run after the coarse step that finds the end state",
           "[unit][coarse][run]") {
     // The toy comes to rest at t = 33 (inside the burst of the fourth cycle, 30-32... 40-42:

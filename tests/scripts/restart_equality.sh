@@ -3,7 +3,8 @@
 # (ICDF, compact and rank observables; adaptive Adams-Bashforth 2 with a rejection before
 # the checkpoint, whose controller state is in it; adaptive forward Euler from pooled slopes,
 # whose slope pool, evidence-sized healing and window, trajectory budget (cpi.accuracy) and, with
-# cpi.lift = own, each realization's own slope deviation are in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
+# cpi.lift = own, each realization's own slope deviation and, with cpi.finish = steady, the drift
+# test's pool are in it), restarted on 1, 2 and 4 ranks from a checkpoint written by 4
 # realizations on 2 ranks; and a run from settled beds ("settled"), whose restart builds its beds
 # without settling them (the checkpoint replaces every particle state); and a cpi run restarted
 # from a checkpoint written inside its warm-up ("warmup": a job shorter than its warm-up used to
@@ -39,7 +40,7 @@ for spec in "direct 4 00000008 1,2,4 mode=direct" "cpi 1 00000001 1,2,4 mode=cpi
             "compact 1 00000002 4 mode=cpi,cpi.observable=compact,run.duration=8" \
             "ranks 1 00000002 2 mode=cpi,cpi.observable=ranks,cpi.lift=members,run.duration=8" \
             "adaptive 2 00000004 1,2,4 mode=cpi,cpi.projection=adaptive,cpi.integrator=adams_bashforth2,cpi.tolerance=0.06,cpi.dt_min=0.5,run.duration=24" \
-            "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.accuracy=4,cpi.dt_min=0.5,run.duration=24" \
+            "pooled 2 00000004 2 mode=cpi,cpi.projection=adaptive,cpi.slope=pooled,cpi.pool=3,cpi.healing_auto=true,cpi.window_auto=true,cpi.lift=own,cpi.accuracy=4,cpi.finish=steady,cpi.dt_min=0.5,run.duration=24" \
             "warmup 1 00000000 1,2 mode=cpi,cpi.warmup=4,run.duration=12" \
             "warmsteady 1 00000000 1,2 mode=cpi,cpi.projection=adaptive,cpi.tolerance=0.06,cpi.dt_min=0.5,cpi.warmup=1.5,run.duration=12" \
             "settled 4 00000008 2 mode=direct,bed.settle=true,bed.settle.ke_threshold=1e-3,bed.settle.max_time=20"; do
@@ -75,6 +76,8 @@ assert f['/driver/warmup_tail/expansion'].shape == (len(t), 4)" "$ckpt" \
   if [ "$mode" = pooled ]; then  # the budget is in the checkpoint, and jumps follow the restart
     /usr/bin/python3 -c "import h5py, sys; h5py.File(sys.argv[1], 'r')['/driver/integrator/budget/sigma']" "$ckpt" \
       || { echo "FAIL: no trajectory budget in $ckpt"; exit 1; }
+    /usr/bin/python3 -c "import h5py, sys; assert len(h5py.File(sys.argv[1], 'r')['/driver/drift']) > 2" "$ckpt" \
+      || { echo "FAIL: no drift test pool (cpi.finish = steady) in $ckpt"; exit 1; }
     after=$(sed -n '/checkpoint .*_ckpt_'"$from"'/,$p' "$work/$mode-ck.log" | grep -c ", projected," || true)
     [ "$after" -ge 1 ] || { echo "FAIL: no jump after the checkpoint in $mode-ck.log"; exit 1; }
   fi

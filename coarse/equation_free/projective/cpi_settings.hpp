@@ -41,7 +41,8 @@
 /// | cpi.noisy_curvature | adaptive: a posteriori curvature within its noise `ignored` | ignored |
 /// |                   | or `counted` as truncation error (runs before it: counted)    |         |
 /// | cpi.finish        | `duration` (run to run.duration) or `steady`: end where the    | duration|
-/// |                   | stepper reaches an end state (every realization at rest)      |         |
+/// |                   | stepper reaches an end state (every realization at rest) or   |         |
+/// |                   | the pooled slope is noise (DriftTest, projective_run.hpp)     |         |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance
@@ -89,6 +90,7 @@ struct CpiSettings {
     double warmup_drift_rate = 0.0;
     /// cpi.finish = steady: the run ends after the first coarse step whose last sample finds
     /// the stepper at an end state (CoarseStepper::end_state_since: every realization at rest),
+    /// or after which the drift test calls a moving ensemble statistically steady (DriftTest),
     /// with the time it was reached in the end status.
     bool finish_at_end_state = false;
     /// Projection = fixed: healing, window, DT, stability policy.

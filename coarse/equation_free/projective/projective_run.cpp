@@ -22,6 +22,18 @@ ProjectiveRun::ProjectiveRun(const CpiSettings& settings, CoarseStepper& stepper
     EFDEM_EXPECTS(settings_.burst() > 0.0);
 }
 
+bool ProjectiveRun::steady_by_drift(const ProjectiveStepRecord& rec) {
+    if (stepper_.any_at_rest()) {
+        drift_.clear();  // a partly stopped ensemble: its spread would hide the others' drift
+        return false;
+    }
+    const bool accepted_burst =
+        rec.status == StepStatus::projected || rec.status == StepStatus::burst_only;
+    if (accepted_burst && rec.slope_standard_error.size() == rec.slope.size())
+        drift_.add({rec.t_end - 0.5 * rec.window, rec.slope, rec.slope_standard_error});
+    return drift_.steady();
+}
+
 void ProjectiveRun::use(const CoarseVariable& variable) {
     if (variable.select) variable.select();
     integrator_ = settings_.make_integrator(variable.repair);
@@ -47,6 +59,7 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
     // before the checkpoint this run resumed from.
     use(state_.fell_back && fallback_ ? *fallback_ : primary_);
     if (resume) integrator_->restore_state(state_.integrator);
+    drift_.restore(state_.drift);
     ProjectiveRunOutcome out;
     out.end_status = "completed";
     if ((settings_.warmup > 0 || settings_.warmup_until_steady) && !state_.warmed_up) {
@@ -60,6 +73,7 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
     state_.warmed_up = true;
     while (stepper_.time() < t_end_ - tol) {
         state_.integrator = integrator_->save_state();
+        state_.drift = drift_.save();
         for (auto* o : observers_) o->between_steps(*this);
         // The integrators shorten their jumps to end at t_end; only a run shorter than warm-up
         // plus one burst (or one whose period bursts were extended) can be left with less.
@@ -81,6 +95,18 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
                 "end state at t = {:.6g}, {:.6g} time units after the start: every realization "
                 "at rest",
                 out.end_state_time, out.end_state_time - state_.t_origin);
+            out.end_status = "completed (" + what + ")";
+            log::info("cpi.finish = steady: {}", what);
+            break;
+        }
+        if (settings_.finish_at_end_state && steady_by_drift(rec)) {
+            out.end_state_time = drift_.since();
+            const std::string what = fmt::format(
+                "end state at t = {:.6g}, {:.6g} time units after the start: statistically "
+                "steady, the slope pooled over the last {} bursts within its noise at {} checks "
+                "in a row (z = {:.2f} <= {:.3g})",
+                out.end_state_time, out.end_state_time - state_.t_origin, kDriftBursts,
+                kDriftConfirmations, drift_.z(), DriftTest::kSteadyZ);
             out.end_status = "completed (" + what + ")";
             log::info("cpi.finish = steady: {}", what);
             break;

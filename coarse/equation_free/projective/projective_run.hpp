@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/estimators/drift_test.hpp"
 #include "coarse/equation_free/projective/cpi_settings.hpp"
 #include "coarse/equation_free/projective/projective_integrator.hpp"
 
@@ -74,6 +75,9 @@ struct ProjectiveRunState {
     /// The integrator's own state (ProjectiveIntegrator::save_state(); nullopt for the
     /// single-step integrators).
     IntegratorState integrator;
+    /// cpi.finish = steady: the drift test's pool of the last bursts' slopes (DriftTest::save();
+    /// empty when the pool is or the key is off).
+    std::vector<double> drift;
 };
 
 /// A coarse variable the loop can integrate: how projected vectors are repaired, how the
@@ -117,7 +121,8 @@ struct ProjectiveRunOutcome {
     long jumps = 0;             ///< projective jumps (DT > 0, accepted) made by this call of run()
     double simulated_time = 0;  ///< stepper time at the end minus t_origin
     bool fell_back = false;
-    /// cpi.finish = steady: when the end state was reached (CoarseStepper::end_state_since);
+    /// cpi.finish = steady: when the end state was reached (CoarseStepper::end_state_since, or
+    /// for a moving ensemble DriftTest::since());
     /// NaN when the run ended otherwise.
     double end_state_time = std::numeric_limits<double>::quiet_NaN();
 };
@@ -155,6 +160,14 @@ class ProjectiveRun {
     /// A safe point inside a warm-up until steady: the observers see the state with the
     /// samples the next drift test reads (`w`'s last burst length) in warmup_tail.
     void warmup_safe_point(const BurstSamples& w, double burst);
+    /// cpi.finish = steady: feeds the drift test from a step's record; true when the moving
+    /// ensemble is statistically steady (DriftTest::steady()).
+    bool steady_by_drift(const ProjectiveStepRecord& rec);
+
+    /// cpi.finish = steady for a moving ensemble: the slopes of the last 4 accepted bursts pooled,
+    /// steady at 2 quiet checks in a row (docs/error_control.md §1).
+    static constexpr std::size_t kDriftBursts = 4;
+    static constexpr int kDriftConfirmations = 2;
 
     CpiSettings settings_;
     CoarseStepper& stepper_;
@@ -163,6 +176,7 @@ class ProjectiveRun {
     std::unique_ptr<ProjectiveIntegrator> integrator_;
     std::vector<ProjectiveRunObserver*> observers_;
     ProjectiveRunState state_;
+    DriftTest drift_{kDriftBursts, kDriftConfirmations};
     double t_end_ = std::numeric_limits<double>::infinity();
 };
 
