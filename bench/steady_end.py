@@ -8,10 +8,10 @@ direct ensembles, and a CPI run that ended at it checked against a long direct t
    over the last 4 windows with one inverse-variance weight per window; z = RMS over the nodes of
    pooled slope / pooled standard error. Without drift z is about 1; the run calls the state
    steady at z <= 2 at two checks in a row.
-2. With --cpi RUN.h5 --reference DIRECT.h5 --after T: the CPI run's end state (the mean ICDF over
-   its samples from the end-state time on, i.e. the bursts the test pooled) against the direct
-   run's time average over t >= T, RMS over the nodes; beside it the direct run's own two halves
-   of that span against each other (a floor of the same kind: two time averages of one process).
+2. With --cpi RUN.h5 --reference DIRECT.h5 --after T: the drift test's z after each accepted burst
+   of the CPI run, and its end state (the mean ICDF over the bursts the test pooled; over its last
+   --last units when it did not end steady) against the direct run's time average over t >= T,
+   RMS over the nodes, beside the floor of two independent ensembles' time averages.
 
     /usr/bin/python3 bench/steady_end.py                           # section 1 on the committed runs
     /usr/bin/python3 bench/steady_end.py --cpi runs/steady_end/cpi_steady.h5 \\
@@ -83,49 +83,70 @@ def first_steady(zs):
     return None
 
 
-def end_state(args):
-    with h5py.File(args.cpi, "r") as f:
-        status = run_files.text(f.attrs["end_status"]) if "end_status" in f.attrs else "?"
+def cpi_pooled_z(f):
+    """The drift test's z after each accepted burst of a CPI run (a redone burst counted once)."""
+    status = [run_files.text(v) for v in f["cpi/status"][:]]
+    s, se, t_end = f["cpi/slope"][:], f["cpi/slope_standard_error"][:], f["cpi/t_end"][:]
+    nodes, seen = [], set()
+    for k, st in enumerate(status):
+        if st in ("projected", "burst_only") and t_end[k] not in seen:
+            seen.add(t_end[k])
+            nodes.append((t_end[k] - WINDOW / 2, s[k], se[k]))
+    return pooled_z(nodes)
+
+
+def end_state(args, path):
+    """The CPI run's end state (over the bursts the drift test pooled; when it did not end at a
+    steady state, over its last --last time units) against the direct run's time average."""
+    import re
+    with h5py.File(path, "r") as f:
+        status = run_files.text(f.attrs["end_status"])
         t = f["samples/time"][:]
         mean = run_files.get(f, "samples/mean_icdf")[:]
-    import re
+        zs = cpi_pooled_z(f)
     m = re.search(r"end state at t = ([0-9.e+-]+)", status)
-    if not m:
-        return [f"The CPI run did not end at a steady state: {status}"]
-    t_end_state = float(m.group(1)) - WINDOW / 2  # since() is the oldest pooled window's centre
-    cpi = mean[t >= t_end_state - 1e-9].mean(axis=0)
+    since = float(m.group(1)) - WINDOW / 2 if m else t[-1] - args.last
+    cpi = mean[t >= since - 1e-9].mean(axis=0)
     with h5py.File(args.reference, "r") as f:
         td, xd = members(f)
-    span = td >= args.after - 1e-9
-    direct = xd[span].mean(axis=(0, 1))
-    half = len(td[span]) // 2
-    first, second = xd[span][:half].mean(axis=(0, 1)), xd[span][half:].mean(axis=(0, 1))
-    rms = lambda v: float(np.sqrt(np.mean(v ** 2)))  # noqa: E731
+    span = xd[td >= args.after - 1e-9]
+    direct = span.mean(axis=(0, 1))
+    # Two independent ensembles of R: their time averages differ by sqrt(2) x the members'
+    # spread of their own time averages / sqrt(R) (the members' levels are nearly frozen, so
+    # averaging over time does not shrink it; halves of one run share them and would understate it).
+    r = span.shape[1]
+    floor = float(np.sqrt(2.0 * np.mean(span.mean(axis=0).var(axis=0, ddof=1)) / r))
+    rms = float(np.sqrt(np.mean((cpi - direct) ** 2)))
+    mid = len(cpi) // 2
     return [
-        f"CPI run `{os.path.relpath(args.cpi)}`: {status}",
+        f"CPI run `{os.path.relpath(path)}`: {status}",
         "",
-        f"| | value |",
+        "The drift test's z after each of its accepted bursts (t: z): "
+        + " ".join(f"{a:.0f}:{b:.1f}" for a, b in zs),
+        "",
+        "| | value |",
         "|---|---|",
-        f"| end-state time (oldest pooled window's start) | {t_end_state:.1f} |",
-        f"| simulated time at the end | {t[-1]:.1f} |",
-        f"| CPI end state (mean ICDF over t >= {t_end_state:.1f}), median node | {cpi[len(cpi) // 2]:.3f} d_p |",
-        f"| direct time average over t >= {args.after:g} (`{os.path.relpath(args.reference)}`), median node | "
-        f"{direct[len(direct) // 2]:.3f} d_p |",
-        f"| RMS over the nodes, CPI end state - direct time average | {rms(cpi - direct):.3f} d_p |",
-        f"| RMS over the nodes, the direct span's first half - second half | {rms(first - second):.3f} d_p |",
+        f"| CPI state: mean ICDF over t >= {since:.1f} ("
+        + ("the pooled bursts" if m else f"its last {args.last:g} units: no steady end") + f"), median | {cpi[mid]:.3f} d_p |",
+        f"| direct time average over t >= {args.after:g} (`{os.path.relpath(args.reference)}`, R = {r}), median | "
+        f"{direct[mid]:.3f} d_p |",
+        f"| RMS over the nodes, CPI - direct | {rms:.3f} d_p |",
+        f"| floor: two independent ensembles' time averages, sqrt(2) x members' spread / sqrt(R) | {floor:.3f} d_p |",
+        f"| CPI - direct in floors | {rms / floor:.1f} |",
     ]
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--cpi", help="a cpi run that ended with cpi.finish = steady")
+    p.add_argument("--cpi", nargs="*", default=[], help="cpi runs made with cpi.finish = steady")
     p.add_argument("--reference", help="a long direct run of the same scene (own seed)")
     p.add_argument("--after", type=float, default=200.0, help="time from which the direct run is steady")
+    p.add_argument("--last", type=float, default=100.0, help="span of a CPI run without a steady end")
     args = p.parse_args()
     lines = ["# The fluidized end state of cpi.finish = steady\n",
              "Made by `/usr/bin/python3 bench/steady_end.py"
-             + (f" --cpi {os.path.relpath(args.cpi)} --reference {os.path.relpath(args.reference)} --after {args.after:g}"
-                if args.cpi else "") + "`.\n",
+             + (f" --cpi {' '.join(os.path.relpath(c) for c in args.cpi)} --reference "
+                f"{os.path.relpath(args.reference)} --after {args.after:g}" if args.cpi else "") + "`.\n",
              "## 1. The drift test on direct ensembles\n",
              f"Bursts emulated as {WINDOW:g}-unit windows every {EVERY:g} units; pool of {POOL}; t:z at the "
              f"last window's end; steady at z <= {Z_STEADY:g} at {CONFIRM} checks in a row.\n",
@@ -138,7 +159,9 @@ def main():
         lines.append(f"| {label} | " + " ".join(f"{a:.0f}:{b:.1f}" for a, b in zs) + " | "
                      + (f"t = {when:.0f}" if when is not None else "never") + " |")
     if args.cpi:
-        lines += ["", "## 2. A CPI run's end state against a long direct time average\n"] + end_state(args)
+        lines += ["", "## 2. CPI runs' end states against a long direct time average\n"]
+        for path in args.cpi:
+            lines += end_state(args, path) + [""]
     text = "\n".join(lines) + "\n"
     print(text)
     with open(os.path.join(RESULTS, "steady_end.md"), "w") as f:

@@ -49,6 +49,20 @@ Member moved(const Member& m, double a, double b) {
     return {(a + b * m.icdf.array()).matrix(), (a + b * m.profile.array()).matrix()};
 }
 
+/// `count` members of n heights each, member r's on [lo(r), lo(r) + h(r)]: their light ICDFs and
+/// whole-bed profiles.
+template <class Lo, class H>
+std::pair<std::vector<Eigen::VectorXd>, std::vector<Eigen::VectorXd>> members(
+    efdem::RandomStream& rng, int count, std::size_t n, Lo lo, H h) {
+    std::vector<Eigen::VectorXd> icdf, profile;
+    for (int r = 0; r < count; ++r) {
+        const Member m = member(rng, sorted_heights(rng, n, lo(r), h(r)), ProbabilityGrid(19));
+        icdf.push_back(m.icdf);
+        profile.push_back(m.profile);
+    }
+    return {icdf, profile};
+}
+
 Eigen::MatrixXd rows(const std::vector<Eigen::VectorXd>& v) {
     Eigen::MatrixXd out(static_cast<Eigen::Index>(v.size()), v.front().size());
     for (std::size_t r = 0; r < v.size(); ++r)
@@ -131,15 +145,10 @@ TEST_CASE("rank coordinates cancel a shift and an expansion of a member's whole 
 
 TEST_CASE("a rank lift restricts back to the target it was given, in each member's own bed",
           "[unit][coarse]") {
-    const ProbabilityGrid grid(19);
     efdem::RandomStream rng(13, 0, "test");
-    std::vector<Eigen::VectorXd> icdf, profile;
-    for (int r = 0; r < 4; ++r) {
-        // Beds of different extents: member r stands r d_p higher.
-        const Member m = member(rng, sorted_heights(rng, 1000, 0.5 + r, 15.0), grid);
-        icdf.push_back(m.icdf);
-        profile.push_back(m.profile);
-    }
+    // Beds of different extents: member r stands r d_p higher.
+    const auto [icdf, profile] = members(
+        rng, 4, 1000, [](int r) { return 0.5 + r; }, [](int) { return 15.0; });
     RankObservable obs(19);
     const Eigen::VectorXd x = obs.restrict_ensemble(rows(icdf), rows(profile));
     // A projected X: the light species 0.7 d_p higher (as a jump would move it), kept inside the
@@ -161,14 +170,9 @@ TEST_CASE("a rank lift restricts back to the target it was given, in each member
 
 TEST_CASE("the rank observable's reference is its state; dropped members give NaN rows",
           "[unit][coarse]") {
-    const ProbabilityGrid grid(19);
     efdem::RandomStream rng(17, 0, "test");
-    std::vector<Eigen::VectorXd> icdf, profile;
-    for (int r = 0; r < 3; ++r) {
-        const Member m = member(rng, sorted_heights(rng, 800, 0.5, 12.0 + r), grid);
-        icdf.push_back(m.icdf);
-        profile.push_back(m.profile);
-    }
+    const auto [icdf, profile] = members(
+        rng, 3, 800, [](int) { return 0.5; }, [](int r) { return 12.0 + r; });
     RankObservable a(19);
     CHECK(a.saved_state().empty());
     const Eigen::VectorXd x0 = a.restrict_ensemble(rows(icdf), rows(profile));
