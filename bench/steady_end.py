@@ -17,6 +17,17 @@ direct ensembles, and a CPI run that ended at it checked against a long direct t
     /usr/bin/python3 bench/steady_end.py --cpi runs/steady_end/cpi_steady.h5 \\
         --reference bench/results/steady_study/direct.h5 --after 200
 
+The runs of section 2 (demo bed at U_s = 0.41, R = 4 on 2 ranks; run files not in git):
+
+    S="examples/demo_small/scene.cfg gas_drag.superficial_velocity=0.41 ensemble.realizations_per_rank=2"
+    C="mode=cpi seed=505 run.duration=400 cpi.projection=adaptive cpi.tolerance=0.32 cpi.healing=2 \
+       cpi.window=20 cpi.warmup=10 cpi.finish=steady"
+    mpirun -n 2 build/mpi_driver/efdem $S $C output.directory=runs/steady_end output.prefix=cpi_mean
+    mpirun -n 2 build/mpi_driver/efdem $S $C cpi.lift=members output.directory=runs/steady_end \
+        output.prefix=cpi_members
+    mpirun -n 2 build/mpi_driver/efdem $S mode=direct seed=606 run.duration=300 \
+        output.directory=runs/steady_end output.prefix=direct
+
 Writes bench/results/steady_end.md.
 """
 import argparse
