@@ -31,6 +31,7 @@ The runs of section 2 (demo bed at U_s = 0.41, R = 4 on 2 ranks; run files not i
 Writes bench/results/steady_end.md.
 """
 import argparse
+import math
 import os
 import sys
 
@@ -73,15 +74,23 @@ def window_slopes(t, x):
 
 
 def pooled_z(nodes):
-    """z of the drift test over each run of POOL consecutive windows, at the last one's time."""
+    """z of the drift test over each run of POOL consecutive windows, at the last one's time (as
+    DriftTest::z: equal weights when a window has no noise; a component without noise is left
+    out when it did not move, and makes z infinite when it did)."""
     res = []
     for j in range(POOL - 1, len(nodes)):
         use = nodes[j - POOL + 1:j + 1]
-        inv = np.array([1.0 / np.mean(se ** 2) for _, _, se in use])
-        w = inv / inv.sum()
+        v = np.array([np.mean(se ** 2) for _, _, se in use])
+        w = np.ones(len(use)) if (v == 0).any() else 1.0 / v
+        w = w / w.sum()
         s = sum(wi * si for wi, (_, si, _) in zip(w, use))
         var = sum(wi ** 2 * se ** 2 for wi, (_, _, se) in zip(w, use))
-        res.append((use[-1][0] + WINDOW / 2, float(np.sqrt(np.mean(s ** 2 / var)))))
+        noisy = var > 0
+        if (~noisy & (np.abs(s) > 1e-12)).any():
+            z = math.inf
+        else:
+            z = float(np.sqrt(np.mean(s[noisy] ** 2 / var[noisy]))) if noisy.any() else 0.0
+        res.append((use[-1][0] + WINDOW / 2, z))
     return res
 
 

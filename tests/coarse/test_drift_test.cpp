@@ -104,3 +104,35 @@ TEST_CASE("the drift test needs a full pool and quiet checks in a row; it keeps 
     CHECK_FALSE(d.ready());
     CHECK(d.save().empty());
 }
+
+TEST_CASE("a component without noise is quiet when it does not move and a drift when it does",
+          "[unit][coarse]") {
+    // A segregated bed in rank coordinates: every member's lowest light node sits at the same
+    // rank, so its slope and its standard error are exactly 0 in every burst. It must neither
+    // block the test (0/0) nor count as noise; the other components decide.
+    DriftTest d(2, 1);
+    SlopeNode n;
+    n.slope = Eigen::Vector3d(0.0, 0.01, -0.01);
+    n.se = Eigen::Vector3d(0.0, 0.1, 0.1);
+    n.tau = 1.0;
+    d.add(n);
+    n.tau = 2.0;
+    d.add(n);
+    REQUIRE(d.ready());
+    CHECK(d.z() == Approx(0.01 / (0.1 / std::sqrt(2.0))));  // the two noisy components only
+    CHECK(d.steady());
+    // The same component moving with every member alike: an exactly known drift.
+    n.slope[0] = 1e-3;
+    d.add(n);
+    CHECK(std::isinf(d.z()));
+    CHECK_FALSE(d.steady());
+    // Nothing noisy and nothing moving: z = 0.
+    DriftTest still(2, 1);
+    SlopeNode zero;
+    zero.slope = Eigen::Vector2d::Zero();
+    zero.se = Eigen::Vector2d::Zero();
+    still.add(zero);
+    still.add(zero);
+    CHECK(still.z() == 0.0);
+    CHECK(still.steady());
+}

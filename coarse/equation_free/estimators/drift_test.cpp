@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "core/contracts.hpp"
 
@@ -15,7 +16,7 @@ DriftTest::DriftTest(std::size_t bursts, int confirmations)
 void DriftTest::add(const SlopeNode& node) {
     EFDEM_EXPECTS(node.slope.size() == node.se.size());
     const bool usable = node.slope.size() > 0 && node.slope.allFinite() && node.se.allFinite() &&
-                        (node.se.array() > 0).all();
+                        (node.se.array() >= 0).all();
     if (!usable) {
         clear();
         return;
@@ -34,16 +35,38 @@ void DriftTest::clear() {
 
 double DriftTest::z() const {
     if (!ready()) return std::numeric_limits<double>::quiet_NaN();
-    double inverse_sum = 0;
-    for (const SlopeNode& n : nodes_) inverse_sum += 1.0 / n.se.array().square().mean();
+    // One weight per burst, inverse to its mean variance; equal weights when a burst has none
+    // (every member moved alike: a segregated bed in rank coordinates).
+    std::vector<double> w;
+    bool noiseless = false;
+    for (const SlopeNode& n : nodes_) {
+        const double v = n.se.array().square().mean();
+        noiseless = noiseless || v == 0.0;
+        w.push_back(v > 0.0 ? 1.0 / v : 0.0);
+    }
+    double total = 0;
+    for (double& x : w) total += noiseless ? (x = 1.0) : x;
     const Eigen::Index m = nodes_.front().slope.size();
     Eigen::VectorXd s = Eigen::VectorXd::Zero(m), var = Eigen::VectorXd::Zero(m);
-    for (const SlopeNode& n : nodes_) {
-        const double w = (1.0 / n.se.array().square().mean()) / inverse_sum;
-        s += w * n.slope;
-        var += (w * w) * n.se.array().square().matrix();
+    for (std::size_t j = 0; j < nodes_.size(); ++j) {
+        const double wj = w[j] / total;
+        s += wj * nodes_[j].slope;
+        var += (wj * wj) * nodes_[j].se.array().square().matrix();
     }
-    return std::sqrt((s.array().square() / var.array()).mean());
+    // A component whose members all moved alike in every pooled burst has no noise: it is quiet
+    // when it did not move (left out; round-off leaves ~1e-26), and a drift known exactly when
+    // it did.
+    double sum = 0;
+    long counted = 0;
+    for (Eigen::Index i = 0; i < m; ++i) {
+        if (var[i] > 0.0) {
+            sum += s[i] * s[i] / var[i];
+            ++counted;
+        } else if (std::abs(s[i]) > kExactlyQuiet) {
+            return std::numeric_limits<double>::infinity();
+        }
+    }
+    return counted > 0 ? std::sqrt(sum / static_cast<double>(counted)) : 0.0;
 }
 
 double DriftTest::since() const {

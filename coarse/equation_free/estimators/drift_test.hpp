@@ -32,14 +32,21 @@ class DriftTest {
   public:
     /// The largest z called steady.
     static constexpr double kSteadyZ = 2.0;
+    /// A noiseless component's pooled slope at or below this (in X's units per unit time) did
+    /// not move: round-off of slopes that are 0 (1e-26 seen) is far below it, a real drift far
+    /// above (1e-4 d_p per time unit moves a node by 0.01 d_p in 100 units).
+    static constexpr double kExactlyQuiet = 1e-12;
 
     /// \pre bursts >= 2 (one burst's slope is the controller's own; a pool is what tells a
     /// drift from noise); confirmations >= 1.
     DriftTest(std::size_t bursts, int confirmations);
 
     /// A new accepted burst's slope; the oldest falls out beyond `bursts`. A node without a
-    /// finite slope and positive standard error (e.g. from one realization) empties the pool:
-    /// nothing can be judged across it. \pre node.slope.size() == node.se.size().
+    /// finite slope and standard error (e.g. from one realization) empties the pool: nothing can
+    /// be judged across it. A component whose se is 0 in every pooled burst (the members moved
+    /// alike: a segregated bed in rank coordinates) counts as quiet when its pooled slope is 0 (|s|
+    /// <= kExactlyQuiet) and as an exactly known drift (z infinite) when not. \pre
+    /// node.slope.size() == node.se.size().
     void add(const SlopeNode& node);
     /// Forget everything (the ensemble changed, or a realization came to rest).
     void clear();
