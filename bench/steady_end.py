@@ -25,6 +25,8 @@ The runs of section 2 (demo bed at U_s = 0.41, R = 4 on 2 ranks; run files not i
     mpirun -n 2 build/mpi_driver/efdem $S $C output.directory=runs/steady_end output.prefix=cpi_mean
     mpirun -n 2 build/mpi_driver/efdem $S $C cpi.lift=members output.directory=runs/steady_end \
         output.prefix=cpi_members
+    mpirun -n 2 build/mpi_driver/efdem $S $C cpi.observable=ranks output.directory=runs/steady_end \
+        output.prefix=cpi_ranks            # and with run.duration=800 output.prefix=cpi_ranks_800
     mpirun -n 2 build/mpi_driver/efdem $S mode=direct seed=606 run.duration=300 \
         output.directory=runs/steady_end output.prefix=direct
 
