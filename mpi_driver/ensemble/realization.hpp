@@ -19,7 +19,6 @@
 
 #include "coarse/demixing/ensemble_observable.hpp"  // ReferenceIcdf
 #include "coarse/demixing/probability_grid.hpp"
-#include "core/contracts.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "mpi_driver/checkpoint_data/realization_state.hpp"
@@ -61,11 +60,6 @@ struct Observation {
     Eigen::VectorXd top;   ///< ICDF of the top half (only when asked for)
     /// The whole bed's profile (coarse/demixing/whole_bed_profile.hpp; only when asked for).
     Eigen::VectorXd whole_bed;
-    /// `top` or `whole_bed`. \pre kind is not none.
-    Eigen::VectorXd& reference(coarse::ReferenceIcdf kind) {
-        EFDEM_EXPECTS(kind != coarse::ReferenceIcdf::none);
-        return kind == coarse::ReferenceIcdf::top_half ? top : whole_bed;
-    }
     double com = 0;  ///< centre-of-mass height: the travelling-wave phase signal
     /// Number-weighted mean particle height: the bed's expansion, which (unlike the mass-weighted
     /// centre of mass) demixing of equal spheres leaves unchanged.

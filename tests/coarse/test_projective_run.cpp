@@ -657,6 +657,7 @@ TEST_CASE("cpi.finish = steady ends a moving ensemble's run once its pooled slop
         CpiSettings settings = fixed_settings();
         settings.fixed.dt = 4.0;
         settings.finish_at_end_state = finish;
+        settings.finish_on_drift = finish;
         ProjectiveRun run(settings, toy, variable("ou"));
         const ProjectiveRunOutcome out = run.run(400.0);
         INFO(out.end_status);
@@ -690,6 +691,7 @@ TEST_CASE("a run resumed with the drift test's pool ends where the uninterrupted
     CpiSettings settings = fixed_settings();
     settings.fixed.dt = 4.0;
     settings.finish_at_end_state = true;
+    settings.finish_on_drift = true;
     test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(3, 0.1), 0.3, 8, 0.05,
                                 Eigen::VectorXd::Constant(3, 10.0), 7);
     ProjectiveRun run(settings, toy, variable("ou"));
@@ -747,7 +749,11 @@ TEST_CASE("cpi.finish = steady ends the run after the coarse step that finds the
         return CpiSettings::from_params(table.root().scope("cpi"), 0.5);
     };
     CHECK(read("steady").finish_at_end_state);
+    CHECK(read("steady").finish_on_drift);
+    CHECK(read("at_rest").finish_at_end_state);
+    CHECK_FALSE(read("at_rest").finish_on_drift);  // every realization at rest, nothing else
     CHECK_FALSE(read("duration").finish_at_end_state);
+    CHECK_FALSE(read("duration").finish_on_drift);
     CHECK_THAT(test::input_error([&] { read("never"); }).what(),
                Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.finish") &&
                    Catch::Contains("duration") && Catch::Contains("steady"));

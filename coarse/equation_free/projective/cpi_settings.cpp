@@ -189,8 +189,10 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         cpi.get_or<double>("warmup_max", 10.0 * (healing + window), Bounds::closed(0.0, 1e7));
     on_grid("warmup_max", s.warmup_max);
     s.warmup_drift_rate = by_tolerance ? m.drift_rate : 0.0;
-    s.finish_at_end_state =
-        cpi.get_or_choice("finish", "duration", {"duration", "steady"}) == "steady";
+    const std::string finish =
+        cpi.get_or_choice("finish", "duration", {"duration", "steady", "at_rest"});
+    s.finish_at_end_state = finish != "duration";
+    s.finish_on_drift = finish == "steady";
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
     return s;

@@ -40,9 +40,9 @@
 /// | cpi.window_max    | adaptive: the longest window cpi.window_auto may choose       | 4 burst |
 /// | cpi.noisy_curvature | adaptive: a posteriori curvature within its noise `ignored` | ignored |
 /// |                   | or `counted` as truncation error (runs before it: counted)    |         |
-/// | cpi.finish        | `duration` (run to run.duration) or `steady`: end where the    | duration|
-/// |                   | stepper reaches an end state (every realization at rest) or   |         |
-/// |                   | the pooled slope is noise (DriftTest, projective_run.hpp)     |         |
+/// | cpi.finish        | `duration` (run to run.duration); `at_rest`: end where every  | duration|
+/// |                   | realization is at rest; `steady`: there, or where the pooled  |         |
+/// |                   | slope is noise (DriftTest, projective_run.hpp)                |         |
 // clang-format on
 ///
 /// With `adaptive`, cpi.dt (if given) caps the first jump (default: planned from the tolerance
@@ -88,11 +88,13 @@ struct CpiSettings {
     /// threshold the integrator holds a jump back by, multistep.drift_rate); 0 otherwise (no
     /// tolerance: steady only when the drift is within its noise).
     double warmup_drift_rate = 0.0;
-    /// cpi.finish = steady: the run ends after the first coarse step whose last sample finds
-    /// the stepper at an end state (CoarseStepper::end_state_since: every realization at rest),
-    /// or after which the drift test calls a moving ensemble statistically steady (DriftTest),
-    /// with the time it was reached in the end status.
+    /// cpi.finish = steady or at_rest: the run ends after the first coarse step whose last sample
+    /// finds the stepper at an end state (CoarseStepper::end_state_since: every realization at
+    /// rest), with the time it was reached in the end status.
     bool finish_at_end_state = false;
+    /// cpi.finish = steady: also after the coarse step at which the drift test calls a moving
+    /// ensemble statistically steady (DriftTest, projective_run.hpp).
+    bool finish_on_drift = false;
     /// Projection = fixed: healing, window, DT, stability policy.
     ProjectiveEulerSettings fixed;
     /// Projection = periods: healing, window, k, burst extension, stability policy.

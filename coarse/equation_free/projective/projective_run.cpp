@@ -99,7 +99,7 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
             log::info("cpi.finish = steady: {}", what);
             break;
         }
-        if (settings_.finish_at_end_state && steady_by_drift(rec)) {
+        if (settings_.finish_on_drift && steady_by_drift(rec)) {
             out.end_state_time = drift_.since();
             const std::string what = fmt::format(
                 "end state at t = {:.6g}, {:.6g} time units after the start: statistically "
