@@ -88,27 +88,25 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
         ++state_.coarse_steps;
         if (rec.status == StepStatus::projected && rec.dt > 0) ++out.jumps;
         for (auto* o : observers_) o->step_done(*this, rec);
-        if (settings_.finish_at_end_state && !std::isnan(stepper_.end_state_since())) {
-            // Nothing changes from here on however long the run: the end state is reached.
-            out.end_state_time = stepper_.end_state_since();
-            const std::string what = fmt::format(
-                "end state at t = {:.6g}, {:.6g} time units after the start: every realization "
-                "at rest",
-                out.end_state_time, out.end_state_time - state_.t_origin);
+        // cpi.finish: the end status names the end state's time and why it is one.
+        const auto end_at = [&](double t, const std::string& why) {
+            out.end_state_time = t;
+            const std::string what =
+                fmt::format("end state at t = {:.6g}, {:.6g} time units after the start: {}", t,
+                            t - state_.t_origin, why);
             out.end_status = "completed (" + what + ")";
             log::info("cpi.finish = steady: {}", what);
+        };
+        if (settings_.finish_at_end_state && !std::isnan(stepper_.end_state_since())) {
+            // Nothing changes from here on however long the run: the end state is reached.
+            end_at(stepper_.end_state_since(), "every realization at rest");
             break;
         }
         if (settings_.finish_on_drift && steady_by_drift(rec)) {
-            out.end_state_time = drift_.since();
-            const std::string what = fmt::format(
-                "end state at t = {:.6g}, {:.6g} time units after the start: statistically "
-                "steady, the slope pooled over the last {} bursts within its noise at {} checks "
-                "in a row (z = {:.2f} <= {:.3g})",
-                out.end_state_time, out.end_state_time - state_.t_origin, kDriftBursts,
-                kDriftConfirmations, drift_.z(), DriftTest::kSteadyZ);
-            out.end_status = "completed (" + what + ")";
-            log::info("cpi.finish = steady: {}", what);
+            end_at(drift_.since(),
+                   fmt::format("statistically steady, the slope pooled over the last {} bursts "
+                               "within its noise at {} checks in a row (z = {:.2f} <= {:.3g})",
+                               kDriftBursts, kDriftConfirmations, drift_.z(), DriftTest::kSteadyZ));
             break;
         }
         if (rec.advanced()) {
