@@ -64,6 +64,7 @@ SCENES = [
     (TINY, ["mode=steady", "ensemble.realizations_per_rank=2"]),
     (TINY, ["mode=steady", "steady.coordinates=gaps", "ensemble.realizations_per_rank=2"]),
     (TINY, ["mode=steady", "steady.solver=anderson", "steady.eigenvalues=0", "ensemble.realizations_per_rank=2"]),
+    (TINY, ["mode=cpi", "cpi.hand_off=steady", "ensemble.realizations_per_rank=2"]),
     (TINY, ["mode=continuation", "continuation.parameter=gas_drag.superficial_velocity", "continuation.end=0.5",
             "ensemble.realizations_per_rank=2"]),
 ]

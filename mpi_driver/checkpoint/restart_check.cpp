@@ -40,6 +40,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.at_rest", "lift"},  // hold: realizations at rest are not lifted (issue 34)
     {"cpi.finish", "duration"},  // steady: end at the end state (issue 34)
     {"cpi.relabel", "any"},      // moving: relabel moving particles first (issue 34)
+    {"cpi.hand_off", "none"},    // steady: the end state goes to the steady solver (issue 34)
 };
 // clang-format on
 

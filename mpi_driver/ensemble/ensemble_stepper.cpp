@@ -156,6 +156,12 @@ void EnsembleStepper::confirm_kept_state() {
     do_confirm();
 }
 
+void EnsembleStepper::begin_steady_solve() {
+    settings_.lift_members = false;
+    settings_.hold_at_rest = false;
+    progress_ = nullptr;
+}
+
 void EnsembleStepper::set_parameter(double value) {
     broadcast({Command::set_parameter, value, false});
     do_set_parameter(value);

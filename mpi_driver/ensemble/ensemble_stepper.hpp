@@ -123,6 +123,11 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     void keep_state() override;
     void return_to_kept_state() override;
     void confirm_kept_state() override;
+    /// Root, where a cpi run hands its state to a steady solve (cpi.hand_off = steady): from
+    /// now on every lift puts every realization on its target (Phi_tau lifts one X, so
+    /// cpi.lift = members | own and cpi.at_rest = hold no longer apply), and no progress line is
+    /// drawn (a solve goes back in time; it logs each iterate instead).
+    void begin_steady_solve();
     /// Root: sets StepperSettings::parameter to `value` on every realization (every rank joins
     /// through serve()): the continuation parameter, before a lift. Not part of the kept state.
     void set_parameter(double value);

@@ -140,7 +140,7 @@ void Hdf5Recorder::start(const RunProvenance& p, bool resume) {
     document("/parameters");
     file_.create_group("/samples");
     if (p.mode == "cpi") file_.create_group("/cpi");
-    if (p.mode == "steady" || p.mode == "continuation") {
+    if (p.mode == "steady" || p.mode == "continuation" || p.hand_off) {
         file_.create_group("/steady");
         file_.create_group("/steady/iterate");
         if (p.mode == "continuation") file_.create_group("/branch");
@@ -543,6 +543,8 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         file_.attribute("/steady", "difference_step_origin", o.difference_step_origin);
     }
     file_.attribute("/steady", "warmup_end", o.warmup_end);
+    if (std::isfinite(o.hand_off_time))
+        file_.attribute("/steady", "hand_off_time", o.hand_off_time);
     file_.attribute("/steady", "evaluations", std::int64_t{o.evaluations});
     file_.attribute("/steady", "dem_time", o.micro_time);
     file_.attribute("/steady", "repairs", std::int64_t{o.repairs});

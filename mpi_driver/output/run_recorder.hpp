@@ -106,6 +106,7 @@ struct RunProvenance {
     std::string overrides;   ///< the command-line overrides, space-separated
     std::string parameters;  ///< every parameter as "key = value   [origin]" lines
     std::string mode;
+    bool hand_off = false;  ///< cpi.hand_off = steady: a cpi run that ends in a steady solve
     int ranks = 1;
     int realizations = 1;
     int realizations_per_rank = 1;

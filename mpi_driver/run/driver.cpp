@@ -12,6 +12,7 @@
 #include "mpi_driver/parallel/stop_signal.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
 #include "mpi_driver/run/progress_observer.hpp"
+#include "mpi_driver/run/steady_driver.hpp"
 #include "mpi_driver/run/step_report_observer.hpp"
 #include "mpi_driver/run/stop_observer.hpp"
 
@@ -47,6 +48,58 @@ void stopped(RunSummary& sum, const EnsembleStepper& stepper,
             : fmt::format("interrupted: {} at t = {:.6g}; checkpoint {} (t = {:.6g})",
                           signal_name(sum.stop_signal), stepper.time(), sum.checkpoint,
                           checkpoint_time);
+}
+/// cpi.hand_off = steady: the cpi run's state at its end goes to the steady solver; the run's
+/// end status and exit code then include the solve's (exit 3 when it does not converge). A
+/// signal ends the stepper here (exit 4; the solve is not checkpointed).
+void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder,
+              Progress& progress, RunSummary& sum) {
+    const double t_end = stepper.time();
+    const double cpi_dem_time = stepper.micro_time();
+    if (stepper.any_at_rest())
+        log::warn(
+            "cpi.hand_off: a realization is at rest at t = {:.6g}; the steady solve lifts it too, "
+            "but a bed the gas no longer moves keeps any lifted state (Phi_tau(X) = X for it), "
+            "so its part of F is not a test of steadiness",
+            t_end);
+    log::info(
+        "cpi.hand_off: the cpi run ended at t = {:.6g} ({}) after {:.4g} of DEM time; its state "
+        "goes to the steady solver ({})",
+        t_end, sum.end_status, cpi_dem_time,
+        s.steady.solver == coarse::SteadyRunSettings::Solver::anderson ? "anderson" : "newton");
+    stepper.begin_steady_solve();
+    const SteadySolveResult solved = solve_steady(stepper, s, recorder, progress, t_end);
+    const coarse::SteadyRunOutcome& out = solved.outcome;
+    sum.end_status += "; then the steady solve: " + out.end_status;
+    if (solved.stop_signal != 0) {
+        stepper.finish(kExitInterrupted);
+        sum.stop_signal = solved.stop_signal;
+        return;
+    }
+    sum.unconverged = !out.converged;
+    if (sum.unconverged) {
+        report_unconverged(out);
+        return;
+    }
+    const coarse::SteadySolveRecord& r = out.solve;
+    const double residual = r.state_residuals.empty() ? 0.0 : r.state_residuals.back();
+    const double noise = r.state_noise.empty() ? 0.0 : r.state_noise.back();
+    std::string band;
+    if (!out.spectrum.leading.empty()) {
+        // |x - x*| <= (|F| + |SE|) / (1 - |mu_1|) along the slowest mode (docs/steady_states.md).
+        const double mu = std::abs(out.spectrum.leading.front().mu);
+        band = mu < 1.0 ? fmt::format(
+                              "; the end state is within (|F| + noise) / (1 - |mu_1|) = "
+                              "{:.3g} of the steady state (|mu_1| = {:.3g})",
+                              (residual + noise) / (1.0 - mu), mu)
+                        : fmt::format("; |mu_1| = {:.3g} >= 1: no band (not a stable state)", mu);
+    }
+    log::info(
+        "cpi.hand_off: end state reached at t = {:.6g} (the cpi run's end), refined by {} "
+        "evaluations of Phi_{:g} ({:.4g} of DEM time; {:.4g} in all): |F| = {:.4g}, noise {:.4g}, "
+        "mean light height {:.4g} d_p{}",
+        t_end, out.evaluations, out.tau, out.micro_time, stepper.micro_time(), residual, noise,
+        coarse::mean_height(r.x), band);
 }
 }  // namespace
 
@@ -168,17 +221,18 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
         stopped(sum, stepper, path, stepper.resume_point_time());
         return sum;
     }
-    stepper.finish();
     RunSummary sum;
     sum.end_status = out.end_status;
     sum.coarse_steps = out.coarse_steps;
     sum.simulated_time = out.simulated_time;
-    fill_totals(sum, stepper, progress);
-    sum.lift_seconds = stepper.overhead().lift_seconds;
     if (stepper.failures() > 0 && sum.end_status.rfind("completed", 0) == 0)
         sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
     sum.controller = run.integrator().summary(stepper.realizations(), out.coarse_steps);
     if (!sum.controller.empty()) log::info("{}", sum.controller);
+    if (s.hand_off) hand_off(stepper, s, recorder, progress, sum);
+    if (sum.stop_signal == 0) stepper.finish();
+    fill_totals(sum, stepper, progress);
+    sum.lift_seconds = stepper.overhead().lift_seconds;
     return sum;
 }
 

@@ -23,11 +23,14 @@ int report_end(const RunSummary& summary, const RunSettings& s, const ParamTable
         format_duration(summary.wall_seconds), summary.particle_steps);
     if (summary.stop_signal == 0) return summary.unconverged ? kExitRuntimeFailure : kExitOk;
     const std::string signal = signal_name(summary.stop_signal);
-    if (s.is_steady()) {
+    if (s.solves_steady() && summary.checkpoint.empty()) {
         log::notice(
-            "stopped by {}; the iterates so far and the best one are in {}/{}.h5 (mode = {} cannot "
-            "be continued from a checkpoint)",
-            signal, s.output.directory.string(), s.output.prefix, s.mode_name());
+            "stopped by {}; the iterates so far and the best one are in {}/{}.h5 ({} cannot be "
+            "continued from a checkpoint{})",
+            signal, s.output.directory.string(), s.output.prefix,
+            s.is_steady() ? fmt::format("mode = {}", s.mode_name())
+                          : std::string("the steady solve of cpi.hand_off = steady"),
+            s.is_steady() ? "" : "; restarting the cpi run's last checkpoint redoes it");
     } else if (summary.checkpoint.empty()) {
         log::notice("stopped by {}; nothing could be saved (no HDF5)", signal);
     } else {

@@ -36,6 +36,7 @@ RunProvenance provenance(const MpiSession& mpi, const ParamTable& table, const R
     for (const auto& r : table.resolved())
         p.parameters += fmt::format("{} = {}   [{}]\n", r.key, r.value, r.origin);
     p.mode = s.mode_name();
+    p.hand_off = s.is_cpi() && s.hand_off;
     p.ranks = mpi.size();
     p.realizations_per_rank = s.realizations_per_rank;
     p.realizations = mpi.size() * s.realizations_per_rank;

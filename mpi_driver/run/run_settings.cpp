@@ -103,7 +103,10 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                  "= own moves each realization by its own slope's jump, which cpi.projection = "
                  "periods does not measure",
                  "mean or members with cpi.projection = periods; own with fixed or adaptive");
-    if (s.is_steady()) {
+    // cpi.hand_off = steady: the CPI run's end state goes to the steady solver. Read in both
+    // modes like the other cpi keys (its steady.* keys then too); a direct run does not use it.
+    s.hand_off = cpi.get_or_choice("hand_off", "none", {"none", "steady"}) == "steady";
+    if (s.is_steady() || s.hand_off) {
         const auto* row = coarse::observable_table().find(s.observable);
         const long dimension =
             row ? static_cast<long>(
@@ -115,8 +118,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         for (const dem::EffectParameter& p : dem::run_parameters())
             parameters.push_back({p.key, p.parameter.bounds});
         s.steady = coarse::SteadyRunSettings::from_params(
-            root, s.observe.interval, dimension, s.mode == Mode::continuation, parameters,
-            [&](const std::string& key) {
+            root, s.observe.interval, dimension,
+            s.mode == Mode::continuation ? coarse::SteadyRunSettings::Use::continuation
+            : s.is_steady()              ? coarse::SteadyRunSettings::Use::steady
+                                         : coarse::SteadyRunSettings::Use::hand_off,
+            parameters, [&](const std::string& key) {
                 const dem::EffectParameter p = *dem::find_run_parameter(key);
                 if (std::find(scene.effect_names.begin(), scene.effect_names.end(), p.effect) ==
                     scene.effect_names.end())
@@ -211,14 +217,15 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.on_failure.action = action == "drop"      ? FailurePolicy::Action::drop
                           : action == "replace" ? FailurePolicy::Action::replace
                                                 : FailurePolicy::Action::abort;
-    if (s.is_steady() && s.on_failure.action != FailurePolicy::Action::abort)
+    if (s.solves_steady() && s.on_failure.action != FailurePolicy::Action::abort)
         ensemble.fail(
             "on_failure",
             fmt::format(
-                "is not supported with mode = {}: the derivatives compare evaluations of the same "
-                "ensemble, which a dropped or replaced realization would change",
-                s.mode_name()),
-            "abort with mode = steady or continuation");
+                "is not supported with {}: the solve compares evaluations of the same ensemble, "
+                "which a dropped or replaced realization would change",
+                s.is_steady() ? fmt::format("mode = {}", s.mode_name())
+                              : std::string("cpi.hand_off = steady")),
+            "abort with mode = steady or continuation, or with cpi.hand_off = steady");
     if (s.on_failure.action == FailurePolicy::Action::replace && !s.is_cpi())
         ensemble.fail(
             "on_failure",
@@ -258,23 +265,33 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
     if (on_failure.action == FailurePolicy::Action::drop &&
         on_failure.max_failures > realizations - on_failure.min_active)
         on_failure.max_failures = std::max(0, realizations - on_failure.min_active);
-    if (is_steady()) {
-        if (realizations < 2)
-            root.fail("mode",
-                      fmt::format("= {} stops its solve at the noise level of the ensemble, "
-                                  "measured from the spread "
-                                  "of >= 2 realizations; this run has {} (ranks x "
-                                  "ensemble.realizations_per_rank)",
-                                  mode_name(), realizations),
-                      "steady or continuation with >= 2 realizations (more ranks or "
-                      "ensemble.realizations_per_rank)");
+    if (solves_steady()) {
+        // The key that asked for the solve: the mode, or the hand-off of a cpi run.
+        const bool by_mode = is_steady();
+        const std::string asked =
+            by_mode ? fmt::format("mode = {}", mode_name()) : "cpi.hand_off = steady";
+        if (realizations < 2) {
+            const std::string why = fmt::format(
+                "{} stops its solve at the noise level of the ensemble, measured from the spread "
+                "of >= 2 realizations; this run has {} (ranks x ensemble.realizations_per_rank)",
+                by_mode ? fmt::format("= {}", mode_name()) : std::string("= steady"), realizations);
+            const std::string allowed =
+                by_mode ? "steady or continuation with >= 2 realizations (more ranks or "
+                          "ensemble.realizations_per_rank)"
+                        : "none, or steady with >= 2 realizations (more ranks or "
+                          "ensemble.realizations_per_rank)";
+            if (by_mode)
+                root.fail("mode", why, allowed);
+            else
+                root.scope("cpi").fail("hand_off", why, allowed);
+        }
         if (!restricts_members(observable, observe.quantiles))
             root.scope("cpi").fail(
                 "observable",
-                fmt::format("cannot restrict a realization on its own, and mode = {} measures the "
+                fmt::format("cannot restrict a realization on its own, and {} measures the "
                             "noise of F from the realizations' spread",
-                            mode_name()),
-                "icdf or ranks with mode = steady or continuation");
+                            asked),
+                fmt::format("icdf or ranks with {}", asked));
     }
     if (!spread) return;
     const Params c = root.scope("cpi");

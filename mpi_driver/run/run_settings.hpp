@@ -114,7 +114,10 @@ struct RunSettings {
     bool pause_at_rest = true;
     /// The other cpi.* keys, read by the coarse layer.
     coarse::CpiSettings cpi;
-    /// mode = steady | continuation: the steady.* and continuation.* keys.
+    /// cpi.hand_off = steady: when the CPI run ends (cpi.finish), its state goes to the steady
+    /// solver (the steady.* keys, with the hand-off's defaults).
+    bool hand_off = false;
+    /// mode = steady | continuation, or a hand-off: the steady.* and continuation.* keys.
     coarse::SteadyRunSettings steady;
     OutputSettings output;
     CheckpointSettings checkpoint;
@@ -127,6 +130,9 @@ struct RunSettings {
     bool is_cpi() const { return mode == Mode::cpi; }
     /// mode = steady or continuation (the coarse time-tau map, docs/steady_states.md).
     bool is_steady() const { return mode == Mode::steady || mode == Mode::continuation; }
+    /// The run solves for a steady state: mode = steady or continuation, or a cpi run that hands
+    /// its end to the steady solver.
+    bool solves_steady() const { return is_steady() || (is_cpi() && hand_off); }
     /// The run lifts coarse vectors onto the realizations (cpi, steady, continuation).
     bool lifts() const { return mode != Mode::direct; }
     /// "direct", "cpi", "steady" or "continuation".

@@ -1,5 +1,6 @@
 #include "mpi_driver/run/steady_driver.hpp"
 
+#include <limits>
 #include <string>
 
 #include <fmt/format.h>
@@ -22,8 +23,8 @@ struct SolveTrace {
 };
 }  // namespace
 
-RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder,
-                      Progress& progress) {
+SteadySolveResult solve_steady(EnsembleStepper& stepper, const RunSettings& s,
+                               RunRecorder* recorder, Progress& progress, double hand_off_time) {
     const coarse::SteadyRunSettings& ss = s.steady;
     coarse::EnsembleObservable& observable = stepper.observable();
     coarse::SteadyRun run(
@@ -31,7 +32,9 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         [&stepper](double value) { stepper.set_parameter(value); },
         ss.gap_coordinates ? coarse::icdf_gap_coordinates() : coarse::CoarseCoordinates{});
     const double micro_start = stepper.micro_time();
-    const double budget = s.duration;  // 0: none
+    // mode = steady | continuation: run.duration is the solve's budget (0: none); a hand-off's
+    // run.duration was the cpi run's span, and its solve ends by steady.max_iterations.
+    const double budget = s.is_steady() ? s.duration : 0.0;
     double parameter = ss.continuation ? ss.parameter_start : 0.0;
     SolveTrace trace;
 
@@ -82,8 +85,8 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
             "continued; its best iterate is saved)",
             signal_name(stepper.interrupted()), stepper.time());
     };
-    RunSummary sum;
-    coarse::SteadyRunOutcome out;
+    SteadySolveResult result;
+    coarse::SteadyRunOutcome& out = result.outcome;
     try {
         out = run.run();
     } catch (const RunInterrupted&) {
@@ -95,47 +98,62 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
         out.branch = trace.branch;
         out.branch.end_reason = out.solve.message;
         out.end_status = interrupted_status();
-        sum.stop_signal = stepper.interrupted();
+        result.stop_signal = stepper.interrupted();
     }
-    if (stepper.interrupted() && sum.stop_signal == 0) {
+    if (stepper.interrupted() && result.stop_signal == 0) {
         // The observer stopped the solve at an iterate.
-        sum.stop_signal = stepper.interrupted();
+        result.stop_signal = stepper.interrupted();
         out.end_status = interrupted_status();
     }
+    out.hand_off_time = hand_off_time;
     if (recorder) recorder->steady_outcome(out);
+    return result;
+}
+
+RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder,
+                      Progress& progress) {
+    const double micro_start = stepper.micro_time();
+    const SteadySolveResult result =
+        solve_steady(stepper, s, recorder, progress, std::numeric_limits<double>::quiet_NaN());
+    const coarse::SteadyRunOutcome& out = result.outcome;
+    RunSummary sum;
+    sum.stop_signal = result.stop_signal;
     stepper.finish(sum.stop_signal ? kExitInterrupted : 0);
     sum.end_status = out.end_status;
     sum.unconverged = sum.stop_signal == 0 && !out.converged;
     sum.simulated_time = stepper.micro_time() - micro_start;
     fill_totals(sum, stepper, progress);
     sum.lift_seconds = stepper.overhead().lift_seconds;
-    if (sum.unconverged) {
-        const coarse::SteadySolveRecord& r = out.solve;
-        // In heights [d_p] like the run file's /steady/iterate/residual (the solver's own |F| is
-        // in its coordinates, log gaps with steady.coordinates = gaps).
-        std::string history;
-        for (std::size_t k = 0; k < r.state_residuals.size(); ++k)
-            history += fmt::format("{}{:.3e}", k ? ", " : "", r.state_residuals[k]);
-        log::error("{}", out.end_status);
-        if (!out.continuation)
-            log::error(
-                "residual history |F| [d_p]: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is "
-                "/steady/best in "
-                "the run file. What to try: a longer steady.tau (slow modes then contract more per "
-                "evaluation), more realizations (the noise falls as 1/sqrt(R)), a larger "
-                "steady.difference_step when GMRES did not converge, steady.solver = anderson for "
-                "a stable "
-                "state",
-                history, r.state_noise.empty() ? 0.0 : r.state_noise.back(),
-                r.best_state_residual());
-        else
-            log::error(
-                "no branch point converged; the first point's residual history |F| [d_p]: {}. What "
-                "to try: a "
-                "longer steady.tau, more realizations, a larger steady.difference_step",
-                history);
-    }
+    if (sum.unconverged) report_unconverged(out);
     return sum;
+}
+
+void report_unconverged(const coarse::SteadyRunOutcome& out) {
+    const coarse::SteadySolveRecord& r = out.solve;
+    // In heights [d_p] like the run file's /steady/iterate/residual (the solver's own |F| is
+    // in its coordinates, log gaps with steady.coordinates = gaps).
+    std::string history;
+    for (std::size_t k = 0; k < r.state_residuals.size(); ++k)
+        history += fmt::format("{}{:.3e}", k ? ", " : "", r.state_residuals[k]);
+    log::error("{}", out.end_status);
+    if (!out.continuation)
+        log::error(
+            "residual history |F| [d_p]: {} (noise {:.3e}); the best iterate (|F| = {:.4e}) is "
+            "/steady/best in "
+            "the run file. What to try: a longer steady.tau (slow modes then contract more per "
+            "evaluation), more realizations (the noise falls as 1/sqrt(R)){}",
+            history, r.state_noise.empty() ? 0.0 : r.state_noise.back(), r.best_state_residual(),
+            out.solver == "newton"
+                ? ", a larger steady.difference_step when GMRES did not converge, steady.solver = "
+                  "anderson for a stable state"
+                : ", more steady.max_iterations while |F| still falls, steady.solver = newton for "
+                  "an unstable or nearly neutral state");
+    else
+        log::error(
+            "no branch point converged; the first point's residual history |F| [d_p]: {}. What "
+            "to try: a "
+            "longer steady.tau, more realizations, a larger steady.difference_step",
+            history);
 }
 
 }  // namespace efdem::mpi_driver

@@ -12,6 +12,8 @@
 ///   the best iterate in the run file, and RunSummary::unconverged (exit code 3);
 /// * a stop signal ends the run at the next sample with the iterates so far recorded (no
 ///   checkpoint: a solve holds kept micro states that a checkpoint does not).
+///
+/// A cpi run with cpi.hand_off = steady calls solve_steady() where its own loop ended.
 
 #include "coarse/demixing/ensemble_observable.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
@@ -23,5 +25,22 @@ namespace efdem::mpi_driver {
 
 RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& settings, RunRecorder* recorder,
                       Progress& progress);
+
+/// What solve_steady() found, and the signal that cut it short (0: none).
+struct SteadySolveResult {
+    coarse::SteadyRunOutcome outcome;
+    int stop_signal = 0;
+};
+
+/// The steady solve itself (settings.steady) from the stepper's current state, with the
+/// observers above (record, log, budget, signal): run_steady() and the hand-off of a cpi run
+/// (cpi.hand_off = steady) use it. The stepper is not finished. `hand_off_time`: the coarse time
+/// at which a cpi run handed its state over (NaN: mode = steady | continuation).
+SteadySolveResult solve_steady(EnsembleStepper& stepper, const RunSettings& settings,
+                               RunRecorder* recorder, Progress& progress, double hand_off_time);
+
+/// The error lines of a solve that did not reach its stopping rule: the residual history, where
+/// the best iterate is, and what to try.
+void report_unconverged(const coarse::SteadyRunOutcome& outcome);
 
 }  // namespace efdem::mpi_driver

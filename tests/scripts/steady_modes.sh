@@ -7,7 +7,9 @@
 #     with the smallest |F|; the run file is self-describing (check_run_file.py);
 #  3. a continuation in gas_drag.superficial_velocity records a branch starting at the
 #     scene's value and plot_steady.py draws it (PNG);
-#  4. bad input is refused (exit 2) naming the key.
+#  4. bad input is refused (exit 2) naming the key;
+#  5. a stop signal mid-solve exits 4 with the iterates so far;
+#  6. a cpi run with cpi.hand_off = steady ends in a steady solve from its last state.
 #   steady_modes.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 source "$(dirname "$0")/lib.sh" "$@"
 set -e
@@ -131,6 +133,33 @@ assert len(f["steady/iterate/residual"]) >= 2 and "best" in f["steady"]
 print("signal: interrupted with", len(f["steady/iterate/residual"]), "iterates recorded")
 PY
 
+# 6. cpi.hand_off = steady: a cpi run hands its end state to the steady solver (Anderson by
+#    default). The solve starts one sample after the cpi run's end from that sample's mean ICDF,
+#    converges by its rule (|F| <= 2 x noise), and the DEM time adds up exactly: the cpi run's
+#    warm-up and bursts, the solve's one-sample warm-up, its evaluations x tau.
+"$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=cpi ensemble.realizations_per_rank=2 cpi.hand_off=steady \
+  steady.tau=1 output.directory="$work" output.prefix=hand_off > "$work/hand_off.log" 2>&1 || { cat "$work/hand_off.log"; exit 1; }
+grep -q "cpi.hand_off: end state reached at t = 6" "$work/hand_off.log" || { echo "hand-off: no end-state line"; cat "$work/hand_off.log"; exit 1; }
+/usr/bin/python3 "$here/check_run_file.py" "$work/hand_off.h5"
+/usr/bin/python3 - "$work/hand_off.h5" <<'PY'
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1])
+s = f["steady"]
+assert str(f.attrs["end_status"]).startswith("completed; then the steady solve: completed"), f.attrs["end_status"]
+assert s.attrs["solver"] == "anderson" and s.attrs["converged"] == 1
+assert s.attrs["hand_off_time"] == 6.0          # run.duration of the tiny scene: the cpi run's end
+t = f["samples/time"][:]
+k = int(np.argmin(np.abs(t - 6.25)))            # one sample (observe.interval 0.25) after it
+assert abs(t[k] - 6.25) < 1e-9, t
+assert np.allclose(s["x0"][:], f["samples/mean_icdf"][k], rtol=0, atol=1e-12)
+r, noise = s["iterate/residual"][:], s["iterate/noise"][:]
+assert r[-1] <= 2 * noise[-1] and np.all(r[:-1] > 2 * noise[:-1]), (r, noise)  # stopped at its rule, not before
+assert s.attrs["dem_time"] == s.attrs["evaluations"] * 1.0
+cpi = 0.5 + f["cpi/burst_length"][:].sum()     # cpi.warmup 0.5 and the bursts
+assert abs(f.attrs["dem_time"] - (cpi + 0.25 + s.attrs["dem_time"])) < 1e-9, (f.attrs["dem_time"], cpi, s.attrs["dem_time"])
+print("hand-off: converged in", len(r) - 1, "iterations, |F| =", r[-1], "noise", noise[-1])
+PY
+
 refused() {  # WHAT KEY NP OVERRIDES...: exit 2 and the key in the message
   local what=$1 key=$2 np=$3; shift 3
   set +e
@@ -154,4 +183,7 @@ refused "drop on failure" "ensemble.on_failure" 2 mode=steady ensemble.on_failur
 refused "tau off the sampling grid" "steady.tau" 2 mode=steady steady.tau=0.3
 refused "gap coordinates of the compact vector" "steady.coordinates" 2 mode=steady steady.coordinates=gaps cpi.observable=compact
 refused "a restart" "restart" 2 mode=steady restart=$work/none_ckpt.h5
+refused "a hand-off with drop on failure" "ensemble.on_failure" 2 mode=cpi cpi.hand_off=steady ensemble.on_failure=drop
+refused "a hand-off of one realization" "cpi.hand_off" 1 mode=cpi cpi.hand_off=steady
+refused "a steady key without a hand-off" "steady.tau" 2 mode=cpi steady.tau=1
 echo "steady_modes: ok"

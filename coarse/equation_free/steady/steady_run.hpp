@@ -16,6 +16,7 @@
 /// stop on a budget) and each branch point.
 
 #include <functional>
+#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -39,7 +40,11 @@ struct SteadyRunOutcome {
     double difference_step = 0;
     std::string difference_step_origin;
     double warmup_end = 0;  ///< micro clock at the end of the warm-up
-    Eigen::VectorXd x0;     ///< the initial guess (last warm-up sample)
+    /// A cpi run that handed its state to the solve (cpi.hand_off = steady): the coarse time at
+    /// which it ended, the time the process took to reach the end state the solve then refined
+    /// (NaN: mode = steady | continuation, which start from a warm-up).
+    double hand_off_time = std::numeric_limits<double>::quiet_NaN();
+    Eigen::VectorXd x0;  ///< the initial guess (last warm-up sample)
     /// mode = steady: the solve, and the spectrum at its answer (empty: not computed).
     SteadySolveRecord solve;
     CoarseSpectrum spectrum;

@@ -19,17 +19,20 @@ void refuse(const Params& scope, const std::vector<const char*>& keys, const std
 }  // namespace
 
 SteadyRunSettings SteadyRunSettings::from_params(
-    const Params& root, double sample_interval, long dimension, bool continuation,
+    const Params& root, double sample_interval, long dimension, Use use,
     const std::vector<ContinuationParameter>& allowed_parameters,
     const std::function<double(const std::string&)>& current_value) {
     SteadyRunSettings s;
+    const bool continuation = use == Use::continuation;
+    const bool hand_off = use == Use::hand_off;
     s.continuation = continuation;
     const Params steady = root.scope("steady");
     const Params cont = root.scope("continuation");
     const char* interval = "observe.interval";
     const std::string solver =
         continuation ? std::string("newton")
-                     : steady.get_or_choice("solver", "newton", {"newton", "anderson"});
+                     : steady.get_or_choice("solver", hand_off ? "anderson" : "newton",
+                                            {"newton", "anderson"});
     if (continuation && steady.contains("solver") &&
         steady.get_or_choice("solver", "newton", {"newton", "anderson"}) != "newton")
         steady.fail(
@@ -40,7 +43,10 @@ SteadyRunSettings SteadyRunSettings::from_params(
     s.solver = solver == "anderson" ? Solver::anderson : Solver::newton;
     const bool newton = s.solver == Solver::newton;
 
-    s.warmup = steady.get_or<double>("warmup", 20.0, Bounds::open_closed(0.0, 1e7));
+    // A hand-off starts from the CPI run's last state: one sample gives the solver its initial
+    // guess and the members' noise.
+    s.warmup = steady.get_or<double>("warmup", hand_off ? sample_interval : 20.0,
+                                     Bounds::open_closed(0.0, 1e7));
     whole_multiple(steady, "warmup", s.warmup, sample_interval, interval);
     s.map.tau = steady.get_or<double>("tau", 20.0, Bounds::open_closed(0.0, 1e7));
     whole_multiple(steady, "tau", s.map.tau, sample_interval, interval);
@@ -77,7 +83,7 @@ SteadyRunSettings SteadyRunSettings::from_params(
                "is read only with steady.solver = newton",
                "remove it, or set steady.solver = newton");
     }
-    s.eigenvalues = steady.get_or<int>("eigenvalues", 3, Bounds::closed(0, 1000));
+    s.eigenvalues = steady.get_or<int>("eigenvalues", newton ? 3 : 0, Bounds::closed(0, 1000));
     if (s.eigenvalues > dim)
         steady.fail(
             "eigenvalues",

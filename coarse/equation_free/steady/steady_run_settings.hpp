@@ -8,9 +8,12 @@
 // clang-format off
 /// | key                       | meaning                                                     | default  |
 /// |---------------------------|-------------------------------------------------------------|----------|
-/// | steady.solver             | `newton` (Newton-GMRES, CRN derivatives) or `anderson`      | newton   |
-/// | steady.warmup             | direct simulation before the first evaluation; its last     | 20       |
-/// |                           | sample is the initial guess                                 |          |
+/// | steady.solver             | `newton` (Newton-GMRES, CRN derivatives) or `anderson`      | newton;  |
+/// |                           |                                                             | anderson |
+/// |                           |                                                             | hand-off |
+/// | steady.warmup             | direct simulation before the first evaluation; its last     | 20; one  |
+/// |                           | sample is the initial guess                                 | sample   |
+/// |                           |                                                             | hand-off |
 /// | steady.tau                | micro time of one evaluation of Phi_tau                     | 20       |
 /// | steady.coordinates        | `heights` (the ICDF nodes) or `gaps` (first node, log gaps) | heights  |
 /// | steady.difference_step    | h of the CRN differences J v (norm of the perturbation)     | 6 x noise|
@@ -22,7 +25,8 @@
 /// | steady.max_backtracks     | newton: line-search halvings                                | 3        |
 /// | steady.depth              | anderson: depth m (0: damped iteration)                     | 3        |
 /// | steady.damping            | anderson: beta in (0, 1]                                    | 1        |
-/// | steady.eigenvalues        | leading coarse eigenvalues at the solution (0: none)        | 3        |
+/// | steady.eigenvalues        | leading coarse eigenvalues at the solution (0: none)        | 3 newton,|
+/// |                           |                                                             | 0 anders.|
 /// | steady.eigenvalue_products| most J v products the Arnoldi process spends                | dim      |
 /// | continuation.parameter    | the scene key continued in                                  | required |
 /// | continuation.end          | the other end of the parameter range (start: the scene's)  | required |
@@ -37,6 +41,10 @@
 ///
 /// Newton-only keys are refused with steady.solver = anderson and the other way round;
 /// continuation.* keys are refused outside mode = continuation, which always uses Newton.
+/// A hand-off (cpi.hand_off = steady: the solve starts from where a CPI run ended) reads the
+/// same steady.* keys; its defaults differ where the CPI run already did the work: the state a
+/// forward integration reached is a stable one, so Anderson (no derivatives), and the warm-up is
+/// one sample of the CPI's last state.
 
 #include <functional>
 #include <string>
@@ -60,7 +68,10 @@ struct ContinuationParameter {
 
 struct SteadyRunSettings {
     enum class Solver { newton, anderson } solver = Solver::newton;
-    bool continuation = false;  ///< mode = continuation (else mode = steady)
+    /// What the keys are read for: mode = steady, mode = continuation, or the hand-off of a CPI
+    /// run to the steady solver (cpi.hand_off = steady).
+    enum class Use { steady, continuation, hand_off };
+    bool continuation = false;  ///< mode = continuation (else a steady solve)
     /// steady.coordinates: solve in the node heights or in the ICDF's gap coordinates
     /// (coarse/demixing/icdf_gap_coordinates.hpp; the caller supplies them).
     bool gap_coordinates = false;
@@ -88,11 +99,11 @@ struct SteadyRunSettings {
     ContinuationSettings branch;
 
     /// Reads the keys above. `sample_interval`: the stepper's (observe.interval), which tau and
-    /// warmup must be whole multiples of; `dimension`: of the coarse vector; `continuation`:
-    /// mode = continuation; `allowed_parameters`: the keys continuation.parameter may name, and
-    /// `current_value` the scene's value of one of them (the start of the branch).
+    /// warmup must be whole multiples of; `dimension`: of the coarse vector; `use`: which run
+    /// reads them (the defaults above); `allowed_parameters`: the keys continuation.parameter may
+    /// name, and `current_value` the scene's value of one of them (the start of the branch).
     static SteadyRunSettings from_params(
-        const Params& root, double sample_interval, long dimension, bool continuation,
+        const Params& root, double sample_interval, long dimension, Use use,
         const std::vector<ContinuationParameter>& allowed_parameters,
         const std::function<double(const std::string&)>& current_value);
 };
