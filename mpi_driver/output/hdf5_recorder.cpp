@@ -543,8 +543,10 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
         file_.attribute("/steady", "difference_step_origin", o.difference_step_origin);
     }
     file_.attribute("/steady", "warmup_end", o.warmup_end);
-    if (std::isfinite(o.hand_off_time))
+    if (std::isfinite(o.hand_off_time)) {
         file_.attribute("/steady", "hand_off_time", o.hand_off_time);
+        file_.attribute("/steady", "end_state_time", o.end_state_time);  // NaN: not reached
+    }
     file_.attribute("/steady", "evaluations", std::int64_t{o.evaluations});
     file_.attribute("/steady", "dem_time", o.micro_time);
     file_.attribute("/steady", "repairs", std::int64_t{o.repairs});

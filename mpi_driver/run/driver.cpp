@@ -2,15 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include <fmt/format.h>
+#include "coarse/equation_free/estimators/arrival_time.hpp"
 #include "coarse/equation_free/projective/projective_run.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 
 #include "mpi_driver/parallel/stop_signal.hpp"
 #include "mpi_driver/run/checkpoint_observer.hpp"
+#include "mpi_driver/run/kept_bursts_observer.hpp"
 #include "mpi_driver/run/progress_observer.hpp"
 #include "mpi_driver/run/steady_driver.hpp"
 #include "mpi_driver/run/step_report_observer.hpp"
@@ -49,11 +52,18 @@ void stopped(RunSummary& sum, const EnsembleStepper& stepper,
                           signal_name(sum.stop_signal), stepper.time(), sum.checkpoint,
                           checkpoint_time);
 }
+/// Within this of the solve's answer a kept burst's end state counts as at the end state: the
+/// solve's own stopping threshold on |F| (steady.noise_factor x the noise), times sqrt(2) because
+/// both the burst's state and the answer carry that noise.
+double arrival_radius(const RunSettings& s, double noise) {
+    return std::sqrt(2.0) * s.steady.newton.stop.noise_factor * noise;
+}
+
 /// cpi.hand_off = steady: the cpi run's state at its end goes to the steady solver; the run's
 /// end status and exit code then include the solve's (exit 3 when it does not converge). A
 /// signal ends the stepper here (exit 4; the solve is not checkpointed).
 void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder,
-              Progress& progress, RunSummary& sum) {
+              Progress& progress, const KeptBurstsObserver& kept, RunSummary& sum) {
     const double t_end = stepper.time();
     const double cpi_dem_time = stepper.micro_time();
     if (stepper.any_at_rest())
@@ -68,7 +78,15 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
         t_end, sum.end_status, cpi_dem_time,
         s.steady.solver == coarse::SteadyRunSettings::Solver::anderson ? "anderson" : "newton");
     stepper.begin_steady_solve();
-    const SteadySolveResult solved = solve_steady(stepper, s, recorder, progress, t_end);
+    // The time to the end state is known once the solve has found it: it is measured from the
+    // kept bursts, and recorded with the outcome (the recorder takes it from there).
+    std::function<double(const coarse::SteadyRunOutcome&)> arrival =
+        [&kept, &s](const coarse::SteadyRunOutcome& o) {
+            if (!o.converged || o.solve.state_noise.empty()) return std::nan("");
+            return coarse::arrival_time(kept.times(), kept.states(), o.solve.x,
+                                        arrival_radius(s, o.solve.state_noise.back()));
+        };
+    const SteadySolveResult solved = solve_steady(stepper, s, recorder, progress, t_end, arrival);
     const coarse::SteadyRunOutcome& out = solved.outcome;
     sum.end_status += "; then the steady solve: " + out.end_status;
     if (solved.stop_signal != 0) {
@@ -94,11 +112,22 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
                               (residual + noise) / (1.0 - mu), mu)
                         : fmt::format("; |mu_1| = {:.3g} >= 1: no band (not a stable state)", mu);
     }
+    const double radius = arrival_radius(s, noise);
+    const std::string reached =
+        std::isfinite(out.end_state_time)
+            ? fmt::format(
+                  "reached at t = {:.6g} (from the cpi run's kept burst ending then, every "
+                  "one lies within {:.3g} of it: sqrt(2) x steady.noise_factor x the noise)",
+                  out.end_state_time, radius)
+            : fmt::format(
+                  "not reached by the cpi run's bursts (its last kept burst is farther "
+                  "than {:.3g} from it: sqrt(2) x steady.noise_factor x the noise); the "
+                  "solve took it from t = {:.6g}",
+                  radius, t_end);
     log::info(
-        "cpi.hand_off: end state reached at t = {:.6g} (the cpi run's end), refined by {} "
-        "evaluations of Phi_{:g} ({:.4g} of DEM time; {:.4g} in all): |F| = {:.4g}, noise {:.4g}, "
-        "mean light height {:.4g} d_p{}",
-        t_end, out.evaluations, out.tau, out.micro_time, stepper.micro_time(), residual, noise,
+        "cpi.hand_off: end state {}; the solve refined it in {} evaluations of Phi_{:g} ({:.4g} of "
+        "DEM time; {:.4g} in all): |F| = {:.4g}, noise {:.4g}, mean light height {:.4g} d_p{}",
+        reached, out.evaluations, out.tau, out.micro_time, stepper.micro_time(), residual, noise,
         coarse::mean_height(r.x), band);
 }
 }  // namespace
@@ -191,6 +220,8 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
     if (checkpoints) run.add_observer(*checkpoints);
     run.add_observer(report);
     run.add_observer(progress_line);
+    KeptBurstsObserver kept;  // cpi.hand_off = steady: the time to the end state
+    if (s.hand_off) run.add_observer(kept);
 
     coarse::ProjectiveRunOutcome out;
     try {
@@ -229,7 +260,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
         sum.end_status += fmt::format(" with {} failure(s)", stepper.failures());
     sum.controller = run.integrator().summary(stepper.realizations(), out.coarse_steps);
     if (!sum.controller.empty()) log::info("{}", sum.controller);
-    if (s.hand_off) hand_off(stepper, s, recorder, progress, sum);
+    if (s.hand_off) hand_off(stepper, s, recorder, progress, kept, sum);
     if (sum.stop_signal == 0) stepper.finish();
     fill_totals(sum, stepper, progress);
     sum.lift_seconds = stepper.overhead().lift_seconds;

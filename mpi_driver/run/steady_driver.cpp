@@ -23,8 +23,10 @@ struct SolveTrace {
 };
 }  // namespace
 
-SteadySolveResult solve_steady(EnsembleStepper& stepper, const RunSettings& s,
-                               RunRecorder* recorder, Progress& progress, double hand_off_time) {
+SteadySolveResult solve_steady(
+    EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder, Progress& progress,
+    double hand_off_time,
+    const std::function<double(const coarse::SteadyRunOutcome&)>& end_state_time) {
     const coarse::SteadyRunSettings& ss = s.steady;
     coarse::EnsembleObservable& observable = stepper.observable();
     coarse::SteadyRun run(
@@ -106,6 +108,7 @@ SteadySolveResult solve_steady(EnsembleStepper& stepper, const RunSettings& s,
         out.end_status = interrupted_status();
     }
     out.hand_off_time = hand_off_time;
+    if (end_state_time) out.end_state_time = end_state_time(out);
     if (recorder) recorder->steady_outcome(out);
     return result;
 }

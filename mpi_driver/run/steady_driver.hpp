@@ -15,6 +15,8 @@
 ///
 /// A cpi run with cpi.hand_off = steady calls solve_steady() where its own loop ended.
 
+#include <functional>
+
 #include "coarse/demixing/ensemble_observable.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 #include "mpi_driver/output/progress.hpp"
@@ -36,8 +38,12 @@ struct SteadySolveResult {
 /// observers above (record, log, budget, signal): run_steady() and the hand-off of a cpi run
 /// (cpi.hand_off = steady) use it. The stepper is not finished. `hand_off_time`: the coarse time
 /// at which a cpi run handed its state over (NaN: mode = steady | continuation).
-SteadySolveResult solve_steady(EnsembleStepper& stepper, const RunSettings& settings,
-                               RunRecorder* recorder, Progress& progress, double hand_off_time);
+/// `end_state_time` (hand-off; may be empty): the time the process reached the solve's answer,
+/// from the outcome, before it is recorded.
+SteadySolveResult solve_steady(
+    EnsembleStepper& stepper, const RunSettings& settings, RunRecorder* recorder,
+    Progress& progress, double hand_off_time,
+    const std::function<double(const coarse::SteadyRunOutcome&)>& end_state_time = {});
 
 /// The error lines of a solve that did not reach its stopping rule: the residual history, where
 /// the best iterate is, and what to try.

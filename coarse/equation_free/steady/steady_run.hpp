@@ -44,6 +44,9 @@ struct SteadyRunOutcome {
     /// which it ended, the time the process took to reach the end state the solve then refined
     /// (NaN: mode = steady | continuation, which start from a warm-up).
     double hand_off_time = std::numeric_limits<double>::quiet_NaN();
+    /// A hand-off: when the cpi run's kept bursts reached the answer and stayed within the
+    /// solve's threshold of it (coarse::arrival_time; NaN: not reached, or not a hand-off).
+    double end_state_time = std::numeric_limits<double>::quiet_NaN();
     Eigen::VectorXd x0;  ///< the initial guess (last warm-up sample)
     /// mode = steady: the solve, and the spectrum at its answer (empty: not computed).
     SteadySolveRecord solve;
