@@ -3,8 +3,10 @@
 // colour assignments on the root, scatter, apply), timed through the real EnsembleStepper with
 // realizations of N particles that do not move (the DEM is not what is measured here).
 //
-//   mpirun -np P efdem_root_cost_benchmark N_PARTICLES PER_RANK [repeats=5]
-// Prints: R, N, median restriction and lift wall times [s] (barrier-synchronized).
+//   mpirun -np P efdem_root_cost_benchmark N_PARTICLES PER_RANK [repeats=5] [observable=icdf]
+// observable: a name of cpi.observable (icdf, ranks, ...): ranks also sorts every particle's height
+// per realization and sample (the whole-bed profile) and gathers it.
+// Prints: R, N, the observable, median restriction and lift wall times [s] (barrier-synchronized).
 #include <mpi.h>
 
 #include <algorithm>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "coarse/demixing/ensemble_observable.hpp"
+#include "coarse/demixing/observable_table.hpp"
 #include "core/rng.hpp"
 #include "dem/system.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
@@ -49,12 +52,18 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
     MPI_Init(&argc, &argv);
     if (argc < 3) {
-        std::fprintf(stderr, "usage: %s N_PARTICLES PER_RANK [repeats]\n", argv[0]);
+        std::fprintf(stderr, "usage: %s N_PARTICLES PER_RANK [repeats] [observable]\n", argv[0]);
         MPI_Abort(MPI_COMM_WORLD, 2);
     }
     const long n = std::atol(argv[1]);
     const int k = std::atoi(argv[2]);
     const int repeats = argc > 3 ? std::atoi(argv[3]) : 5;
+    const std::string name = argc > 4 ? argv[4] : "icdf";
+    const auto* row = coarse::observable_table().find(name);
+    if (row == nullptr) {
+        std::fprintf(stderr, "unknown observable '%s'\n", name.c_str());
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
     {
         const MpiComm world(MPI_COMM_WORLD);
         const EnsembleLayout layout(world, k);
@@ -65,9 +74,11 @@ int main(int argc, char** argv) {
         StepperSettings ss;
         ss.sample_interval = 1e-4;
         ss.steps_per_sample = 1;
-        coarse::IcdfObservable observable(19);
+        const std::unique_ptr<coarse::EnsembleObservable> observable =
+            row->make(coarse::ProbabilityGrid(19));
         const ColourLifter lifter;
-        EnsembleStepper stepper(layout, std::move(local), ss, observable, lifter, nullptr, nullptr);
+        EnsembleStepper stepper(layout, std::move(local), ss, *observable, lifter, nullptr,
+                                nullptr);
         std::vector<double> restrict_s, lift_s;
         for (int rep = 0; rep < repeats; ++rep) {
             coarse::BurstSamples burst;
@@ -88,8 +99,9 @@ int main(int argc, char** argv) {
             }
         }
         if (world.is_root())
-            std::printf("R=%d N=%ld ranks=%d restrict_seconds=%.6f lift_seconds=%.6f\n",
-                        layout.size(), n, world.size(), median(restrict_s), median(lift_s));
+            std::printf(
+                "R=%d N=%ld ranks=%d observable=%s restrict_seconds=%.6f lift_seconds=%.6f\n",
+                layout.size(), n, world.size(), name.c_str(), median(restrict_s), median(lift_s));
     }
     MPI_Finalize();
     return 0;
