@@ -30,6 +30,18 @@ The runs of section 2 (demo bed at U_s = 0.41, R = 4 on 2 ranks; run files not i
     mpirun -n 2 build/mpi_driver/efdem $S mode=direct seed=606 run.duration=300 \
         output.directory=runs/steady_end output.prefix=direct
 
+3. With --hand-off RUN.h5 ...: runs made with cpi.hand_off = steady (the cpi run's end refined by
+   the steady solver): the cpi run's end and the solve's answer against the direct time average,
+   the solve's band, the time to the end state as efdem states it, and, for every run and the
+   direct reference alike, when its state came within a fixed radius of the direct time average
+   for good (the same yardstick for all: the kept bursts' ends of a cpi run, every sample of the
+   direct run) and the DEM time that took. The runs (as above, plus cpi.hand_off = steady):
+
+    H="$S $C cpi.hand_off=steady steady.tau=20 run.duration=300 output.directory=runs/hand_off"
+    mpirun -n 2 build/mpi_driver/efdem $H cpi.observable=ranks output.prefix=ranks_300
+    mpirun -n 2 build/mpi_driver/efdem $H cpi.observable=ranks seed=515 output.prefix=ranks_300_s2
+    mpirun -n 2 build/mpi_driver/efdem $H output.prefix=icdf_300          # the ICDF, lift mean
+
 Writes bench/results/steady_end.md.
 """
 import argparse
@@ -55,6 +67,9 @@ DIRECT = [
     ("tall, U_s 0.41, R 4 (seed 101)", "tall_study_r4/u0.41/direct_a.h5"),
 ]
 WINDOW, EVERY, POOL, Z_STEADY, CONFIRM = 10.0, 20.0, 4, 2.0, 2
+# The slowest coarse mode of the demo bed at U_s = 0.41 over tau = 20: mu = exp(-0.044 x 20), the
+# direct ensemble's approach rate (docs/steady_states.md, "Measured on the DEM").
+MU_041 = 0.42
 
 
 def members(f):
@@ -158,17 +173,130 @@ def end_state(args, path):
     ]
 
 
+def hand_off_state(args, path):
+    """A run with cpi.hand_off = steady: the cpi run's state where it handed over (the mean ICDF
+    over its last --last units) and the steady solve's answer (the mean ICDF over the second half
+    of the solve's last evaluation of Phi_tau: the recorded light ICDF, comparable whatever
+    cpi.observable the solve worked in), each against the direct run's time average, beside the
+    floor of two independent ensembles' time averages."""
+    with h5py.File(path, "r") as f:
+        status = run_files.text(f.attrs["end_status"])
+        t = f["samples/time"][:]
+        mean = run_files.get(f, "samples/mean_icdf")[:]
+        s = f["steady"]
+        t_hand, tau = float(s.attrs["hand_off_time"]), float(s.attrs["tau"])
+        r_final, noise = s["iterate/residual"][-1], s["iterate/noise"][-1]
+        evaluations, solve_dem = int(s.attrs["evaluations"]), float(s.attrs["dem_time"])
+        dem_total = float(f.attrs["dem_time"])
+        # The time to the end state as efdem states it (runs made before it did: the same rule,
+        # coarse::arrival_time, from the kept bursts' end states and the answer, in the solve's
+        # coordinates).
+        if "end_state_time" in s.attrs:
+            arrival = float(s.attrs["end_state_time"])
+        else:
+            status_k = [run_files.text(v) for v in f["cpi/status"][:]]
+            kept = [k for k, st in enumerate(status_k) if st in ("projected", "burst_only")]
+            radius = math.sqrt(2.0) * 2.0 * noise  # steady.noise_factor = 2 (the default)
+            arrival = math.nan
+            for k in reversed(kept):
+                if np.linalg.norm(f["cpi/x_end"][k] - s["x"][:]) > radius:
+                    break
+                arrival = float(f["cpi/t_end"][k])
+        m = s["x"].shape[0]
+    before = (t <= t_hand + 1e-9) & (t >= t_hand - args.last - 1e-9)
+    cpi = mean[before].mean(axis=0)
+    last = t > t[-1] - tau / 2 + 1e-9
+    solved = mean[last].mean(axis=0)
+    with h5py.File(args.reference, "r") as f:
+        td, xd = members(f)
+    span = xd[td >= args.after - 1e-9]
+    direct = span.mean(axis=(0, 1))
+    r = span.shape[1]
+    floor = float(np.sqrt(2.0 * np.mean(span.mean(axis=0).var(axis=0, ddof=1)) / r))
+    rms = lambda a: float(np.sqrt(np.mean((a - direct) ** 2)))  # noqa: E731
+    return [
+        f"Run `{os.path.relpath(path)}`: {status}",
+        "",
+        "| | RMS from the direct time average [d_p] | in floors |",
+        "|---|---|---|",
+        f"| cpi run's end: mean ICDF over t = {t_hand - args.last:g}-{t_hand:g} | {rms(cpi):.3f} | {rms(cpi) / floor:.1f} |",
+        f"| steady solve ({evaluations} evaluations of Phi_{tau:g}, {solve_dem:g} of DEM time; final "
+        f"|F| = {r_final:.3f}, noise {noise:.3f}): mean ICDF over the last evaluation's second half "
+        f"| {rms(solved):.3f} | {rms(solved) / floor:.1f} |",
+        f"| floor: two independent ensembles' time averages (direct R = {r}, t >= {args.after:g}) | {floor:.3f} | 1 |",
+        f"| the solve's band per node, (\\|F\\| + noise) / (1 - mu) / sqrt(m), mu = {MU_041:g} (the direct "
+        f"ensemble's approach rate, docs/steady_states.md) | {(r_final + noise) / (1 - MU_041) / math.sqrt(m):.3f} | "
+        f"{(r_final + noise) / (1 - MU_041) / math.sqrt(m) / floor:.1f} |",
+        "",
+        "Time to the end state (the first kept burst from which every later one lies within sqrt(2) x 2 x "
+        f"the noise of the answer): " + (f"t = {arrival:g}" if math.isfinite(arrival) else "not reached by the bursts")
+        + ".",
+        "",
+        f"DEM time per realization: {dem_total - solve_dem:.0f} for the cpi run (its warm-up and bursts; the "
+        f"solve's one-sample warm-up included), {solve_dem:.0f} for the solve, {dem_total:.0f} in all, for "
+        f"{t_hand:g} time units of the process (the direct reference: {td[-1]:g} units).",
+    ]
+
+
+# Radii [d_p, norm over the 19 nodes] within which a state counts as at the direct time average:
+# 0.8 = sqrt(2) x 2 x the ICDF's noise norm at R = 4 (0.28: the ICDF solve's own threshold), i.e.
+# 0.18 d_p per node; 0.5 (0.11 per node) for a stricter look.
+RADII = (0.8, 0.5)
+
+
+def arrival(t, x, target, radius):
+    """The first t[k] from which every x[j >= k] lies within radius of target (NaN: never), the
+    rule of coarse::arrival_time."""
+    since = math.nan
+    for k in range(len(t) - 1, -1, -1):
+        if np.linalg.norm(x[k] - target) > radius:
+            break
+        since = float(t[k])
+    return since
+
+
+def arrivals(args, paths):
+    """When each run's state came within RADII of the direct time average for good, and at what
+    DEM time per realization (a cpi run: its warm-up and every burst up to then, rejected ones
+    included)."""
+    with h5py.File(args.reference, "r") as f:
+        td, xd = f["samples/time"][:], run_files.get(f, "samples/mean_icdf")[:]
+    target = xd[td >= args.after - 1e-9].mean(axis=0)
+    head = " | ".join(f"within {r:g} ({r / math.sqrt(len(target)):.2f} per node): t / DEM time" for r in RADII)
+    lines = [f"| run | {head} |", "|---|" + "---|" * len(RADII)]
+    cells = [f"{arrival(td, xd, target, r):.0f} / {arrival(td, xd, target, r):.0f}" for r in RADII]
+    lines.append(f"| direct (`{os.path.relpath(args.reference)}`, every sample) | " + " | ".join(cells) + " |")
+    for path in paths:
+        with h5py.File(path, "r") as f:
+            c = f["cpi"]
+            status = [run_files.text(v) for v in c["status"][:]]
+            t_end, burst, t0 = c["t_end"][:], c["burst_length"][:], float(c["t_start"][0])
+            t, x = f["samples/time"][:], run_files.get(f, "samples/mean_icdf")[:]
+        ends = np.array([t_end[k] for k, st in enumerate(status) if st in ("projected", "burst_only")])
+        states = x[[int(np.argmin(np.abs(t - e))) for e in ends]]
+        row = []
+        for r in RADII:
+            a = arrival(ends, states, target, r)
+            dem = t0 + sum(burst[k] for k in range(len(status)) if t_end[k] <= a + 1e-9) if math.isfinite(a) else math.nan
+            row.append("never" if not math.isfinite(a) else f"{a:.0f} / {dem:.0f}")
+        lines.append(f"| `{os.path.relpath(path)}` (kept bursts' ends) | " + " | ".join(row) + " |")
+    return lines
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--cpi", nargs="*", default=[], help="cpi runs made with cpi.finish = steady")
     p.add_argument("--reference", help="a long direct run of the same scene (own seed)")
     p.add_argument("--after", type=float, default=200.0, help="time from which the direct run is steady")
     p.add_argument("--last", type=float, default=100.0, help="span of a CPI run without a steady end")
+    p.add_argument("--hand-off", nargs="*", default=[], help="cpi runs made with cpi.hand_off = steady")
     args = p.parse_args()
     lines = ["# The fluidized end state of cpi.finish = steady\n",
              "Made by `/usr/bin/python3 bench/steady_end.py"
-             + (f" --cpi {' '.join(os.path.relpath(c) for c in args.cpi)} --reference "
-                f"{os.path.relpath(args.reference)} --after {args.after:g}" if args.cpi else "") + "`.\n",
+             + (f" --cpi {' '.join(os.path.relpath(c) for c in args.cpi)}" if args.cpi else "")
+             + (f" --hand-off {' '.join(os.path.relpath(c) for c in args.hand_off)}" if args.hand_off else "")
+             + (f" --reference {os.path.relpath(args.reference)} --after {args.after:g}"
+                if args.cpi or args.hand_off else "") + "`.\n",
              "## 1. The drift test on direct ensembles\n",
              f"Bursts emulated as {WINDOW:g}-unit windows every {EVERY:g} units; pool of {POOL}; t:z at the "
              f"last window's end; steady at z <= {Z_STEADY:g} at {CONFIRM} checks in a row.\n",
@@ -184,6 +312,11 @@ def main():
         lines += ["", "## 2. CPI runs' end states against a long direct time average\n"]
         for path in args.cpi:
             lines += end_state(args, path) + [""]
+    if args.hand_off:
+        lines += ["", "## 3. cpi.hand_off = steady: the cpi run's end refined by the steady solver\n"]
+        for path in args.hand_off:
+            lines += hand_off_state(args, path) + [""]
+        lines += ["### When each run reached the direct time average\n"] + arrivals(args, args.hand_off) + [""]
     text = "\n".join(lines) + "\n"
     print(text)
     with open(os.path.join(RESULTS, "steady_end.md"), "w") as f:
