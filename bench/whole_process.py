@@ -59,6 +59,12 @@ SLOW = {
     "members_moving": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving"},
     # the same with another seed: one draw does not set a default
     "members_moving_s505": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "seed": 505},
+    # members_moving in rank coordinates (cpi.observable = ranks: a lift the realizations' own beds
+    # can meet; at U_s = 0.41 it removed most of the ICDF lift's error, 2026-12-05)
+    "ranks_moving": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.observable": "ranks"},
+    # each realization by its own slope, relabelling where it moves: a bed slowing to rest has a
+    # slope near zero, so its lifts change few labels (the kicks that keep CPI beds moving)
+    "own_moving": {**ADAPTIVE, "cpi.lift": "own", "cpi.relabel": "moving"},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own)
 CASES = {
