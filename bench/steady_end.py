@@ -132,6 +132,20 @@ def cpi_pooled_z(f):
     return pooled_z(nodes)
 
 
+def reference_average(args):
+    """The direct run's time average over t >= --after, the floor of two independent ensembles'
+    time averages, and R. Two independent ensembles of R: their time averages differ by sqrt(2) x
+    the members' spread of their own time averages / sqrt(R) (the members' levels are nearly
+    frozen, so averaging over time does not shrink it; halves of one run share them and would
+    understate it)."""
+    with h5py.File(args.reference, "r") as f:
+        td, xd = members(f)
+    span = xd[td >= args.after - 1e-9]
+    r = span.shape[1]
+    floor = float(np.sqrt(2.0 * np.mean(span.mean(axis=0).var(axis=0, ddof=1)) / r))
+    return span.mean(axis=(0, 1)), floor, r
+
+
 def end_state(args, path):
     """The CPI run's end state (over the bursts the drift test pooled; when it did not end at a
     steady state, over its last --last time units) against the direct run's time average."""
@@ -144,15 +158,7 @@ def end_state(args, path):
     m = re.search(r"end state at t = ([0-9.e+-]+)", status)
     since = float(m.group(1)) - WINDOW / 2 if m else t[-1] - args.last
     cpi = mean[t >= since - 1e-9].mean(axis=0)
-    with h5py.File(args.reference, "r") as f:
-        td, xd = members(f)
-    span = xd[td >= args.after - 1e-9]
-    direct = span.mean(axis=(0, 1))
-    # Two independent ensembles of R: their time averages differ by sqrt(2) x the members'
-    # spread of their own time averages / sqrt(R) (the members' levels are nearly frozen, so
-    # averaging over time does not shrink it; halves of one run share them and would understate it).
-    r = span.shape[1]
-    floor = float(np.sqrt(2.0 * np.mean(span.mean(axis=0).var(axis=0, ddof=1)) / r))
+    direct, floor, r = reference_average(args)
     rms = float(np.sqrt(np.mean((cpi - direct) ** 2)))
     mid = len(cpi) // 2
     return [
@@ -192,27 +198,20 @@ def hand_off_state(args, path):
         # coarse::arrival_time, from the kept bursts' end states and the answer, in the solve's
         # coordinates).
         if "end_state_time" in s.attrs:
-            arrival = float(s.attrs["end_state_time"])
+            reached = float(s.attrs["end_state_time"])
         else:
             status_k = [run_files.text(v) for v in f["cpi/status"][:]]
             kept = [k for k, st in enumerate(status_k) if st in ("projected", "burst_only")]
             radius = math.sqrt(2.0) * 2.0 * noise  # steady.noise_factor = 2 (the default)
-            arrival = math.nan
-            for k in reversed(kept):
-                if np.linalg.norm(f["cpi/x_end"][k] - s["x"][:]) > radius:
-                    break
-                arrival = float(f["cpi/t_end"][k])
+            reached = arrival(f["cpi/t_end"][kept], f["cpi/x_end"][kept], s["x"][:], radius)
         m = s["x"].shape[0]
     before = (t <= t_hand + 1e-9) & (t >= t_hand - args.last - 1e-9)
     cpi = mean[before].mean(axis=0)
     last = t > t[-1] - tau / 2 + 1e-9
     solved = mean[last].mean(axis=0)
+    direct, floor, r = reference_average(args)
     with h5py.File(args.reference, "r") as f:
-        td, xd = members(f)
-    span = xd[td >= args.after - 1e-9]
-    direct = span.mean(axis=(0, 1))
-    r = span.shape[1]
-    floor = float(np.sqrt(2.0 * np.mean(span.mean(axis=0).var(axis=0, ddof=1)) / r))
+        td = f["samples/time"][:]
     rms = lambda a: float(np.sqrt(np.mean((a - direct) ** 2)))  # noqa: E731
     return [
         f"Run `{os.path.relpath(path)}`: {status}",
@@ -229,7 +228,7 @@ def hand_off_state(args, path):
         f"{(r_final + noise) / (1 - MU_041) / math.sqrt(m) / floor:.1f} |",
         "",
         "Time to the end state (the first kept burst from which every later one lies within sqrt(2) x 2 x "
-        f"the noise of the answer): " + (f"t = {arrival:g}" if math.isfinite(arrival) else "not reached by the bursts")
+        f"the noise of the answer): " + (f"t = {reached:g}" if math.isfinite(reached) else "not reached by the bursts")
         + ".",
         "",
         f"DEM time per realization: {dem_total - solve_dem:.0f} for the cpi run (its warm-up and bursts; the "
