@@ -88,7 +88,15 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
         };
     const SteadySolveResult solved = solve_steady(stepper, s, recorder, progress, t_end, arrival);
     const coarse::SteadyRunOutcome& out = solved.outcome;
-    sum.end_status += "; then the steady solve: " + out.end_status;
+    // The run's status leads with what a reader must know first: "completed" only when both
+    // parts did ("interrupted: ..." and "not converged: ..." otherwise, as in mode = steady).
+    sum.end_status =
+        out.converged && solved.stop_signal == 0
+            ? fmt::format("{}; then the steady solve: {}", sum.end_status, out.end_status)
+            : fmt::format(
+                  "{} (the steady solve of cpi.hand_off; the cpi run before "
+                  "it: {})",
+                  out.end_status, sum.end_status);
     if (solved.stop_signal != 0) {
         stepper.finish(kExitInterrupted);
         sum.stop_signal = solved.stop_signal;

@@ -177,6 +177,29 @@ assert len(s["iterate/residual"]) == 1  # converged at its start
 print("hand-off: end state reached at t =", s.attrs["end_state_time"])
 PY
 
+# 6b. A stop signal during a hand-off's solve: exit 4, the status leads with "interrupted" (a
+#     study counts the run as incomplete), and the message says a restart redoes the solve.
+setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=cpi ensemble.realizations_per_rank=2 cpi.hand_off=steady \
+  steady.tau=1 steady.noise_factor=0.001 steady.max_iterations=50 output.directory="$work" output.prefix=hand_off_sig \
+  > "$work/hand_off_sig.log" 2>&1 &
+job=$!
+for _ in $(seq 150); do grep -q "steady: solve 0 iterate 1:" "$work/hand_off_sig.log" 2>/dev/null && break; sleep 0.2; done
+kill -TERM $(ps -o pid=,comm= -s "$job" | awk '$2 == "efdem" {print $1}')
+set +e
+wait "$job"
+rc=$?
+set -e
+[ "$rc" = 4 ] || { echo "hand-off signal: exit $rc, expected 4"; cat "$work/hand_off_sig.log"; exit 1; }
+grep -q "restarting the cpi run's last checkpoint redoes it" "$work/hand_off_sig.log" || { echo "hand-off signal: no message"; cat "$work/hand_off_sig.log"; exit 1; }
+/usr/bin/python3 - "$work/hand_off_sig.h5" <<'PY'
+import sys, h5py
+f = h5py.File(sys.argv[1])
+status = str(f.attrs["end_status"])
+assert status.startswith("interrupted") and "the cpi run before it: completed" in status, status
+assert len(f["steady/iterate/residual"]) >= 2 and len(f["cpi/status"]) >= 1
+print("hand-off signal:", status[:60], "...")
+PY
+
 refused() {  # WHAT KEY NP OVERRIDES...: exit 2 and the key in the message
   local what=$1 key=$2 np=$3; shift 3
   set +e
