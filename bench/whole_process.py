@@ -123,6 +123,40 @@ def stops(run):
     return out
 
 
+# "Stopped demixing" without being at rest: the light ICDF of a realization moves by less than
+# QUIET d_p (the largest change of any node) over every later window of WINDOW units. Direct
+# realizations at U_s = 0.19 pass through three regimes (R = 8, 600 units, 2026-12-05): moving, a
+# node changes by 1e-2 to 1e-1 d_p in 10 units; creeping, 1e-5 to 1e-3 for hundreds of units with
+# particles still moving (never at rest); at rest, 0. A creeping realization moves its ICDF by at
+# most 1e-4 d_p per unit: 0.1 d_p over 1,000 units, below the floor (0.23): it has stopped demixing.
+WINDOW, QUIET = 10.0, 1e-3
+
+
+def demixing_stops(run):
+    """Per realization: from when its light ICDF moved by less than QUIET in every full window of
+    contiguous samples (a CPI run's bursts) to the end (NaN: it still moved in the last one)."""
+    t, q = run["t"], run["icdf"]
+    dt = float(np.median(np.diff(t)))
+    out = []
+    for r in range(q.shape[1]):
+        since, first = float("nan"), 0
+        ends = []
+        for k in range(len(t)):
+            if k > 0 and t[k] - t[k - 1] > 1.5 * dt:
+                first = k  # a jump: a new burst starts
+            if t[k] - t[first] < WINDOW - 1e-6:
+                continue
+            lo = int(np.searchsorted(t, t[k] - WINDOW - 1e-6))
+            w = q[max(lo, first):k + 1, r, :]
+            ends.append((float(t[k]), float((w.max(axis=0) - w.min(axis=0)).max()) <= QUIET))
+        for tk, quiet in reversed(ends):
+            if not quiet:
+                break
+            since = tk
+        out.append(since)
+    return out
+
+
 def held_to(run, t):
     """The run's ensemble mean at the times t; past its last sample a run that ended at its end
     state is held there (nothing changes in an end state)."""
@@ -179,11 +213,12 @@ def analyse_case(args, case):
     direct_medians = np.concatenate([state_at(d, span) for d in directs])
     d_mean, d_se = float(direct_medians.mean()), float(direct_medians.std(ddof=1) / math.sqrt(len(direct_medians)))
     direct_stops = [s for d in directs for s in stops(d)]
+    direct_quiet = [s for d in directs for s in demixing_stops(d)]
     last_stop = max(direct_stops) if all(np.isfinite(direct_stops)) else float("nan")
     summary = {"case": case, "span": span, "floor": floor[whole], "floor_quarters": [floor[w] for w in quarters],
                "direct_end_median": d_mean, "direct_end_median_se": d_se,
                "direct_stopped": int(np.isfinite(direct_stops).sum()), "direct_realizations": len(direct_stops),
-               "direct_all_at_rest_at": last_stop, "cpi": {}}
+               "direct_all_at_rest_at": last_stop, "direct_stopped_demixing": direct_quiet, "cpi": {}}
     lines = [f"## {case}: {scene.split('_')[0]} bed, U_s = {us}, R = {realizations}, {duration:g} time units\n",
              (f"**Compared over t = 0-{span:g} only** (directs still short: {', '.join(shorter)}).\n"
               if span < duration - 1e-6 else ""),
@@ -195,9 +230,12 @@ def analyse_case(args, case):
              f"{len(direct_stops)} (stop times "
              + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_stops) + "). "
              f"State at t = {span:g} (median light height, pooled): {d_mean:.2f} +- {d_se:.2f} d_p.\n",
+             f"Direct realizations that stopped demixing (light ICDF moving < {QUIET:g} d_p per {WINDOW:g} units "
+             f"to the end of the run, at rest or not): {int(np.isfinite(direct_quiet).sum())} of {len(direct_quiet)} "
+             "(since " + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_quiet) + ").\n",
              f"| CPI run | ended | e / floor by quarter | e / floor | median at t = {span:g} [d_p] | off the "
-             "directs' [s.e.] | realizations at rest (stop times) | DEM-time speed-up over the span | to the end "
-             "state: direct / CPI DEM time | wall-time speed-up |", "|---" * 10 + "|"]
+             "directs' [s.e.] | realizations at rest (stop times) | stopped demixing (since) | DEM-time speed-up "
+             "over the span | to the end state: direct / CPI DEM time | wall-time speed-up |", "|---" * 11 + "|"]
     for name in cpi:
         if name not in runs:
             continue
@@ -208,6 +246,7 @@ def analyse_case(args, case):
         c_mean, c_se = float(med.mean()), float(med.std(ddof=1) / math.sqrt(len(med)))
         off = (c_mean - d_mean) / math.sqrt(d_se ** 2 + c_se ** 2)
         cpi_stops = stops(run)
+        cpi_quiet = demixing_stops(run)
         # DEM time within the span: a CPI run samples only in its bursts.
         dem = float(np.sum(run["t"] <= span + 1e-6)) * interval
         speed = min(span, float(run["t"][-1])) / dem
@@ -220,12 +259,15 @@ def analyse_case(args, case):
                  else f"{float(run['simulated_time']):g} (duration)")
         summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole], "e_over_floor_quarters":
                                 [e[w] / floor[w] for w in quarters], "median": c_mean, "median_se": c_se,
-                                "off_se": off, "stops": cpi_stops, "speedup_dem": speed,
+                                "off_se": off, "stops": cpi_stops, "stopped_demixing": cpi_quiet,
+                                "speedup_dem": speed,
                                 "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"]}
         lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / floor[w]:.2f}" for w in quarters)
                      + f" | {e[whole] / floor[whole]:.2f} | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
                      f"{int(np.isfinite(cpi_stops).sum())} of {len(cpi_stops)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
+                     + f") | {int(np.isfinite(cpi_quiet).sum())} of {len(cpi_quiet)} ("
+                     + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_quiet)
                      + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-") + " |")
     lines.append("")
     # While some directs are short, the state at the end of the run against those that got there.
