@@ -177,6 +177,19 @@ assert len(s["iterate/residual"]) == 1  # converged at its start
 print("hand-off: end state reached at t =", s.attrs["end_state_time"])
 PY
 
+# 6c. A cpi run with a hand-off restarted from its checkpoint after the first coarse step ends
+#     bit for bit as the uninterrupted run: the cpi part continues exactly, and the solve then
+#     starts from the same state (compare_runs.py compares /steady too).
+rs=(mode=cpi ensemble.realizations_per_rank=2 cpi.hand_off=steady steady.tau=1 checkpoint.interval=1
+    output.directory="$work/rs" output.prefix=ho)
+"$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${rs[@]}" > "$work/rs_a.log" 2>&1 || { cat "$work/rs_a.log"; exit 1; }
+cp "$work/rs/ho.h5" "$work/rs_reference.h5"
+"$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${rs[@]}" restart="$work/rs/ho_ckpt_00000001.h5" > "$work/rs_b.log" 2>&1 \
+  || { cat "$work/rs_b.log"; exit 1; }
+grep -q "restarted from" "$work/rs_b.log" || { echo "hand-off restart: did not restart"; exit 1; }
+/usr/bin/python3 "$here/compare_runs.py" "$work/rs_reference.h5" "$work/rs/ho.h5"
+/usr/bin/python3 -c "import h5py, sys; f = h5py.File(sys.argv[1]); assert 'x' in f['steady'], 'no /steady/x'" "$work/rs/ho.h5"
+
 # 6b. A stop signal during a hand-off's solve: exit 4, the status leads with "interrupted" (a
 #     study counts the run as incomplete), and the message says a restart redoes the solve.
 setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=cpi ensemble.realizations_per_rank=2 cpi.hand_off=steady \
