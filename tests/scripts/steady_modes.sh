@@ -110,18 +110,23 @@ assert np.all(np.diff(s["iterate/x"][:], axis=1) > 0)
 print("gaps: answer in heights, increasing; repairs", s.attrs["repairs"], "of", s.attrs["evaluations"])
 PY
 
+stop_mid_solve() {  # LOG PATTERN OVERRIDES...: efdem on 2 ranks, SIGTERM to every rank once LOG shows PATTERN; sets rc
+  local log=$1 pattern=$2
+  shift 2
+  setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "$@" > "$log" 2>&1 &
+  local job=$!
+  for _ in $(seq 150); do grep -q "$pattern" "$log" 2>/dev/null && break; sleep 0.2; done
+  kill -TERM $(ps -o pid=,comm= -s "$job" | awk '$2 == "efdem" {print $1}')
+  set +e
+  wait "$job"
+  rc=$?
+  set -e
+}
+
 # 5. A stop signal to every rank mid-solve: exit 4 within seconds, the run file marked
 #    interrupted with the iterates so far and the best one.
-setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=steady run.duration=0 steady.warmup=1 steady.tau=1 \
-  steady.max_iterations=50 steady.max_krylov=3 steady.eigenvalues=0 output.directory="$work" output.prefix=sig \
-  > "$work/sig.log" 2>&1 &
-job=$!
-for _ in $(seq 100); do grep -q "iterate 1:" "$work/sig.log" 2>/dev/null && break; sleep 0.2; done
-kill -TERM $(ps -o pid=,comm= -s "$job" | awk '$2 == "efdem" {print $1}')
-set +e
-wait "$job"
-rc=$?
-set -e
+stop_mid_solve "$work/sig.log" "iterate 1:" mode=steady run.duration=0 steady.warmup=1 steady.tau=1 \
+  steady.max_iterations=50 steady.max_krylov=3 steady.eigenvalues=0 output.directory="$work" output.prefix=sig
 [ "$rc" = 4 ] || { echo "signal: exit $rc, expected 4"; cat "$work/sig.log"; exit 1; }
 grep -q "the iterates so far and the best one are in" "$work/sig.log" || { echo "signal: no message"; cat "$work/sig.log"; exit 1; }
 /usr/bin/python3 "$here/check_run_file.py" "$work/sig.h5"
@@ -192,16 +197,9 @@ grep -q "restarted from" "$work/rs_b.log" || { echo "hand-off restart: did not r
 
 # 6b. A stop signal during a hand-off's solve: exit 4, the status leads with "interrupted" (a
 #     study counts the run as incomplete), and the message says a restart redoes the solve.
-setsid "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=cpi ensemble.realizations_per_rank=2 cpi.hand_off=steady \
-  steady.tau=1 steady.noise_factor=0.001 steady.max_iterations=50 output.directory="$work" output.prefix=hand_off_sig \
-  > "$work/hand_off_sig.log" 2>&1 &
-job=$!
-for _ in $(seq 150); do grep -q "steady: solve 0 iterate 1:" "$work/hand_off_sig.log" 2>/dev/null && break; sleep 0.2; done
-kill -TERM $(ps -o pid=,comm= -s "$job" | awk '$2 == "efdem" {print $1}')
-set +e
-wait "$job"
-rc=$?
-set -e
+stop_mid_solve "$work/hand_off_sig.log" "steady: solve 0 iterate 1:" mode=cpi ensemble.realizations_per_rank=2 \
+  cpi.hand_off=steady steady.tau=1 steady.noise_factor=0.001 steady.max_iterations=50 output.directory="$work" \
+  output.prefix=hand_off_sig
 [ "$rc" = 4 ] || { echo "hand-off signal: exit $rc, expected 4"; cat "$work/hand_off_sig.log"; exit 1; }
 grep -q "restarting the cpi run's last checkpoint redoes it" "$work/hand_off_sig.log" || { echo "hand-off signal: no message"; cat "$work/hand_off_sig.log"; exit 1; }
 /usr/bin/python3 - "$work/hand_off_sig.h5" <<'PY'
