@@ -546,6 +546,9 @@ void Hdf5Recorder::steady_outcome(const coarse::SteadyRunOutcome& o) {
     if (std::isfinite(o.hand_off_time)) {
         file_.attribute("/steady", "hand_off_time", o.hand_off_time);
         file_.attribute("/steady", "end_state_time", o.end_state_time);  // NaN: not reached
+        // 1: a resumed run saw no burst outside the radius; the time is an upper bound.
+        file_.attribute("/steady", "end_state_time_is_bound",
+                        std::int64_t{o.end_state_time_is_bound ? 1 : 0});
     }
     file_.attribute("/steady", "evaluations", std::int64_t{o.evaluations});
     file_.attribute("/steady", "dem_time", o.micro_time);

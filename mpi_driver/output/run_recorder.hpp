@@ -44,6 +44,9 @@ struct RunSummary {
     /// mode = steady | continuation: the solve did not reach its stopping rule (exit code 3;
     /// the best iterate is in the run file).
     bool unconverged = false;
+    /// A steady solve (mode = steady | continuation, or a cpi run's hand-off) was stopped by a
+    /// signal: nothing of it can be continued from a checkpoint.
+    bool solve_interrupted = false;
 };
 
 /// mode = steady | continuation: one iterate of a solve, as it comes.

@@ -80,12 +80,13 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
     stepper.begin_steady_solve();
     // The time to the end state is known once the solve has found it: it is measured from the
     // kept bursts, and recorded with the outcome (the recorder takes it from there).
-    std::function<double(const coarse::SteadyRunOutcome&)> arrival =
-        [&kept, &s](const coarse::SteadyRunOutcome& o) {
-            if (!o.converged || o.solve.state_noise.empty()) return std::nan("");
-            return coarse::arrival_time(kept.times(), kept.states(), o.solve.x,
-                                        arrival_radius(s, o.solve.state_noise.back()));
-        };
+    std::function<void(coarse::SteadyRunOutcome&)> arrival = [&kept,
+                                                              &s](coarse::SteadyRunOutcome& o) {
+        if (!o.converged || o.solve.state_noise.empty()) return;
+        o.end_state_time = coarse::arrival_time(kept.times(), kept.states(), o.solve.x,
+                                                arrival_radius(s, o.solve.state_noise.back()));
+        o.end_state_time_is_bound = kept.only_a_bound(o.end_state_time);
+    };
     const SteadySolveResult solved = solve_steady(stepper, s, recorder, progress, t_end, arrival);
     const coarse::SteadyRunOutcome& out = solved.outcome;
     // The run's status leads with what a reader must know first: "completed" only when both
@@ -100,6 +101,7 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
     if (solved.stop_signal != 0) {
         stepper.finish(kExitInterrupted);
         sum.stop_signal = solved.stop_signal;
+        sum.solve_interrupted = true;
         return;
     }
     sum.unconverged = !out.converged;
@@ -124,8 +126,11 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
     const std::string reached =
         std::isfinite(out.end_state_time)
             ? fmt::format(
-                  "reached at t = {:.6g} (from the cpi run's kept burst ending then, every "
+                  "reached {}t = {:.6g} (from the cpi run's kept burst ending then, every "
                   "one lies within {:.3g} of it: sqrt(2) x steady.noise_factor x the noise)",
+                  out.end_state_time_is_bound ? "at or before (this process resumed a checkpoint "
+                                                "and saw no burst outside it) "
+                                              : "at ",
                   out.end_state_time, radius)
             : fmt::format(
                   "not reached by the cpi run's bursts (its last kept burst is farther "
@@ -228,7 +233,7 @@ RunSummary run_cpi(EnsembleStepper& stepper, const RunSettings& s,
     if (checkpoints) run.add_observer(*checkpoints);
     run.add_observer(report);
     run.add_observer(progress_line);
-    KeptBurstsObserver kept;  // cpi.hand_off = steady: the time to the end state
+    KeptBurstsObserver kept(control.resume.has_value());  // cpi.hand_off: the time to the end state
     if (s.hand_off) run.add_observer(kept);
 
     coarse::ProjectiveRunOutcome out;

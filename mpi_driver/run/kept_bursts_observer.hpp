@@ -15,12 +15,21 @@ namespace efdem::mpi_driver {
 
 class KeptBurstsObserver final : public coarse::ProjectiveRunObserver {
   public:
+    /// `resumed`: the run continues a checkpoint, and the bursts before it are not seen here.
+    explicit KeptBurstsObserver(bool resumed = false) : resumed_(resumed) {}
+    /// Whether `time` (an arrival_time over times()) may be later than the true one: the run was
+    /// resumed and every burst seen here was already within the radius, so the state may have
+    /// arrived before the checkpoint.
+    bool only_a_bound(double time) const {
+        return resumed_ && !times_.empty() && time == times_.front();
+    }
     void step_done(const coarse::ProjectiveRun& run,
                    const coarse::ProjectiveStepRecord& record) override;
     const std::vector<double>& times() const { return times_; }
     const std::vector<Eigen::VectorXd>& states() const { return states_; }
 
   private:
+    bool resumed_;
     std::vector<double> times_;
     std::vector<Eigen::VectorXd> states_;
 };

@@ -23,7 +23,7 @@ int report_end(const RunSummary& summary, const RunSettings& s, const ParamTable
         format_duration(summary.wall_seconds), summary.particle_steps);
     if (summary.stop_signal == 0) return summary.unconverged ? kExitRuntimeFailure : kExitOk;
     const std::string signal = signal_name(summary.stop_signal);
-    if (s.solves_steady() && summary.checkpoint.empty()) {
+    if (summary.solve_interrupted) {
         log::notice(
             "stopped by {}; the iterates so far and the best one are in {}/{}.h5 ({} cannot be "
             "continued from a checkpoint{})",

@@ -25,8 +25,7 @@ struct SolveTrace {
 
 SteadySolveResult solve_steady(
     EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recorder, Progress& progress,
-    double hand_off_time,
-    const std::function<double(const coarse::SteadyRunOutcome&)>& end_state_time) {
+    double hand_off_time, const std::function<void(coarse::SteadyRunOutcome&)>& end_state_time) {
     const coarse::SteadyRunSettings& ss = s.steady;
     coarse::EnsembleObservable& observable = stepper.observable();
     coarse::SteadyRun run(
@@ -108,7 +107,7 @@ SteadySolveResult solve_steady(
         out.end_status = interrupted_status();
     }
     out.hand_off_time = hand_off_time;
-    if (end_state_time) out.end_state_time = end_state_time(out);
+    if (end_state_time) end_state_time(out);
     if (recorder) recorder->steady_outcome(out);
     return result;
 }
@@ -121,6 +120,7 @@ RunSummary run_steady(EnsembleStepper& stepper, const RunSettings& s, RunRecorde
     const coarse::SteadyRunOutcome& out = result.outcome;
     RunSummary sum;
     sum.stop_signal = result.stop_signal;
+    sum.solve_interrupted = result.stop_signal != 0;
     stepper.finish(sum.stop_signal ? kExitInterrupted : 0);
     sum.end_status = out.end_status;
     sum.unconverged = sum.stop_signal == 0 && !out.converged;

@@ -38,12 +38,12 @@ struct SteadySolveResult {
 /// observers above (record, log, budget, signal): run_steady() and the hand-off of a cpi run
 /// (cpi.hand_off = steady) use it. The stepper is not finished. `hand_off_time`: the coarse time
 /// at which a cpi run handed its state over (NaN: mode = steady | continuation).
-/// `end_state_time` (hand-off; may be empty): the time the process reached the solve's answer,
-/// from the outcome, before it is recorded.
+/// `end_state_time` (hand-off; may be empty): fills the outcome's time to the end state from its
+/// answer, before it is recorded.
 SteadySolveResult solve_steady(
     EnsembleStepper& stepper, const RunSettings& settings, RunRecorder* recorder,
     Progress& progress, double hand_off_time,
-    const std::function<double(const coarse::SteadyRunOutcome&)>& end_state_time = {});
+    const std::function<void(coarse::SteadyRunOutcome&)>& end_state_time = {});
 
 /// The error lines of a solve that did not reach its stopping rule: the residual history, where
 /// the best iterate is, and what to try.

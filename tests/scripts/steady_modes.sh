@@ -194,6 +194,22 @@ cp "$work/rs/ho.h5" "$work/rs_reference.h5"
 grep -q "restarted from" "$work/rs_b.log" || { echo "hand-off restart: did not restart"; exit 1; }
 /usr/bin/python3 "$here/compare_runs.py" "$work/rs_reference.h5" "$work/rs/ho.h5"
 /usr/bin/python3 -c "import h5py, sys; f = h5py.File(sys.argv[1]); assert 'x' in f['steady'], 'no /steady/x'" "$work/rs/ho.h5"
+# With every kept burst inside the radius (50 x the noise) the uninterrupted run's end state is its
+# first kept burst; the restarted process saw none of the bursts before its checkpoint, so its time
+# is later and marked an upper bound (end_state_time_is_bound = 1), not passed off as exact.
+rs_wide=("${rs[@]/output.prefix=ho/output.prefix=ho_wide}" steady.noise_factor=50)
+"$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${rs_wide[@]}" > "$work/rs_c.log" 2>&1 || { cat "$work/rs_c.log"; exit 1; }
+cp "$work/rs/ho_wide.h5" "$work/rs_wide_reference.h5"
+"$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" "${rs_wide[@]}" restart="$work/rs/ho_wide_ckpt_00000001.h5" \
+  > "$work/rs_d.log" 2>&1 || { cat "$work/rs_d.log"; exit 1; }
+grep -q "end state reached at or before" "$work/rs_d.log" || { echo "hand-off restart: no bound in the log"; cat "$work/rs_d.log"; exit 1; }
+/usr/bin/python3 - "$work/rs_wide_reference.h5" "$work/rs/ho_wide.h5" <<'PY'
+import sys, h5py
+a, b = (h5py.File(p)["steady"].attrs for p in sys.argv[1:])
+assert a["end_state_time_is_bound"] == 0 and b["end_state_time_is_bound"] == 1, (a["end_state_time_is_bound"], b["end_state_time_is_bound"])
+assert b["end_state_time"] > a["end_state_time"], (a["end_state_time"], b["end_state_time"])
+print("hand-off restart: end state at", a["end_state_time"], "; after the restart an upper bound", b["end_state_time"])
+PY
 
 # 6b. A stop signal during a hand-off's solve: exit 4, the status leads with "interrupted" (a
 #     study counts the run as incomplete), and the message says a restart redoes the solve.

@@ -47,6 +47,9 @@ struct SteadyRunOutcome {
     /// A hand-off: when the cpi run's kept bursts reached the answer and stayed within the
     /// solve's threshold of it (coarse::arrival_time; NaN: not reached, or not a hand-off).
     double end_state_time = std::numeric_limits<double>::quiet_NaN();
+    /// The run resumed a checkpoint and every burst it saw was within the radius: the end state
+    /// may have been reached before, so end_state_time is an upper bound.
+    bool end_state_time_is_bound = false;
     Eigen::VectorXd x0;  ///< the initial guess (last warm-up sample)
     /// mode = steady: the solve, and the spectrum at its answer (empty: not computed).
     SteadySolveRecord solve;
