@@ -123,10 +123,10 @@ def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None, beds=
 
 
 # What a study keeps of a run, in the run file's own layout: the groups its analysis reads and the
-# root attributes. The working folders (runs/) are not part of a checkout, and a study outlives the
-# machine it started on only through these files: one per run, committed under bench/results/, so
-# that a study continues in a fresh clone. They are compact (below): 1-2 MB for 1,000 units of a
-# demo-bed ensemble of R = 4-8, where the run file is 5 MB and more.
+# root attributes, one file per run under bench/results/ (not committed: study run files stay out of
+# git; the analysis, the plots and the commands that regenerate them are). A study skips a run
+# whose archive is there. They are compact (below): 0.3-1.2 MB for a demo-bed ensemble of
+# R = 4-8 over 600-1,000 units, where the run file is 5 MB and more.
 ARCHIVED_GROUPS = ("samples", "cpi", "realization", "p", "bed", "steady")
 
 

@@ -79,7 +79,7 @@ if "bed.write" not in open(os.path.join(work, "d3", "command.txt")).read():
     fail("a run of another seed (another bed) did not settle its own")
 print("PASS: a study keeps a bed once and starts its later runs of that bed from it")
 
-# The archive a study commits (one per run): the kept groups, compact. Time axes and 1-D series are
+# The archive a study keeps (one per run, not in git): the kept groups, compact. Time axes and 1-D series are
 # exact; members' arrays are float32, within 1e-6 relative of the run file (7 significant digits:
 # 1e-5 d_p at 10 d_p, far below any noise floor a study reads).
 import numpy as np
