@@ -223,8 +223,7 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
             fmt::format(
                 "is not supported with {}: the solve compares evaluations of the same ensemble, "
                 "which a dropped or replaced realization would change",
-                s.is_steady() ? fmt::format("mode = {}", s.mode_name())
-                              : std::string("cpi.hand_off = steady")),
+                s.steady_solve_key()),
             "abort with mode = steady or continuation, or with cpi.hand_off = steady");
     if (s.on_failure.action == FailurePolicy::Action::replace && !s.is_cpi())
         ensemble.fail(
@@ -257,6 +256,10 @@ const char* RunSettings::mode_name() const {
     return "?";
 }
 
+std::string RunSettings::steady_solve_key() const {
+    return is_steady() ? fmt::format("mode = {}", mode_name()) : "cpi.hand_off = steady";
+}
+
 void RunSettings::check_ensemble(const Params& root, int realizations) {
     // A run that measures the spread of the realizations' slopes needs two of them to the end.
     const bool spread = is_cpi() && cpi.projection == coarse::CpiSettings::Projection::adaptive;
@@ -268,8 +271,7 @@ void RunSettings::check_ensemble(const Params& root, int realizations) {
     if (solves_steady()) {
         // The key that asked for the solve: the mode, or the hand-off of a cpi run.
         const bool by_mode = is_steady();
-        const std::string asked =
-            by_mode ? fmt::format("mode = {}", mode_name()) : "cpi.hand_off = steady";
+        const std::string asked = steady_solve_key();
         if (realizations < 2) {
             const std::string why = fmt::format(
                 "{} stops its solve at the noise level of the ensemble, measured from the spread "

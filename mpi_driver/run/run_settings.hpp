@@ -133,6 +133,9 @@ struct RunSettings {
     /// The run solves for a steady state: mode = steady or continuation, or a cpi run that hands
     /// its end to the steady solver.
     bool solves_steady() const { return is_steady() || (is_cpi() && hand_off); }
+    /// What asked for the solve, for messages: "mode = steady | continuation" or
+    /// "cpi.hand_off = steady".
+    std::string steady_solve_key() const;
     /// The run lifts coarse vectors onto the realizations (cpi, steady, continuation).
     bool lifts() const { return mode != Mode::direct; }
     /// "direct", "cpi", "steady" or "continuation".
