@@ -16,8 +16,10 @@ the end of 4 sample intervals in a row), else as in bench/stop_times.py (the lig
 again by more than 1e-6 d_p). Until a case's own direct runs are there, the shorter runs of the
 same seeds from an earlier study (EARLIER) stand in, and the comparison covers their span.
 
-Cost (AMD EPYC, 2 shared cores, R = 4): a demo-bed direct run of 1,000 units ~50 min, a CPI run
-13-50 min (the load varies); a tall-bed direct run of 600 units ~2 h.
+Cost (AMD EPYC, 2 cores, R = 4): a demo-bed direct run of 1,000 units 20 min on an idle machine
+(50-90 min shared), a CPI run 10-50 min; a tall-bed direct run of 600 units at R = 8 about 2 h
+idle. The tall bed's R = 4 cases take their directs from the R = 8 ones (DIRECTS_FROM): run
+`--case tall_u0.41_r8 --only direct_a direct_b direct_c` for both.
 """
 import argparse
 import json
@@ -66,23 +68,58 @@ SLOW = {
     # slope near zero, so its lifts change few labels (the kicks that keep CPI beds moving)
     "own_moving": {**ADAPTIVE, "cpi.lift": "own", "cpi.relabel": "moving"},
 }
-# case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own)
+# The tall bed (3,120 spheres, the paper's height at a quarter of its area; bench/scenes/tall_bed.cfg):
+# its floor is about three times the demo bed's in d_p (docs/accuracy_vs_cost.md, "The tall bed"), so
+# the per-jump tolerances are twice the demo bed's and the accuracy key (one value for every bed,
+# issue 34 item 1) runs beside them. U_s = 0.41: rank coordinates (the lift a segregated bed can
+# meet, 1.8-2.4x the floor at the demo bed's steady state) and bursts 2 + 20 (the waves' window).
+TALL_SLOW = {
+    "members_moving": {**ADAPTIVE, "cpi.tolerance": 0.32, "cpi.lift": "members", "cpi.relabel": "moving"},
+    "ranks_moving": {**ADAPTIVE, "cpi.tolerance": 0.32, "cpi.lift": "members", "cpi.relabel": "moving",
+                     "cpi.observable": "ranks"},
+}
+WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
+         "cpi.observable": "ranks"}
+TALL_WAVES = {
+    "ranks_tol": {**WAVES, "cpi.tolerance": 0.64},
+    "ranks_accuracy": {**WAVES, "cpi.accuracy": 1.5},
+}
+# case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own). The R = 4 cases of
+# the tall bed run no direct ensembles of their own: each R = 8 direct ensemble of the same bed and
+# U_s is two independent R = 4 ones (realization r's seed depends on the run's seed and r only, not on
+# R: whole_process direct_a's realizations 0 and 1 stop at the same times as the R = 8 study's), so
+# three R = 8 directs give three floors' worth of pairs at R = 8 and six R = 4 ensembles (DIRECTS_FROM).
 CASES = {
     "demo_u0.19_r4": ("demo_bed.cfg", 0.19, 1000.0, 4, SLOW),
+    "tall_u0.41_r4": ("tall_bed.cfg", 0.41, 600.0, 4, TALL_WAVES),
+    "tall_u0.19_r4": ("tall_bed.cfg", 0.19, 600.0, 4, TALL_SLOW),
+    "tall_u0.41_r8": ("tall_bed.cfg", 0.41, 600.0, 8, TALL_WAVES),
+    "tall_u0.19_r8": ("tall_bed.cfg", 0.19, 600.0, 8, TALL_SLOW),
 }
-# Shorter direct runs of a case's seeds made by an earlier study (bit for bit the same runs, cut
-# shorter: direct_a's first 950 samples checked equal): used for a direct whose own result is
-# not there yet, and the comparison is then over their common span.
+DIRECTS_FROM = {"tall_u0.41_r4": "tall_u0.41_r8", "tall_u0.19_r4": "tall_u0.19_r8"}
 EARLIER = {"demo_u0.19_r4": "slope_study_r4_u0.19_t600"}
 
 
 def runs_of(case):
-    """name -> (mode, overrides) of every run of CASE, directs first."""
+    """name -> (mode, overrides) of every run of CASE, directs first (none for a case whose directs
+    are the halves of another's, DIRECTS_FROM)."""
     scene, us, duration, realizations, cpi = CASES[case]
     base = {"gas_drag.superficial_velocity": us, "run.duration": duration, "cpi.warmup": 10,
             "ensemble.realizations_per_rank": realizations // 2}
-    out = {name: ("direct", {**base, "seed": seed}) for name, seed in DIRECT}
+    out = {} if case in DIRECTS_FROM else {name: ("direct", {**base, "seed": seed}) for name, seed in DIRECT}
     out.update({name: ("cpi", {**base, "seed": 404, **extra}) for name, extra in cpi.items()})
+    return out
+
+
+def halves(run, realizations):
+    """The two independent ensembles of REALIZATIONS in a direct run of twice as many: realizations
+    0..R-1 and R..2R-1, each with its own mean (every realization of a direct run is used)."""
+    out = []
+    for k in range(2):
+        sel = slice(k * realizations, (k + 1) * realizations)
+        h = dict(run, icdf=run["icdf"][:, sel, :], mean=run["icdf"][:, sel, :].mean(axis=1))
+        h["rest"] = None if run["rest"] is None else run["rest"][:, sel]
+        out.append(h)
     return out
 
 
@@ -179,7 +216,14 @@ def analyse_case(args, case):
     scene, us, duration, realizations, cpi = CASES[case]
     folder = os.path.join(args.results, case)
     runs, shorter = {}, []
-    for name in runs_of(case):
+    names = list(runs_of(case))
+    if case in DIRECTS_FROM:  # the halves of the R = 2R directs of another case
+        source = os.path.join(args.results, DIRECTS_FROM[case])
+        for name, _ in DIRECT:
+            if sr.archived(os.path.join(source, name + ".h5")):
+                for k, h in enumerate(halves(load(os.path.join(source, name + ".h5")), realizations)):
+                    runs[f"{name}{k}"] = h
+    for name in names:
         path = os.path.join(folder, name + ".h5")
         earlier = os.path.join(HERE, "results", EARLIER.get(case, "-"), name + ".h5")
         if sr.archived(path):
@@ -189,7 +233,8 @@ def analyse_case(args, case):
             shorter.append(f"{name} from {EARLIER[case]}")
     for run in runs.values():
         run["end_state"] = "end state at" in run["end_status"]
-    directs = [runs[n] for n, _ in DIRECT if n in runs]
+    direct_names = [n for n in runs if n.startswith("direct")]
+    directs = [runs[n] for n in direct_names]
     if not directs:
         return None, []
     # The comparison's span: the run's duration, or less while some direct is shorter.
@@ -222,7 +267,8 @@ def analyse_case(args, case):
     lines = [f"## {case}: {scene.split('_')[0]} bed, U_s = {us}, R = {realizations}, {duration:g} time units\n",
              (f"**Compared over t = 0-{span:g} only** (directs still short: {', '.join(shorter)}).\n"
               if span < duration - 1e-6 else ""),
-             f"Direct ensembles: {len(directs)} (seeds {', '.join(str(s) for n, s in DIRECT if n in runs)}); noise "
+             f"Direct ensembles: {len(directs)} ({', '.join(direct_names)}"
+             + (f": the halves of {DIRECTS_FROM[case]}'s" if case in DIRECTS_FROM else "") + "); noise "
              f"floor (RMS between two direct ensembles' mean ICDF, mean over {len(pairs)} pair(s)): "
              f"{floor[whole]:.3f} d_p over the span, by quarter " + " / ".join(f"{floor[w]:.3f}" for w in quarters)
              + ".\n",
@@ -303,6 +349,7 @@ def plot(folder, case, t, directs, cpis):
     ax.set_title(case)
     ax.legend(fontsize=8)
     fig.tight_layout()
+    os.makedirs(folder, exist_ok=True)
     fig.savefig(os.path.join(folder, "whole_process.png"), dpi=120)
     plt.close(fig)
 
