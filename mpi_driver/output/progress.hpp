@@ -23,6 +23,17 @@ class Progress {
     /// the simulated time left.
     void set_expected_particle_steps(double total) { expected_particle_steps_ = total; }
     double elapsed_seconds() const;
+    /// A restarted run: the simulated time and the particle-steps it resumes with are not this
+    /// process's work, so the rate and the time left count from them (without this, a run
+    /// restarted at 40 % showed a rate of 7e9 particle-steps/s and 3 s left).
+    void resume(double t_sim, double particle_steps);
+    /// What a line shows, given the wall time of this process so far.
+    struct Figures {
+        double shown = 0.0;  ///< fraction of the span reached (the furthest time)
+        double rate = 0.0;   ///< particle-steps per wall second since the start or the resume
+        double eta = 0.0;    ///< wall seconds left; NaN while nothing is done yet
+    };
+    Figures figures(double t_sim, double particle_steps, double wall) const;
     /// A checkpoint was written (`what`: "checkpoint FILE (t = ...)"): said at the end of the
     /// next progress line, not on a line of its own, so that a job's log holds no more
     /// checkpoint lines than progress lines (checkpoint.interval = 1 in a direct run would
@@ -34,6 +45,8 @@ class Progress {
     using Clock = std::chrono::steady_clock;
     double t_start_, t_end_, min_seconds_;
     double expected_particle_steps_ = 0.0;
+    double t_resumed_ = t_start_;  ///< where this process's work started
+    double steps_resumed_ = 0.0;   ///< the particle-steps done before it
     Clock::time_point start_ = Clock::now();
     Clock::time_point last_ = Clock::time_point::min();
     double t_furthest_ = -std::numeric_limits<double>::infinity();  ///< the latest time reached

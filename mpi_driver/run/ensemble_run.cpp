@@ -142,6 +142,8 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     if (resume) {
         stepper.restore_state(restart->header.stepper);
         control.resume = restart->header.driver;
+        // The rate and the time left count this process's work only.
+        if (mpi.is_root()) progress.resume(stepper.time(), stepper.particle_steps());
     }
 #if EFDEM_HAVE_HDF5
     // Always a writer: a stop signal checkpoints even a run without periodic checkpoints.
