@@ -118,9 +118,9 @@ TEST_CASE("the checksum of a realization sees one flipped bit", "[mpi][checkpoin
 
 TEST_CASE("a restart may change run length, output and layout keys, not physics",
           "[mpi][checkpoint]") {
-    for (const char* key :
-         {"run.duration", "output.prefix", "checkpoint.interval", "restart.allow_physics_change",
-          "debug.checkpoint_delay", "watchdog.max_overlap", "ensemble.realizations_per_rank"})
+    for (const char* key : {"run.duration", "output.prefix", "checkpoint.interval",
+                            "restart.allow_physics_change", "debug.checkpoint_delay",
+                            "watchdog.max_overlap", "ensemble.realizations_per_rank", "cpi.finish"})
         CHECK(may_change_on_restart(key));
     for (const char* key : {"dt", "seed", "pair_contact.kn", "cpi.dt", "mode", "observe.interval"})
         CHECK_FALSE(may_change_on_restart(key));
