@@ -281,7 +281,8 @@ def analyse_case(args, case):
              "(since " + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_quiet) + ").\n",
              f"| CPI run | ended | e / floor by quarter | e / floor | median at t = {span:g} [d_p] | off the "
              "directs' [s.e.] | realizations at rest (stop times) | stopped demixing (since) | DEM-time speed-up "
-             "over the span | to the end state: direct / CPI DEM time | wall-time speed-up |", "|---" * 11 + "|"]
+             "over the span | to the end state: direct / CPI DEM time | wall-time speed-up | DEM time per realization | "
+             "stops expected if they came with DEM time (P of none) |", "|---" * 13 + "|"]
     for name in cpi:
         if name not in runs:
             continue
@@ -298,6 +299,12 @@ def analyse_case(args, case):
         speed = min(span, float(run["t"][-1])) / dem
         # DEM time to the end state: a direct ensemble's is when its last realization came to rest.
         to_end = (last_stop / float(run["dem_time"])) if run["end_state"] and np.isfinite(last_stop) else float("nan")
+        # Do stops come with DEM time (a bed must run so long before it can freeze)? Then a CPI
+        # realization would stop as often as a direct one that ran as long: the share of direct
+        # realizations that had stopped demixing by the CPI run's DEM time per realization.
+        dem_each = float(run["dem_time"])
+        share = float(np.mean([np.isfinite(q) and q <= dem_each for q in direct_quiet]))
+        expected, p_none = share * len(cpi_quiet), (1.0 - share) ** len(cpi_quiet)
         whole_run = span >= duration - 1e-6
         wall = (np.mean([float(d["wall_seconds"]) / float(d["simulated_time"]) for d in directs])
                 * float(run["simulated_time"]) / float(run["wall_seconds"])) if whole_run else float("nan")
@@ -307,14 +314,17 @@ def analyse_case(args, case):
                                 [e[w] / floor[w] for w in quarters], "median": c_mean, "median_se": c_se,
                                 "off_se": off, "stops": cpi_stops, "stopped_demixing": cpi_quiet,
                                 "speedup_dem": speed,
-                                "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"]}
+                                "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"],
+                                "dem_time_each": dem_each, "stops_expected_by_dem_time": expected,
+                                "p_no_stop_by_dem_time": p_none}
         lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / floor[w]:.2f}" for w in quarters)
                      + f" | {e[whole] / floor[whole]:.2f} | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
                      f"{int(np.isfinite(cpi_stops).sum())} of {len(cpi_stops)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
                      + f") | {int(np.isfinite(cpi_quiet).sum())} of {len(cpi_quiet)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_quiet)
-                     + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-") + " |")
+                     + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-")
+                     + f" | {dem_each:g} | {expected:.1f} ({p_none:.2g}) |")
     lines.append("")
     # While some directs are short, the state at the end of the run against those that got there.
     full = [d for d in directs if float(d["t"][-1]) >= duration - 1e-6]
