@@ -187,4 +187,16 @@ TEST_CASE("U_mf and the Stokes numbers match physics.md §6.1 and §12.3", "[uni
           std::string::npos);
     CHECK(text.find("U_mf at phi = 0.6: 0.1228") != std::string::npos);
     CHECK(text.find("1.284 cm/s") != std::string::npos);  // U_s = 0.41 (physics.md §2)
+    // 0.41 is above both U_mf (0.1228, 0.2456); 0.19 lies between them.
+    CHECK(text.find("fluidization: U_s = 0.41 is above every species' U_mf") != std::string::npos);
+    auto t_slow = test::scene_table(kScene);
+    t_slow.add_override("gas_drag.superficial_velocity=0.19");
+    System s_slow = build(t_slow);
+    EffectReport slow;
+    gas_of(s_slow).describe(slow);
+    std::string slow_text;
+    for (const auto& [k, v] : slow.lines) slow_text += k + ": " + v + "\n";
+    INFO(slow_text);
+    CHECK(slow_text.find("fluidization: U_s = 0.19 fluidizes light but not heavy on its own") !=
+          std::string::npos);
 }
