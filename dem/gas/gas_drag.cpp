@@ -262,26 +262,29 @@ void GasDrag::describe(EffectReport& r) const {
     // Which species U_s fluidizes on its own: between their U_mf a bed demixes into a fluidized
     // and a packed part, and can lose its fluidization as the species that is not fluidized
     // gathers at the bottom (at U_s = 0.19 every realization of the demo bed comes to rest).
-    std::vector<std::string> fluidized, packed;
-    for (std::size_t k = 0; k < density_.size(); ++k)
-        (spec_.superficial_velocity > minimum_fluidization_velocity(density_[k], 0.6) ? fluidized
-                                                                                      : packed)
-            .push_back(species_names_[k]);
-    const auto names = [](const std::vector<std::string>& v) {
-        std::string out;
-        for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + v[k];
-        return out;
-    };
+    const std::vector<std::string> packed = species_not_fluidized();
+    std::vector<std::string> fluidized;
+    for (const std::string& name : species_names_)
+        if (std::find(packed.begin(), packed.end(), name) == packed.end())
+            fluidized.push_back(name);
     if (!fluidized.empty() && !packed.empty())
         r.add("fluidization",
               fmt::format("U_s = {:g} fluidizes {} but not {} on its own (U_mf at phi = 0.6): "
                           "where the {} spheres gather, the bed can defluidize and come to rest",
-                          spec_.superficial_velocity, names(fluidized), names(packed),
-                          names(packed)));
+                          spec_.superficial_velocity, fmt::join(fluidized, ", "),
+                          fmt::join(packed, ", "), fmt::join(packed, ", ")));
     else
         r.add("fluidization",
               fmt::format("U_s = {:g} is {} every species' U_mf at phi = 0.6",
                           spec_.superficial_velocity, packed.empty() ? "above" : "below"));
+}
+
+std::vector<std::string> GasDrag::species_not_fluidized() const {
+    std::vector<std::string> out;
+    for (std::size_t k = 0; k < density_.size(); ++k)
+        if (spec_.superficial_velocity <= minimum_fluidization_velocity(density_[k], 0.6))
+            out.push_back(species_names_[k]);
+    return out;
 }
 
 }  // namespace efdem::dem

@@ -103,6 +103,10 @@ class GasDrag final : public Effect {
     /// Minimum fluidization velocity of a uniform packed layer of density `density` [rho_s] at
     /// solid fraction phi (physics.md §6.1): U_mf = density (1-phi)^2/(A r(phi)).
     double minimum_fluidization_velocity(double density, double phi) const;
+    /// The species that U_s does not fluidize on their own (U_mf at phi = 0.6 at or above U_s),
+    /// by name. With some species fluidized and some not, a bed can defluidize and come to rest
+    /// where the others gather as it demixes.
+    std::vector<std::string> species_not_fluidized() const;
 
   private:
     /// Per-slab coefficients of the force kernel: c_j = A r(phi_c,j) and

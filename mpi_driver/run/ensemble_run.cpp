@@ -20,6 +20,7 @@
 #include "mpi_driver/parallel/ensemble_layout.hpp"
 #include "mpi_driver/parallel/mpi_broadcast.hpp"
 #include "mpi_driver/run/driver.hpp"
+#include "mpi_driver/run/run_advice.hpp"
 #include "mpi_driver/run/run_end.hpp"
 #include "mpi_driver/run/run_observables.hpp"
 #include "mpi_driver/run/run_provenance.hpp"
@@ -63,6 +64,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
                  const SetupWall& wall) {
     const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
     const RunProvenance prov = provenance(mpi, table, s, systems.front(), bed);
+    if (mpi.is_root())
+        for (const std::string& advice : run_advice(s.is_cpi(), systems.front()))
+            log::warn("{}", advice);
     const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
     RunObservables observables = RunObservables::from_settings(s);
 

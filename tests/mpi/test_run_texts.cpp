@@ -1,7 +1,14 @@
-// Texts the run prints that a user reads first: the ensemble's size in the header and --check.
+// Texts the run prints that a user reads first: the ensemble's size in the header and --check,
+// and the advice at a run's start.
 #include <catch2/catch.hpp>
 
+#include <string>
+#include <vector>
+
+#include "core/param_table.hpp"
+#include "dem/realization_builder.hpp"
 #include "mpi_driver/run/ensemble_size.hpp"
+#include "mpi_driver/run/run_advice.hpp"
 
 using efdem::mpi_driver::ensemble_size;
 
@@ -9,4 +16,38 @@ TEST_CASE("the ensemble's size agrees in number", "[mpi][run]") {
     CHECK(ensemble_size(1, 1) == "1 rank x 1 per rank = 1 realization");
     CHECK(ensemble_size(2, 2) == "2 ranks x 2 per rank = 4 realizations");
     CHECK(ensemble_size(1, 3) == "1 rank x 3 per rank = 3 realizations");
+}
+
+namespace {
+// A bed of light (U_mf 0.1228 at phi = 0.6) and heavy (0.2456) spheres.
+std::vector<std::string> advice(const char* us, bool cpi) {
+    const std::string scene = std::string(R"(effects = gravity pair_contact wall_contact gas_drag
+dt = 1e-4
+domain.lx = 4.28
+domain.ly = 4.28
+domain.lid = 60
+species.names = light heavy
+species.density = 1 2
+species.diameter = 1 1
+pair_contact.kn = 2e5
+pair_contact.restitution = 0.9
+pair_contact.mu = 0.1
+bed.count = 64 64
+bed.settle = false
+gas_drag.superficial_velocity = )") +
+                              us + "\n";
+    efdem::ParamTable table = efdem::ParamTable::from_text(scene, "advice_test.cfg");
+    const efdem::dem::System sys = efdem::dem::build_system(table.root(), {3, 0, false});
+    return efdem::mpi_driver::run_advice(cpi, sys);
+}
+}  // namespace
+
+TEST_CASE("a cpi run between the species' U_mf is told that CPI keeps beds moving", "[mpi][run]") {
+    const std::vector<std::string> slow = advice("0.19", true);
+    REQUIRE(slow.size() == 1);
+    CHECK(slow.front().find("U_s = 0.19 does not fluidize heavy on its own") == 0);
+    CHECK(slow.front().find("mode = direct") != std::string::npos);
+    CHECK(advice("0.19", false).empty());  // a direct run computes the rest itself
+    CHECK(advice("0.41", true).empty());   // both species fluidized: the bed never rests
+    CHECK(advice("0.1", true).empty());    // neither: a packed bed, nothing to warn of here
 }
