@@ -758,3 +758,71 @@ TEST_CASE("cpi.finish = steady ends the run after the coarse step that finds the
                Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.finish") &&
                    Catch::Contains("duration") && Catch::Contains("steady"));
 }
+
+TEST_CASE("cpi.jump_until: the jumps end there, then bursts of direct simulation to the end",
+          "[unit][coarse][run]") {
+    // Cycles of 10 (bursts 1 + 1, DT 8) from t = 0: bursts end at 2, 12, 22. With jumps until
+    // t = 25 the jump after the burst ending at 22 is shortened to DT = 3, and from t = 25 on every
+    // coarse step is a burst without a jump or a lift; the run still ends at 100 exactly (the
+    // last burst stretched to it).
+    struct Steps final : ProjectiveRunObserver {
+        std::vector<ProjectiveStepRecord> records;
+        void step_done(const ProjectiveRun&, const ProjectiveStepRecord& rec) override {
+            records.push_back(rec);
+        }
+    };
+    auto toy = slow_toy();
+    CpiSettings settings = fixed_settings();
+    settings.jump_until = 25.0;  // fixed DT with it: the multistep integrator (its controller)
+    settings.multistep.burst = settings.fixed.burst;
+    settings.multistep.adaptive = false;
+    settings.multistep.dt = settings.fixed.dt;
+    ProjectiveRun run(settings, toy, variable("x"));
+    Steps steps;
+    run.add_observer(steps);
+    const ProjectiveRunOutcome out = run.run(100.0);
+    INFO(out.end_status);
+    CHECK(out.end_status == "completed");
+    CHECK(toy.time() == Approx(100.0).margin(1e-9));
+    CHECK(out.jumps == 3);  // DT 8, 8 and 3
+    int shortened = 0;
+    for (const ProjectiveStepRecord& r : steps.records)
+        if (r.dt > 0.0 && r.controller.limited_by == DtLimit::jump_until) {
+            ++shortened;
+            CHECK(r.t_end == Approx(22.0).margin(1e-12));
+            CHECK(r.dt == Approx(3.0).margin(1e-12));
+        }
+    CHECK(shortened == 1);
+    double last_jump_end = 0.0;
+    for (const ProjectiveStepRecord& r : steps.records) {
+        if (r.dt > 0.0) last_jump_end = r.t_end + r.dt;
+        if (r.t_end > 25.0) {
+            CHECK(r.dt == 0.0);
+            CHECK(r.status == StepStatus::burst_only);
+        }
+    }
+    CHECK(last_jump_end == Approx(25.0).margin(1e-12));
+}
+
+TEST_CASE("cpi.jump_until is read on the sampling grid, and refused where nothing reads it",
+          "[unit][coarse][run]") {
+    ParamTable table = ParamTable::from_text(
+        "cpi.projection = adaptive\ncpi.tolerance = 0.16\ncpi.jump_until = 250\n", "scene.cfg",
+        "/scenes");
+    const CpiSettings s = CpiSettings::from_params(table.root().scope("cpi"), 0.5);
+    CHECK(s.jump_until == 250.0);
+    CHECK(std::isinf(CpiSettings{}.jump_until));  // not given: jumps to the end
+    ParamTable fixed = ParamTable::from_text("cpi.jump_until = 40\n", "scene.cfg", "/scenes");
+    CHECK(CpiSettings::from_params(fixed.root().scope("cpi"), 0.5).make_integrator({})->name() ==
+          "projective_forward_euler_multistep");  // fixed DT with the controller's rule
+    const auto error = [](const char* text) {
+        ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
+        return std::string(test::input_error([&] {
+                               CpiSettings::from_params(t.root().scope("cpi"), 0.5);
+                           }).what());
+    };
+    CHECK_THAT(error("cpi.projection = periods\ncpi.jump_until = 40\n"),
+               Catch::Contains("cpi.jump_until") && Catch::Contains("periods"));
+    CHECK_THAT(error("cpi.jump_until = 40.25\n"), Catch::Contains("cpi.jump_until"));
+    CHECK_THAT(error("cpi.jump_until = -1\n"), Catch::Contains("cpi.jump_until"));
+}

@@ -287,6 +287,38 @@ TEST_CASE("fixed DT: the controller only shortens at the end and keeps every jum
     CHECK(v.message.empty());
 }
 
+TEST_CASE("cpi.jump_until: the last jump ends there, and none after it",
+          "[unit][coarse][controller]") {
+    // The burst ends at t0 = 100. Without curvature the tolerance allows DT = 0.04 / se.
+    StepSizeController c(setup());
+    PlanInput in = input(model(1e-3));  // DT 40 from the tolerance
+    in.jump_end = 130.0;
+    const DtPlan p = c.plan(in);
+    CHECK(p.dt == 30.0);  // shortened to end at the jump end exactly
+    CHECK(p.limited_by == DtLimit::jump_until);
+    in.jump_end = 103.0;  // 3 left < cpi.dt_min = 5: a burst instead
+    const DtPlan q = c.plan(in);
+    CHECK(q.dt == 0.0);
+    CHECK(q.limited_by == DtLimit::jump_until);
+    CHECK(q.message.find("less than cpi.dt_min") != std::string::npos);
+    in.jump_end = 100.0;  // the burst ended there: bursts only from here
+    const DtPlan r = c.plan(in);
+    CHECK(r.dt == 0.0);
+    CHECK(r.message.find("no jump after t = 100") != std::string::npos);
+    in.jump_end = 1000.0;  // far: the tolerance's DT, as without the key
+    CHECK(c.plan(in).dt == Approx(40.0).epsilon(kBisection));
+    // Fixed DT: capped in the same way, and no jump once it is passed.
+    StepSizeSetup s = setup();
+    s.adaptive = false;
+    s.fixed_dt = 80.0;
+    StepSizeController f(s);
+    in.jump_end = 150.0;
+    CHECK(f.plan(in).dt == 50.0);
+    in.jump_end = 90.0;
+    CHECK(f.plan(in).dt == 0.0);
+    CHECK(f.plan(in).limited_by == DtLimit::jump_until);
+}
+
 TEST_CASE("DtLimit's texts are the recorded ones and read back", "[unit][coarse][controller]") {
     // The run file's /cpi/controller/limited_by and the CSVs hold these texts: they must not
     // change (run files are compared byte for byte with earlier versions).
@@ -305,6 +337,7 @@ TEST_CASE("DtLimit's texts are the recorded ones and read back", "[unit][coarse]
         {DtLimit::stability, "stability"},
         {DtLimit::fast_transient, "fast transient"},
         {DtLimit::in_phase_wave, "in-phase wave"},
+        {DtLimit::jump_until, "cpi.jump_until"},
     };
     std::set<std::string> texts;
     for (const auto& [limit, text] : recorded) {

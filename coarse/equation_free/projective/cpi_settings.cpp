@@ -193,6 +193,13 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         cpi.get_or_choice("finish", "duration", {"duration", "steady", "at_rest"});
     s.finish_at_end_state = finish != "duration";
     s.finish_on_drift = finish == "steady";
+    if (cpi.contains("jump_until")) {
+        if (s.projection == Projection::periods)
+            cpi.fail("jump_until", "is not read by cpi.projection = periods",
+                     "cpi.projection = fixed or adaptive");
+        s.jump_until = cpi.get<double>("jump_until", Bounds::closed(0.0, 1e9));
+        on_grid("jump_until", s.jump_until);
+    }
     // Extensions must land on samples: 5 time units rounded to whole sampling intervals.
     s.periods.extension_step = std::max(1.0, std::round(5.0 / sample_interval)) * sample_interval;
     return s;
@@ -213,8 +220,9 @@ double CpiSettings::window() const {
 
 std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {
     if (projection == Projection::adaptive ||
-        (projection == Projection::fixed && (steps == 2 || multistep.slope == SlopeSource::pooled ||
-                                             multistep.healing_auto || multistep.lift_apart)))
+        (projection == Projection::fixed &&
+         (steps == 2 || multistep.slope == SlopeSource::pooled || multistep.healing_auto ||
+          multistep.lift_apart || std::isfinite(jump_until))))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
     if (projection == Projection::fixed)
         return std::make_unique<ProjectiveForwardEuler>(fixed, std::move(repair));

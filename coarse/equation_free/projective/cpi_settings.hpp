@@ -50,6 +50,7 @@
 /// `periods` are refused; the adaptive keys are refused with the other projections.
 /// warmup, healing, window and max_extension must be whole multiples of the sampling interval.
 
+#include <limits>
 #include <memory>
 
 #include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
@@ -95,6 +96,10 @@ struct CpiSettings {
     /// cpi.finish = steady: also after the coarse step at which the drift test calls a moving
     /// ensemble statistically steady (DriftTest, projective_run.hpp).
     bool finish_on_drift = false;
+    /// cpi.jump_until: no jump ends later than this long after the run's start; from there on
+    /// every coarse step is a burst of direct simulation (no jump, no lift), so that beds can
+    /// come to rest as in a direct run (infinite: jumps to the end).
+    double jump_until = std::numeric_limits<double>::infinity();
     /// Projection = fixed: healing, window, DT, stability policy.
     ProjectiveEulerSettings fixed;
     /// Projection = periods: healing, window, k, burst extension, stability policy.

@@ -319,7 +319,8 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec,
                                        .decay = decay_,
                                        .hold = hold_kind_,
                                        .hold_message = hold_,
-                                       .end_time = end_time()});
+                                       .end_time = end_time(),
+                                       .jump_end = jump_end()});
     ControllerRecord& c = rec.controller;
     c.limited_by = p.limited_by;
     c.dt_tolerance = p.dt_tolerance;
@@ -504,8 +505,11 @@ std::string MultistepProjectiveIntegrator::summary(int realizations, long bursts
     std::string s = fmt::format(
         "{}: {} bursts: {} with a jump kept, {} with a jump rejected, {} run directly (tolerance "
         "allowed DT < cpi.dt_min), {} without a jump (the first, which measures the first slope; "
-        "those in a fast transient; the end of the run)",
-        name(), bursts, t.accepted, t.rejected, t.direct, without);
+        "those in a fast transient; the end of the run{})",
+        name(), bursts, t.accepted, t.rejected, t.direct, without,
+        std::isfinite(jump_end())
+            ? fmt::format("; those after cpi.jump_until (t = {:.6g})", jump_end())
+            : std::string());
     // Every rejected jump cost a burst of DEM time that bought nothing.
     if (t.rejected > 0)
         s += fmt::format(

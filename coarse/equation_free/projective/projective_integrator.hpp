@@ -169,6 +169,10 @@ class ProjectiveIntegrator {
     /// remaining time is at least one burst ends at t_end exactly (default: no end).
     void set_end_time(double t_end) { end_time_ = t_end; }
     double end_time() const { return end_time_; }
+    /// cpi.jump_until: no jump ends after `t` (the multistep integrator's controller; default:
+    /// no such time). After it every step is a burst of direct simulation.
+    void set_jump_end(double t) { jump_end_ = t; }
+    double jump_end() const { return jump_end_; }
 
     /// The integrator's own state between two steps (slope history, step-size controller), for
     /// a checkpoint; integrators without one save nothing (nullopt). restore_state() takes what
@@ -186,11 +190,12 @@ class ProjectiveIntegrator {
     virtual void restore_state(const IntegratorState& state);
 
   protected:
-    /// end_of_run_jump_limit() for this integrator's end time.
+    /// end_of_run_jump_limit() for this integrator's end time, and no further than its jump end.
     double jump_limit(double t_after_burst, double dt, double burst) const;
 
   private:
     double end_time_ = std::numeric_limits<double>::infinity();
+    double jump_end_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace efdem::coarse

@@ -38,6 +38,7 @@ void ProjectiveRun::use(const CoarseVariable& variable) {
     if (variable.select) variable.select();
     integrator_ = settings_.make_integrator(variable.repair);
     integrator_->set_end_time(t_end_);
+    integrator_->set_jump_end(state_.t_origin + settings_.jump_until);
 }
 
 double ProjectiveRun::planned_micro_time(double dt) const {

@@ -45,7 +45,7 @@ double largest_dt_within(const JumpErrorModel& model, double target, double cap)
 
 namespace {
 // The recorded texts: run files and CSVs hold them, so they never change.
-constexpr std::array<std::pair<DtLimit, std::string_view>, 14> kDtLimitText{{
+constexpr std::array<std::pair<DtLimit, std::string_view>, 15> kDtLimitText{{
     {DtLimit::none, ""},
     {DtLimit::fixed, "fixed"},
     {DtLimit::first_burst, "first burst"},
@@ -60,6 +60,7 @@ constexpr std::array<std::pair<DtLimit, std::string_view>, 14> kDtLimitText{{
     {DtLimit::stability, "stability"},
     {DtLimit::fast_transient, "fast transient"},
     {DtLimit::in_phase_wave, "in-phase wave"},
+    {DtLimit::jump_until, "cpi.jump_until"},
 }};
 }  // namespace
 
@@ -107,9 +108,24 @@ DtPlan StepSizeController::plan(const PlanInput& in) const {
     auto end_limit = [&](double dt) {
         return end_of_run_jump_limit(t0 + burst, in.end_time, dt, burst);
     };
+    // cpi.jump_until: no jump ends after in.jump_end; from there on each step is a burst of
+    // direct simulation, so that what only the DEM does (a bed coming to rest) can happen.
+    const double jump_room = in.jump_end - t0;
+    if (std::isfinite(in.jump_end) && jump_room <= time_tolerance(in.jump_end)) {
+        p.limited_by = DtLimit::jump_until;
+        p.message = fmt::format(
+            "cpi.jump_until: no jump after t = {:.6g}, bursts of direct "
+            "simulation from here",
+            in.jump_end);
+        return p;
+    }
     if (!setup_.adaptive) {
         p.limited_by = DtLimit::fixed;
         p.dt = std::min(setup_.fixed_dt, end_limit(setup_.fixed_dt));
+        if (p.dt > jump_room) {
+            p.dt = jump_room;
+            p.limited_by = DtLimit::jump_until;
+        }
         return p;
     }
     const StepSizeSettings& s = setup_.control;
@@ -143,11 +159,19 @@ DtPlan StepSizeController::plan(const PlanInput& in) const {
         limit(std::max(s.dt_min, burst), DtLimit::first_jump_no_curvature);
     if (!first_jump) limit(s.growth * state_.dt_last, DtLimit::growth);
     limit(state_.dt_cap, DtLimit::rejection);
+    limit(jump_room, DtLimit::jump_until);
     if (setup_.dt_quantum > 0.0 && std::isfinite(dt))
         dt = std::floor(dt / setup_.dt_quantum * (1.0 + 1e-12)) * setup_.dt_quantum;
     const double tol = time_tolerance(in.end_time);
     if (end_limit(dt) <= tol) {  // this step's burst is the run's last: no jump before it
         p.limited_by = DtLimit::end_of_run;
+        return p;
+    }
+    if (dt < s.dt_min * (1.0 - 1e-12) && p.limited_by == DtLimit::jump_until) {
+        p.message = fmt::format(
+            "cpi.jump_until: the {:.3g} time units left before t = {:.6g} are "
+            "less than cpi.dt_min = {:.3g}: one burst of direct simulation",
+            jump_room, in.jump_end, s.dt_min);
         return p;
     }
     if (dt < s.dt_min * (1.0 - 1e-12)) {

@@ -83,6 +83,7 @@ enum class DtLimit {
     stability,                ///< "stability": halved until the measured transient is stable
     fast_transient,           ///< "fast transient": no jump from this burst (phase drift)
     in_phase_wave,            ///< "in-phase wave": no jump from this burst (common wave)
+    jump_until,               ///< "cpi.jump_until": no jump ends later; then bursts only
 };
 
 /// The recorded text of `limit` (see DtLimit).
@@ -129,6 +130,9 @@ struct PlanInput {
     DtLimit hold = DtLimit::none;
     std::string hold_message;
     double end_time = std::numeric_limits<double>::infinity();  ///< the run ends here
+    /// cpi.jump_until: no jump ends later than this; from it on every step is a burst of
+    /// direct simulation (infinite: no such time).
+    double jump_end = std::numeric_limits<double>::infinity();
 };
 
 /// What plan() decided.
