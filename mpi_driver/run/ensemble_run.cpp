@@ -65,7 +65,8 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
     const RunProvenance prov = provenance(mpi, table, s, systems.front(), bed);
     if (mpi.is_root())
-        for (const std::string& advice : run_advice(s.is_cpi(), systems.front()))
+        for (const std::string& advice :
+             run_advice(s.is_cpi(), std::isfinite(s.cpi.jump_until), systems.front()))
             log::warn("{}", advice);
     const EnsembleLayout layout(mpi.world(), s.realizations_per_rank);
     RunObservables observables = RunObservables::from_settings(s);

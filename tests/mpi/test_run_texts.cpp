@@ -20,7 +20,7 @@ TEST_CASE("the ensemble's size agrees in number", "[mpi][run]") {
 
 namespace {
 // A bed of light (U_mf 0.1228 at phi = 0.6) and heavy (0.2456) spheres.
-std::vector<std::string> advice(const char* us, bool cpi) {
+std::vector<std::string> advice(const char* us, bool cpi, bool jumps_end = false) {
     const std::string scene = std::string(R"(effects = gravity pair_contact wall_contact gas_drag
 dt = 1e-4
 domain.lx = 4.28
@@ -38,7 +38,7 @@ gas_drag.superficial_velocity = )") +
                               us + "\n";
     efdem::ParamTable table = efdem::ParamTable::from_text(scene, "advice_test.cfg");
     const efdem::dem::System sys = efdem::dem::build_system(table.root(), {3, 0, false});
-    return efdem::mpi_driver::run_advice(cpi, sys);
+    return efdem::mpi_driver::run_advice(cpi, jumps_end, sys);
 }
 }  // namespace
 
@@ -46,8 +46,9 @@ TEST_CASE("a cpi run between the species' U_mf is told that CPI keeps beds movin
     const std::vector<std::string> slow = advice("0.19", true);
     REQUIRE(slow.size() == 1);
     CHECK(slow.front().find("U_s = 0.19 does not fluidize heavy on its own") == 0);
-    CHECK(slow.front().find("mode = direct") != std::string::npos);
-    CHECK(advice("0.19", false).empty());  // a direct run computes the rest itself
-    CHECK(advice("0.41", true).empty());   // both species fluidized: the bed never rests
-    CHECK(advice("0.1", true).empty());    // neither: a packed bed, nothing to warn of here
+    CHECK(slow.front().find("cpi.jump_until") != std::string::npos);
+    CHECK(advice("0.19", true, true).empty());  // its jumps end: the beds can come to rest
+    CHECK(advice("0.19", false).empty());       // a direct run computes the rest itself
+    CHECK(advice("0.41", true).empty());        // both species fluidized: the bed never rests
+    CHECK(advice("0.1", true).empty());         // neither: a packed bed, nothing to warn of here
 }
