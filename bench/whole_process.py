@@ -67,6 +67,10 @@ SLOW = {
     # each realization by its own slope, relabelling where it moves: a bed slowing to rest has a
     # slope near zero, so its lifts change few labels (the kicks that keep CPI beds moving)
     "own_moving": {**ADAPTIVE, "cpi.lift": "own", "cpi.relabel": "moving"},
+    # members_moving whose jumps end at t = 250, before the first direct realization stopped
+    # (t = 277): no CPI realization stops while it is lifted (2026-12-05), so the run goes on
+    # directly from there and the beds come to rest as in a direct run (cpi.jump_until)
+    "moving_until250": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 250},
 }
 # The tall bed (3,120 spheres, the paper's height at a quarter of its area; bench/scenes/tall_bed.cfg):
 # its floor is about three times the demo bed's in d_p (docs/accuracy_vs_cost.md, "The tall bed"), so
