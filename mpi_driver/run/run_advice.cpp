@@ -15,7 +15,7 @@ std::vector<std::string> run_advice(bool cpi, bool jumps_end, const dem::System&
     if (packed.empty() || packed.size() == system.species().size()) return out;
     // Measured on the demo bed at U_s = 0.19 (docs/accuracy_vs_cost.md, "Under CPI no
     // realization stops"): every direct realization came to rest after 277-925 time units, no
-    // CPI realization in any run (48, up to 670 units of DEM time each), with any lift.
+    // CPI realization in any run (68, up to 672 units of DEM time each), with any lift.
     out.push_back(fmt::format(
         "U_s = {:g} does not fluidize {} on its own (efdem --check): as the bed demixes it can "
         "defluidize and come to rest, and CPI's lifts keep beds moving (on the demo bed at "
