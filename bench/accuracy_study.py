@@ -102,14 +102,9 @@ def main():
         for name in ORDER:
             if args.only and name not in args.only:
                 continue
-            dest = os.path.join(args.results, name + ".h5")
-            if sr.archived(dest):
-                print(f"  {name}: done before, skipped", flush=True)
-                continue
             scene = os.path.join(HERE, "scenes", CASES[name][0])
-            if sr.completed(args.out, name) or sr.run_case(os.path.abspath(args.efdem), 2, scene, args.out, name,
-                                                           "cpi", overrides(name)):
-                sr.archive(args.out, name, dest)
+            sr.ensure(os.path.abspath(args.efdem), 2, scene, args.out, name, "cpi", overrides(name),
+                      os.path.join(args.results, name + ".h5"))
     analyse(args.results)
 
 

@@ -93,13 +93,8 @@ def main():
         for name, overrides in RUNS.items():
             if args.only and name not in args.only:
                 continue
-            dest = os.path.join(args.results, name + ".h5")
-            if sr.archived(dest):
-                print(f"  {name}: done before, skipped", flush=True)
-                continue
-            if sr.completed(args.out, name) or sr.run_case(os.path.abspath(args.efdem), 2, scene, args.out, name,
-                                                           "cpi", overrides):
-                sr.archive(args.out, name, dest)
+            sr.ensure(os.path.abspath(args.efdem), 2, scene, args.out, name, "cpi", overrides,
+                      os.path.join(args.results, name + ".h5"))
     analyse(args)
 
 

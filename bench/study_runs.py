@@ -122,6 +122,19 @@ def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None, beds=
     return ok
 
 
+def ensure(efdem, np_, scene, folder, name, mode, overrides, dest, label=None):
+    """The archive DEST of the run NAME: skipped when it is there, else the run made in FOLDER (or
+    continued, run_case) and archived. Returns whether DEST holds the completed run."""
+    label = label or name
+    if archived(dest):
+        print(f"  {label}: done before, skipped", flush=True)
+        return True
+    if completed(folder, name) or run_case(efdem, np_, scene, folder, name, mode, overrides, label=label):
+        archive(folder, name, dest)
+        return True
+    return False
+
+
 # What a study keeps of a run, in the run file's own layout: the groups its analysis reads and the
 # root attributes, one file per run under bench/results/ (not committed: study run files stay out of
 # git; the analysis, the plots and the commands that regenerate them are). A study skips a run

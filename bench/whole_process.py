@@ -134,13 +134,8 @@ def make(args, case):
     for name, (mode, overrides) in runs_of(case).items():
         if args.only and name not in args.only:
             continue
-        dest = os.path.join(results, name + ".h5")
-        if sr.archived(dest):
-            print(f"  {case}/{name}: done before, skipped", flush=True)
-            continue
-        if sr.completed(work, name) or sr.run_case(os.path.abspath(args.efdem), 2, scene, work, name, mode,
-                                                   overrides, label=f"{case}/{name}"):
-            sr.archive(work, name, dest)
+        sr.ensure(os.path.abspath(args.efdem), 2, scene, work, name, mode, overrides,
+                  os.path.join(results, name + ".h5"), label=f"{case}/{name}")
 
 
 def load(path):
