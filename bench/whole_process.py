@@ -123,6 +123,7 @@ def halves(run, realizations):
         sel = slice(k * realizations, (k + 1) * realizations)
         h = dict(run, icdf=run["icdf"][:, sel, :], mean=run["icdf"][:, sel, :].mean(axis=1))
         h["rest"] = None if run["rest"] is None else run["rest"][:, sel]
+        h["particle_steps"] = float("nan")  # the run's are not split by realization
         out.append(h)
     return out
 
@@ -191,6 +192,13 @@ def demixing_stops(run):
             since = tk
         out.append(since)
     return out
+
+
+def whole_run_steps(directs, run, duration):
+    """Whether the particle-steps of the directs and of RUN cover the same process: the directs ran
+    their whole duration, and RUN did too or ended at its end state."""
+    return (all(float(d["simulated_time"]) >= duration - 1e-6 for d in directs)
+            and (float(run["simulated_time"]) >= duration - 1e-6 or run["end_state"]))
 
 
 def held_to(run, t):
@@ -281,7 +289,8 @@ def analyse_case(args, case):
              f"| CPI run | ended | e / floor by quarter | e / floor | median at t = {span:g} [d_p] | off the "
              "directs' [s.e.] | realizations at rest (stop times) | stopped demixing (since) | DEM-time speed-up "
              "over the span | to the end state: direct / CPI DEM time | wall-time speed-up | DEM time per realization | "
-             "stops expected if they came with DEM time (P of none) |", "|---" * 13 + "|"]
+             "stops expected if they came with DEM time (P of none) | particle-steps: the directs' mean / the run's |",
+             "|---" * 14 + "|"]
     for name in cpi:
         if name not in runs:
             continue
@@ -304,6 +313,10 @@ def analyse_case(args, case):
         dem_each = float(run["dem_time"])
         share = float(np.mean([np.isfinite(q) and q <= dem_each for q in direct_quiet]))
         expected, p_none = share * len(cpi_quiet), (1.0 - share) ** len(cpi_quiet)
+        # The compute: a direct run pauses its realizations at rest (ensemble.at_rest = pause), so
+        # over a whole process its particle-steps, not its DEM time, are what it cost.
+        steps_ratio = (np.mean([float(d["particle_steps"]) for d in directs]) / float(run["particle_steps"])
+                       if whole_run_steps(directs, run, duration) else float("nan"))
         whole_run = span >= duration - 1e-6
         wall = (np.mean([float(d["wall_seconds"]) / float(d["simulated_time"]) for d in directs])
                 * float(run["simulated_time"]) / float(run["wall_seconds"])) if whole_run else float("nan")
@@ -315,7 +328,7 @@ def analyse_case(args, case):
                                 "speedup_dem": speed,
                                 "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"],
                                 "dem_time_each": dem_each, "stops_expected_by_dem_time": expected,
-                                "p_no_stop_by_dem_time": p_none}
+                                "p_no_stop_by_dem_time": p_none, "particle_steps_ratio": steps_ratio}
         lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / floor[w]:.2f}" for w in quarters)
                      + f" | {e[whole] / floor[whole]:.2f} | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
                      f"{int(np.isfinite(cpi_stops).sum())} of {len(cpi_stops)} ("
@@ -323,7 +336,7 @@ def analyse_case(args, case):
                      + f") | {int(np.isfinite(cpi_quiet).sum())} of {len(cpi_quiet)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_quiet)
                      + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-")
-                     + f" | {dem_each:g} | {expected:.1f} ({p_none:.2g}) |")
+                     + f" | {dem_each:g} | {expected:.1f} ({p_none:.2g}) | {steps_ratio:.2f} |")
     lines.append("")
     # While some directs are short, the state at the end of the run against those that got there.
     full = [d for d in directs if float(d["t"][-1]) >= duration - 1e-6]
