@@ -20,6 +20,9 @@
 #     while its particles still vibrate above the threshold;
 #  5. a restart with paused realizations continues the run bit for bit (their still count is in
 #     the checkpoint, /realizations/still_samples), on another layout;
+#  6. cpi.jump_until = 10 with cpi.finish = at_rest: the jumps end by t = 10 (no jump ends later),
+#     every coarse step after is a burst without a jump or a lift (no label changed, DT 0,
+#     limited by "cpi.jump_until"), and the run still ends at its end state (measured: at 42.25);
 #  4. the lifts on the way held the realizations at rest (/cpi/lift_at_rest) and left their
 #     labels: their ICDF moved by less than 1e-6 d_p across those lifts (a relabelling moves it by
 #     about a light particle's spacing, ~1e-2 d_p; a bed slower than 1e-6 sqrt(g d_p) moves less
@@ -49,6 +52,9 @@ timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mod
   "${common[@]}" cpi.finish=at_rest output.directory="$work" output.prefix=cpi > "$work/cpi.log" 2>&1 \
   || { cat "$work/cpi.log"; echo "FAIL: the cpi run failed"; exit 1; }
 /usr/bin/python3 "$here/check_run_file.py" "$work/cpi.h5" > /dev/null || { echo "FAIL: cpi.h5 layout"; exit 1; }
+timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi run.duration=200 \
+  "${common[@]}" cpi.finish=at_rest cpi.jump_until=10 output.directory="$work" output.prefix=until \
+  > "$work/until.log" 2>&1 || { cat "$work/until.log"; echo "FAIL: the cpi.jump_until run failed"; exit 1; }
 /usr/bin/python3 - "$work" <<'PY' || exit 1
 import re
 import sys
@@ -114,4 +120,21 @@ for j, te in enumerate(t_lift):
             checked += 1
 print(f"PASS: realizations at rest stay at rest; cpi.finish = at_rest ended at the end state; "
       f"{checked} held lift(s) left their realization where it was")
+# 6. cpi.jump_until = 10
+with h5py.File(f"{work}/until.h5", "r") as f:
+    status = f.attrs["end_status"]
+    status = status.decode() if isinstance(status, bytes) else str(status)
+    te, dt, changed = f["cpi/t_end"][:], f["cpi/dt"][:], f["cpi/lift_changed"][:].sum(axis=1)
+    limited = [v.decode() if isinstance(v, bytes) else str(v) for v in f["cpi/controller/limited_by"][:]]
+jumped = dt > 0
+if not jumped.any() or (te[jumped] + dt[jumped]).max() > 10 + 1e-9:
+    sys.exit(f"FAIL: cpi.jump_until = 10: jumps ending at {te[jumped] + dt[jumped]}")
+after = te >= 10 - 1e-9
+if not after.any() or dt[after].any() or changed[after].any() or any(limited[k] != "cpi.jump_until" for k in np.nonzero(after)[0]):
+    sys.exit(f"FAIL: after t = 10: DT {dt[after]}, labels changed {changed[after]}, limited by "
+             f"{sorted(set(limited[k] for k in np.nonzero(after)[0]))}")
+if "end state at" not in status:
+    sys.exit(f"FAIL: the cpi.jump_until run did not end at its end state: {status}")
+print(f"PASS: cpi.jump_until = 10: {int(jumped.sum())} jumps, the last ending at "
+      f"{(te[jumped] + dt[jumped]).max():g}; {int(after.sum())} bursts after without a jump or a lift; {status}")
 PY
