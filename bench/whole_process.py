@@ -71,6 +71,10 @@ SLOW = {
     # (t = 277): no CPI realization stops while it is lifted (2026-12-05), so the run goes on
     # directly from there and the beds come to rest as in a direct run (cpi.jump_until)
     "moving_until250": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 250},
+    # the same with another seed, and with the jumps ended later (the bias against T)
+    "moving_until250_s505": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 250,
+                             "seed": 505},
+    "moving_until400": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 400},
 }
 # The tall bed (3,120 spheres, the paper's height at a quarter of its area; bench/scenes/tall_bed.cfg):
 # its floor is about three times the demo bed's in d_p (docs/accuracy_vs_cost.md, "The tall bed"), so
