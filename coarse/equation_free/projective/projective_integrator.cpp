@@ -58,11 +58,7 @@ void ProjectiveIntegrator::restore_state([[maybe_unused]] const IntegratorState&
 }
 
 double ProjectiveIntegrator::jump_limit(double t_after_burst, double dt, double burst) const {
-    const double end = end_of_run_jump_limit(t_after_burst, end_time_, dt, burst);
-    if (!std::isfinite(jump_end_)) return end;
-    // cpi.jump_until: no jump ends later (none once it is passed, up to round-off).
-    const double room = jump_end_ - t_after_burst;
-    return std::min(end, room <= time_tolerance(jump_end_) ? 0.0 : room);
+    return end_of_run_jump_limit(t_after_burst, end_time_, dt, burst);
 }
 
 }  // namespace efdem::coarse

@@ -169,8 +169,9 @@ class ProjectiveIntegrator {
     /// remaining time is at least one burst ends at t_end exactly (default: no end).
     void set_end_time(double t_end) { end_time_ = t_end; }
     double end_time() const { return end_time_; }
-    /// cpi.jump_until: no jump ends after `t` (the multistep integrator's controller; default:
-    /// no such time). After it every step is a burst of direct simulation.
+    /// cpi.jump_until: no jump ends after `t` (default: no such time); after it every step is a
+    /// burst of direct simulation. Read by the multistep integrator's controller, which
+    /// CpiSettings::make_integrator chooses whenever cpi.jump_until is set.
     void set_jump_end(double t) { jump_end_ = t; }
     double jump_end() const { return jump_end_; }
 
@@ -190,7 +191,7 @@ class ProjectiveIntegrator {
     virtual void restore_state(const IntegratorState& state);
 
   protected:
-    /// end_of_run_jump_limit() for this integrator's end time, and no further than its jump end.
+    /// end_of_run_jump_limit() for this integrator's end time.
     double jump_limit(double t_after_burst, double dt, double burst) const;
 
   private:
