@@ -53,28 +53,29 @@ DIRECT = (("direct_a", 101), ("direct_b", 202), ("direct_c", 303))
 # steps of such a run were direct bursts (2026-12-04), so it is not a CPI run of this study.
 ADAPTIVE = {"cpi.projection": "adaptive", "cpi.tolerance": 0.16, "cpi.healing": 10, "cpi.window": 10,
             "cpi.finish": "steady"}
+# members, relabelling where the beds move: the lift of most runs below
+MOVING = {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving"}
 SLOW = {
     "members_hold": {**ADAPTIVE, "cpi.lift": "members"},  # each realization kept apart
     "mean_hold": {**ADAPTIVE, "cpi.lift": "mean"},  # the paper's lift, those at rest held
     # members_hold, relabelling where the beds move (no realization came to rest under CPI with
     # every candidate alike: the lifts kick beds that are about to stop, bench/lift_restart.py)
-    "members_moving": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving"},
+    "members_moving": MOVING,
     # the same with another seed: one draw does not set a default
-    "members_moving_s505": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "seed": 505},
+    "members_moving_s505": {**MOVING, "seed": 505},
     # members_moving in rank coordinates (cpi.observable = ranks: a lift the realizations' own beds
     # can meet; at U_s = 0.41 it removed most of the ICDF lift's error, 2026-12-05)
-    "ranks_moving": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.observable": "ranks"},
+    "ranks_moving": {**MOVING, "cpi.observable": "ranks"},
     # each realization by its own slope, relabelling where it moves: a bed slowing to rest has a
     # slope near zero, so its lifts change few labels (the kicks that keep CPI beds moving)
     "own_moving": {**ADAPTIVE, "cpi.lift": "own", "cpi.relabel": "moving"},
     # members_moving whose jumps end at t = 250, before the first direct realization stopped
     # (t = 277): no CPI realization stops while it is lifted (2026-12-05), so the run goes on
     # directly from there and the beds come to rest as in a direct run (cpi.jump_until)
-    "moving_until250": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 250},
+    "moving_until250": {**MOVING, "cpi.jump_until": 250},
     # the same with another seed, and with the jumps ended later (the bias against T)
-    "moving_until250_s505": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 250,
-                             "seed": 505},
-    "moving_until400": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving", "cpi.jump_until": 400},
+    "moving_until250_s505": {**MOVING, "cpi.jump_until": 250, "seed": 505},
+    "moving_until400": {**MOVING, "cpi.jump_until": 400},
 }
 # The tall bed (3,120 spheres, the paper's height at a quarter of its area; bench/scenes/tall_bed.cfg):
 # its floor is about three times the demo bed's in d_p (docs/accuracy_vs_cost.md, "The tall bed"), so
@@ -82,9 +83,8 @@ SLOW = {
 # issue 34 item 1) runs beside them. U_s = 0.41: rank coordinates (the lift a segregated bed can
 # meet, 1.8-2.4x the floor at the demo bed's steady state) and bursts 2 + 20 (the waves' window).
 TALL_SLOW = {
-    "members_moving": {**ADAPTIVE, "cpi.tolerance": 0.32, "cpi.lift": "members", "cpi.relabel": "moving"},
-    "ranks_moving": {**ADAPTIVE, "cpi.tolerance": 0.32, "cpi.lift": "members", "cpi.relabel": "moving",
-                     "cpi.observable": "ranks"},
+    "members_moving": {**MOVING, "cpi.tolerance": 0.32},
+    "ranks_moving": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks"},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}
@@ -227,14 +227,14 @@ def analyse_case(args, case):
     scene, us, duration, realizations, cpi = CASES[case]
     folder = os.path.join(args.results, case)
     runs, shorter = {}, []
-    names = list(runs_of(case))
     if case in DIRECTS_FROM:  # the halves of the R = 2R directs of another case
         source = os.path.join(args.results, DIRECTS_FROM[case])
         for name, _ in DIRECT:
-            if sr.archived(os.path.join(source, name + ".h5")):
-                for k, h in enumerate(halves(load(os.path.join(source, name + ".h5")), realizations)):
+            path = os.path.join(source, name + ".h5")
+            if sr.archived(path):
+                for k, h in enumerate(halves(load(path), realizations)):
                     runs[f"{name}{k}"] = h
-    for name in names:
+    for name in runs_of(case):
         path = os.path.join(folder, name + ".h5")
         earlier = os.path.join(HERE, "results", EARLIER.get(case, "-"), name + ".h5")
         if sr.archived(path):
