@@ -31,6 +31,12 @@ test::LinearToyStepper slow_toy() {
     return test::LinearToyStepper(p, kH, Eigen::Vector2d(3.0, 1.0));
 }
 
+/// The input error CpiSettings raises for the scene `text` (on a 0.5 sampling grid).
+std::string cpi_refusal(const std::string& text) {
+    ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
+    return test::input_error([&] { CpiSettings::from_params(t.root().scope("cpi"), 0.5); }).what();
+}
+
 /// Bursts of 1 + 1, DT = 8: a cycle of 10 time units.
 CpiSettings fixed_settings(double warmup = 0.0) {
     CpiSettings s;
@@ -437,44 +443,38 @@ TEST_CASE("CpiSettings reads the adaptive keys and refuses what adaptive would i
     CHECK(f.multistep.dt == 40.0);
     CHECK(f.make_integrator({})->name() == "projective_adams_bashforth2");
 
-    auto refused = [](const std::string& text) {
-        ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
-        return std::string(test::input_error([&] {
-                               CpiSettings::from_params(t.root().scope("cpi"), 0.5);
-                           }).what());
-    };
     // Each message names the key, the file and line, and what is allowed.
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0\n"),
                Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.tolerance"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = -1\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = -1\n"),
                Catch::Contains("cpi.tolerance"));
-    CHECK_THAT(refused("cpi.projection = adaptive\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\n"),
                Catch::Contains("cpi.tolerance"));  // required
     CHECK_THAT(
-        refused(
+        cpi_refusal(
             "cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 50\ncpi.dt_max = 20\n"),
         Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.dt_min") &&
             Catch::Contains("cpi.dt_max = 20"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.periods = 2\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.periods = 2\n"),
                Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.periods") &&
                    Catch::Contains("not read with cpi.projection = adaptive"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt = 500\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt = 500\n"),
                Catch::Contains("cpi.dt") && Catch::Contains("caps the first jump"));
     CHECK_THAT(
-        refused("cpi.projection = fixed\ncpi.tolerance = 0.1\n"),
+        cpi_refusal("cpi.projection = fixed\ncpi.tolerance = 0.1\n"),
         Catch::Contains("cpi.tolerance") && Catch::Contains("only with cpi.projection = adaptive"));
-    CHECK_THAT(refused("cpi.projection = periods\ncpi.integrator = adams_bashforth2\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = periods\ncpi.integrator = adams_bashforth2\n"),
                Catch::Contains("cpi.integrator") && Catch::Contains("periods"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 0.3\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.dt_min = 0.3\n"),
                Catch::Contains("cpi.dt_min"));  // not a whole multiple of the sampling interval
     // cpi.window_auto: adaptive only; its bounds: 4 samples to cpi.window_max (default 4 bursts).
-    CHECK_THAT(refused("cpi.projection = fixed\ncpi.window_auto = true\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = fixed\ncpi.window_auto = true\n"),
                Catch::Contains("cpi.window_auto") &&
                    Catch::Contains("only with cpi.projection = adaptive"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_auto = "
-                       "true\ncpi.window_max = 5\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_auto = "
+                           "true\ncpi.window_max = 5\n"),
                Catch::Contains("cpi.window") && Catch::Contains("cpi.window_max = 5"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_max = 1\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_max = 1\n"),
                Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.window_max"));  // < 4 samples
     ParamTable w = ParamTable::from_text(
         "cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.window_auto = true\n", "scene.cfg",
@@ -485,13 +485,13 @@ TEST_CASE("CpiSettings reads the adaptive keys and refuses what adaptive would i
     CHECK(a.multistep.window_max == 80.0);  // 4 bursts of 10 + 10
     // cpi.accuracy instead of cpi.tolerance: not both, positive, adaptive only; the warm-up then
     // runs by time unless asked otherwise, and no drift is judged before the noise is measured.
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.accuracy = 1\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.accuracy = 1\n"),
                Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.accuracy") &&
                    Catch::Contains("cpi.tolerance") && Catch::Contains("one of them"));
-    CHECK_THAT(refused("cpi.projection = adaptive\ncpi.accuracy = 0\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.accuracy = 0\n"),
                Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.accuracy"));
     CHECK_THAT(
-        refused("cpi.projection = fixed\ncpi.accuracy = 1\n"),
+        cpi_refusal("cpi.projection = fixed\ncpi.accuracy = 1\n"),
         Catch::Contains("cpi.accuracy") && Catch::Contains("only with cpi.projection = adaptive"));
     ParamTable acc = ParamTable::from_text("cpi.projection = adaptive\ncpi.accuracy = 1.5\n",
                                            "scene.cfg", "/scenes");
@@ -815,14 +815,8 @@ TEST_CASE("cpi.jump_until is read on the sampling grid, and refused where nothin
     ParamTable fixed = ParamTable::from_text("cpi.jump_until = 40\n", "scene.cfg", "/scenes");
     CHECK(CpiSettings::from_params(fixed.root().scope("cpi"), 0.5).make_integrator({})->name() ==
           "projective_forward_euler_multistep");  // fixed DT with the controller's rule
-    const auto error = [](const char* text) {
-        ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
-        return std::string(test::input_error([&] {
-                               CpiSettings::from_params(t.root().scope("cpi"), 0.5);
-                           }).what());
-    };
-    CHECK_THAT(error("cpi.projection = periods\ncpi.jump_until = 40\n"),
+    CHECK_THAT(cpi_refusal("cpi.projection = periods\ncpi.jump_until = 40\n"),
                Catch::Contains("cpi.jump_until") && Catch::Contains("periods"));
-    CHECK_THAT(error("cpi.jump_until = 40.25\n"), Catch::Contains("cpi.jump_until"));
-    CHECK_THAT(error("cpi.jump_until = -1\n"), Catch::Contains("cpi.jump_until"));
+    CHECK_THAT(cpi_refusal("cpi.jump_until = 40.25\n"), Catch::Contains("cpi.jump_until"));
+    CHECK_THAT(cpi_refusal("cpi.jump_until = -1\n"), Catch::Contains("cpi.jump_until"));
 }
