@@ -35,9 +35,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
-import run_files  # noqa: E402
-
 sys.path.insert(0, HERE)
 import stop_times as st  # noqa: E402
 import study_runs as sr  # noqa: E402
@@ -125,8 +122,8 @@ def halves(run, realizations):
     out = []
     for k in range(2):
         sel = slice(k * realizations, (k + 1) * realizations)
-        h = dict(run, icdf=run["icdf"][:, sel, :], mean=run["icdf"][:, sel, :].mean(axis=1))
-        h["rest"] = None if run["rest"] is None else run["rest"][:, sel]
+        h = dict(run, icdf=run["icdf"][:, sel, :], mean=run["icdf"][:, sel, :].mean(axis=1),
+                 stops=run["stops"][sel], quiet=run["quiet"][sel])
         h["particle_steps"] = float("nan")  # the run's are not split by realization
         out.append(h)
     return out
@@ -139,16 +136,81 @@ def make(args, case):
     for name, (mode, overrides) in runs_of(case).items():
         if args.only and name not in args.only:
             continue
-        sr.ensure(os.path.abspath(args.efdem), 2, scene, work, name, mode, overrides,
-                  os.path.join(results, name + ".h5"), label=f"{case}/{name}")
+        if os.path.exists(os.path.join(results, name + ".json")):
+            print(f"  {case}/{name}: done before (its reduction is there), skipped", flush=True)
+            continue
+        archive = os.path.join(results, name + ".h5")
+        if sr.ensure(os.path.abspath(args.efdem), 2, scene, work, name, mode, overrides, archive,
+                     label=f"{case}/{name}"):
+            write_reduction(archive, os.path.join(results, name + ".json"))
 
 
-def load(path):
+# What the analysis reads of a run, kept in git beside the analysis (<case>/<run>.json): a study
+# spans more machines than one (a tall-bed direct ensemble of 600 units is 2 h on 2 cores), and the
+# run files and archives stay on the machine that made them. The reduction: the run's attributes,
+# every sample time (the DEM time a run spent), each realization's stop times (from the full
+# samples), and the light ICDF of every realization at the samples on a GRID-unit grid (3 decimals:
+# 1e-3 d_p, 40x below the smallest floor measured, 0.039 d_p at the demo bed's steady state). The
+# errors and floors are RMS over these samples: every 10th of a 0.5-unit sampling, which over a
+# quarter of a 600-unit span leaves 30 samples of a trajectory that moves on a scale of tens of units.
+GRID = 5.0
+KEPT_ATTRIBUTES = ("end_status", "simulated_time", "dem_time", "particle_steps", "wall_seconds", "git_commit",
+                   "study_command")
+
+
+def load_archive(path):
     with h5py.File(path, "r") as f:
         d = {k: sr.text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
-        d["t"], d["mean"], d["icdf"] = f["samples/time"][:], run_files.get(f, "samples/mean_icdf")[:], f["samples/icdf"][:]
+        d["t"], d["icdf"] = f["samples/time"][:], f["samples/icdf"][:]
         d["rest"] = f["samples/at_rest"][:] if "samples/at_rest" in f else None
     return d
+
+
+def reduce_run(full):
+    """The reduction (above) of a run loaded by load_archive."""
+    t = full["t"]
+    on_grid = np.abs(t / GRID - np.round(t / GRID)) < 1e-6
+    out = {k: (float(full[k]) if k not in ("end_status", "git_commit", "study_command") else full[k])
+           for k in KEPT_ATTRIBUTES if k in full}
+    def finite(xs):  # a realization still moving at the end: null (JSON has no NaN)
+        return [float(x) if np.isfinite(x) else None for x in xs]
+
+    out.update(t_all=[round(float(x), 6) for x in t], stops=finite(stops(full)), quiet=finite(demixing_stops(full)),
+               t=[round(float(x), 6) for x in t[on_grid]],
+               icdf=np.round(full["icdf"][on_grid], 3).tolist())
+    return out
+
+
+def from_reduction(d):
+    """A run as the analysis reads it (arrays) from its reduction."""
+    run = dict(d)
+    run["t_all"], run["t"] = np.asarray(d["t_all"]), np.asarray(d["t"])
+    run["icdf"] = np.asarray(d["icdf"], dtype=float).reshape(len(d["t"]), len(d["stops"]), -1)
+    run["mean"] = run["icdf"].mean(axis=1)
+    run["stops"], run["quiet"] = (np.array([np.nan if x is None else x for x in d[k]]) for k in ("stops", "quiet"))
+    return run
+
+
+def write_reduction(archive, dest):
+    tmp = dest + ".part"
+    with open(tmp, "w") as f:
+        json.dump(reduce_run(load_archive(archive)), f, separators=(",", ":"), allow_nan=False)
+        f.write("\n")
+    os.replace(tmp, dest)
+
+
+def load(folder, name, earlier=None):
+    """Run NAME of the case in FOLDER for the analysis: its reduction (written from its archive
+    when it has none yet), or None. EARLIER: an earlier study's archive that stands in."""
+    reduction, archive = os.path.join(folder, name + ".json"), os.path.join(folder, name + ".h5")
+    if not os.path.exists(reduction) and sr.archived(archive):
+        write_reduction(archive, reduction)
+    if os.path.exists(reduction):
+        with open(reduction) as f:
+            return from_reduction(json.load(f))
+    if earlier and sr.archived(earlier):
+        return from_reduction(json.loads(json.dumps(reduce_run(load_archive(earlier)))))
+    return None
 
 
 def stops(run):
@@ -230,18 +292,17 @@ def analyse_case(args, case):
     if case in DIRECTS_FROM:  # the halves of the R = 2R directs of another case
         source = os.path.join(args.results, DIRECTS_FROM[case])
         for name, _ in DIRECT:
-            path = os.path.join(source, name + ".h5")
-            if sr.archived(path):
-                for k, h in enumerate(halves(load(path), realizations)):
+            run = load(source, name)
+            if run is not None:
+                for k, h in enumerate(halves(run, realizations)):
                     runs[f"{name}{k}"] = h
     for name in runs_of(case):
-        path = os.path.join(folder, name + ".h5")
         earlier = os.path.join(HERE, "results", EARLIER.get(case, "-"), name + ".h5")
-        if sr.archived(path):
-            runs[name] = load(path)
-        elif name.startswith("direct") and sr.archived(earlier):
-            runs[name] = load(earlier)
-            shorter.append(f"{name} from {EARLIER[case]}")
+        run = load(folder, name, earlier if name.startswith("direct") else None)
+        if run is not None:
+            runs[name] = run
+            if not os.path.exists(os.path.join(folder, name + ".json")):
+                shorter.append(f"{name} from {EARLIER[case]}")
     for run in runs.values():
         run["end_state"] = "end state at" in run["end_status"]
     direct_names = [n for n in runs if n.startswith("direct")]
@@ -249,9 +310,9 @@ def analyse_case(args, case):
     if not directs:
         return None, []
     # The comparison's span: the run's duration, or less while some direct is shorter.
-    span = min([duration] + [float(d["t"][-1]) for d in directs])
+    span = min([duration] + [float(d["t_all"][-1]) for d in directs])
     t = directs[0]["t"][directs[0]["t"] <= span + 1e-6]
-    interval = float(t[1] - t[0])
+    interval = float(directs[0]["t_all"][1] - directs[0]["t_all"][0])  # the sampling's, not the grid's
     quarters = [(span * k / 4, span * (k + 1) / 4 + 1e-6) for k in range(4)]
     whole = (0.0, span + 1e-6)
     means = [held_to(d, t) for d in directs]
@@ -268,8 +329,8 @@ def analyse_case(args, case):
     # of the span, pooled over the ensembles (their own seeds: independent), with its standard error.
     direct_medians = np.concatenate([state_at(d, span) for d in directs])
     d_mean, d_se = float(direct_medians.mean()), float(direct_medians.std(ddof=1) / math.sqrt(len(direct_medians)))
-    direct_stops = [s for d in directs for s in stops(d)]
-    direct_quiet = [s for d in directs for s in demixing_stops(d)]
+    direct_stops = [s for d in directs for s in d["stops"]]
+    direct_quiet = [s for d in directs for s in d["quiet"]]
     last_stop = max(direct_stops) if all(np.isfinite(direct_stops)) else float("nan")
     summary = {"case": case, "span": span, "floor": floor[whole], "floor_quarters": [floor[w] for w in quarters],
                "direct_end_median": d_mean, "direct_end_median_se": d_se,
@@ -304,11 +365,10 @@ def analyse_case(args, case):
         med = state_at(run, span)
         c_mean, c_se = float(med.mean()), float(med.std(ddof=1) / math.sqrt(len(med)))
         off = (c_mean - d_mean) / math.sqrt(d_se ** 2 + c_se ** 2)
-        cpi_stops = stops(run)
-        cpi_quiet = demixing_stops(run)
+        cpi_stops, cpi_quiet = run["stops"], run["quiet"]
         # DEM time within the span: a CPI run samples only in its bursts.
-        dem = float(np.sum(run["t"] <= span + 1e-6)) * interval
-        speed = min(span, float(run["t"][-1])) / dem
+        dem = float(np.sum(run["t_all"] <= span + 1e-6)) * interval
+        speed = min(span, float(run["t_all"][-1])) / dem
         # DEM time to the end state: a direct ensemble's is when its last realization came to rest.
         to_end = (last_stop / float(run["dem_time"])) if run["end_state"] and np.isfinite(last_stop) else float("nan")
         # Do stops come with DEM time (a bed must run so long before it can freeze)? Then a CPI
@@ -324,7 +384,7 @@ def analyse_case(args, case):
         whole_run = span >= duration - 1e-6
         wall = (np.mean([float(d["wall_seconds"]) / float(d["simulated_time"]) for d in directs])
                 * float(run["simulated_time"]) / float(run["wall_seconds"])) if whole_run else float("nan")
-        ended = (f"end state at {float(run['t'][-1]):g}" if run["end_state"]
+        ended = (f"end state at {float(run['t_all'][-1]):g}" if run["end_state"]
                  else f"{float(run['simulated_time']):g} (duration)")
         summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole], "e_over_floor_quarters":
                                 [e[w] / floor[w] for w in quarters], "median": c_mean, "median_se": c_se,
@@ -343,13 +403,13 @@ def analyse_case(args, case):
                      + f" | {dem_each:g} | {expected:.1f} ({p_none:.2g}) | {steps_ratio:.2f} |")
     lines.append("")
     # While some directs are short, the state at the end of the run against those that got there.
-    full = [d for d in directs if float(d["t"][-1]) >= duration - 1e-6]
+    full = [d for d in directs if float(d["t_all"][-1]) >= duration - 1e-6]
     if span < duration - 1e-6 and full:
         med = np.concatenate([state_at(d, duration) for d in full])
         f_mean, f_se = float(med.mean()), float(med.std(ddof=1) / math.sqrt(len(med)))
         out = []
         for name in cpi:
-            if name in runs and float(runs[name]["t"][-1]) >= duration - 1e-6 or (
+            if name in runs and float(runs[name]["t_all"][-1]) >= duration - 1e-6 or (
                     name in runs and runs[name]["end_state"]):
                 c = state_at(runs[name], duration)
                 c_mean, c_se = float(c.mean()), float(c.std(ddof=1) / math.sqrt(len(c)))
@@ -381,21 +441,35 @@ def plot(folder, case, t, directs, cpis):
 
 
 def analyse(args):
-    out, summary = ["# The whole demixing (issue 34)\n",
-                    "Made by `/usr/bin/python3 bench/whole_process.py --efdem build/mpi_driver/efdem` (resumable; "
-                    "`--analyse-only` redoes this page). e: RMS over the ICDF nodes and the samples of the CPI "
-                    "run's ensemble mean minus each direct ensemble's, averaged in square over the directs; a run "
-                    "that ended at its end state is held there to the end of the span. Wall-time speed-ups are from "
-                    "a shared 2-core AMD EPYC machine whose load varies: the DEM-time ones are the measure.\n"], {}
+    """Each case's section (<case>/analysis.md) and summary from the runs it has; a case none of
+    whose runs is here keeps the section and summary an earlier analysis wrote. analysis.md and
+    analysis.json gather them."""
+    out = ["# The whole demixing (issue 34)\n",
+           "Made by `/usr/bin/python3 bench/whole_process.py --efdem build/mpi_driver/efdem` (resumable; "
+           "`--analyse-only` redoes this page from the runs' reductions, <case>/<run>.json). e: RMS over the "
+           f"ICDF nodes and the samples on a {GRID:g}-unit grid of the CPI run's ensemble mean minus each direct "
+           "ensemble's, averaged in square over the directs; a run that ended at its end state is held there to "
+           "the end of the span. Wall-time speed-ups are from a shared 2-core AMD EPYC machine whose load "
+           "varies: the DEM-time ones are the measure.\n"]
+    path = os.path.join(args.results, "analysis.json")
+    summary = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            summary = json.load(f)
     for case in CASES:
+        section = os.path.join(args.results, case, "analysis.md")
         s, lines = analyse_case(args, case)
         if s:
             summary[case] = s
-            out += lines
+            with open(section, "w") as f:
+                f.write("\n".join(lines) + "\n")
+        if os.path.exists(section):
+            with open(section) as f:
+                out.append(f.read())
     os.makedirs(args.results, exist_ok=True)
     with open(os.path.join(args.results, "analysis.md"), "w") as f:
-        f.write("\n".join(out) + "\n")
-    with open(os.path.join(args.results, "analysis.json"), "w") as f:
+        f.write("\n".join(out))
+    with open(path, "w") as f:
         json.dump(summary, f, indent=1, default=float)
     print("\n".join(out))
 
