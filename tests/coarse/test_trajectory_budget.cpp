@@ -216,3 +216,37 @@ TEST_CASE("cpi.accuracy: the budget charged is the error the jumps made, a loose
     INFO("DEM time: accuracy 2 " << tight.work << ", accuracy 8 " << loose.work);
     CHECK(loose.work < 0.9 * tight.work);
 }
+
+TEST_CASE("cpi.accuracy with cpi.jump_until plans the budget over the jumps before T",
+          "[unit][coarse][trajectory_budget]") {
+    // The budget is spread over the jumps still to come; with cpi.jump_until = T none comes after
+    // T, so a 300-unit run with jumps until 100 must give its first budgeted jump the tolerance of
+    // a run that ends at 100 (the same seed: the same bursts up to it, bit for bit), and a larger
+    // one than a run that jumps to 300 (three times as many jumps share the budget there).
+    const auto first_tolerance = [](double end_time, double jump_end) {
+        const Eigen::Index dim = 19;
+        test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(dim, 1e-4), 0.05, 8, 0.1,
+                                    Eigen::VectorXd::Constant(dim, 3.0), 301);
+        MultistepSettings s;
+        s.burst.healing = 1.0;
+        s.burst.window = 4.0;
+        s.control = {.tolerance = 1.0, .dt_min = 2.5, .dt_max = 80.0};
+        s.dt_quantum = 0.1;
+        s.accuracy = 2.0;
+        MultistepProjectiveIntegrator integrator(s);
+        integrator.set_end_time(end_time);
+        integrator.set_jump_end(jump_end);
+        while (toy.time() < 50.0) {
+            const ProjectiveStepRecord r = integrator.step(toy);
+            REQUIRE(r.advanced());
+            if (std::isfinite(r.controller.budget) && std::isfinite(r.controller.tolerance))
+                return r.controller.tolerance;
+        }
+        FAIL("no budgeted step before t = 50");
+        return 0.0;
+    };
+    const double inf = std::numeric_limits<double>::infinity();
+    const double until100 = first_tolerance(300.0, 100.0);
+    CHECK(until100 == first_tolerance(100.0, inf));
+    CHECK(until100 > 1.2 * first_tolerance(300.0, inf));
+}

@@ -247,10 +247,12 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m, ControllerRe
 void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
                                                        ControllerRecord& c) {
     if (!budget_ || !budget_->ready()) return;
-    // An open-ended run: the budget is planned over ten of the longest cycles ahead.
-    const double horizon = std::isfinite(end_time())
-                               ? end_time()
-                               : t_end_ + 10.0 * (settings_.control.dt_max + burst_length());
+    // An open-ended run: the budget is planned over ten of the longest cycles ahead. The jumps
+    // to come are those before cpi.jump_until where the run sets it: after it no jump adds error.
+    const double horizon = std::min(
+        std::isfinite(end_time()) ? end_time()
+                                  : t_end_ + 10.0 * (settings_.control.dt_max + burst_length()),
+        jump_end());
     double tol = 0.0;
     if (horizon > t_end_)
         tol = budget_->jump_tolerance(basis.model(t_end_, prior_curvature()), horizon,

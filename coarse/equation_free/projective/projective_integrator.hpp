@@ -171,7 +171,8 @@ class ProjectiveIntegrator {
     double end_time() const { return end_time_; }
     /// cpi.jump_until: no jump ends after `t` (default: no such time); after it every step is a
     /// burst of direct simulation. Read by the multistep integrator's controller, which
-    /// CpiSettings::make_integrator chooses whenever cpi.jump_until is set.
+    /// CpiSettings::make_integrator chooses whenever cpi.jump_until is set, and by its
+    /// cpi.accuracy budget (shared by the jumps before `t`).
     void set_jump_end(double t) { jump_end_ = t; }
     double jump_end() const { return jump_end_; }
 
