@@ -2,8 +2,9 @@
 """The whole demixing (issue 34, item 4): direct ensembles and CPI runs over the whole process,
 until the realizations have stopped demixing (U_s = 0.19) or the bed has reached its statistically
 steady state (0.41). One folder per case under bench/results/whole_process/<case>/, one result
-file per run (the kept groups of its run file, bench/study_runs.py; not committed), skipped when
-there; an interrupted run continues from its newest checkpoint.
+file per run (the kept groups of its run file, bench/study_runs.py; not committed) and its
+reduction (<run>.json: what the analysis reads, committed, so that a study continues on another
+machine), skipped when either is there; an interrupted run continues from its newest checkpoint.
 
     /usr/bin/python3 bench/whole_process.py --efdem build/mpi_driver/efdem                 # every case
     /usr/bin/python3 bench/whole_process.py --case demo_u0.19_r4 --only direct_a direct_b   # a part
