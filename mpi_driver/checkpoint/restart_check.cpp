@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -60,6 +61,38 @@ bool as_before_the_key(const std::string& key, const std::string& value) {
     for (const auto& [k, v] : kAddedKeys)
         if (key == k) return v == nullptr || value == v;
     return false;
+}
+
+/// cpi.jump_until in a parameter list: its value, infinity when the list does not set it.
+double jump_until_in(const std::map<std::string, std::string>& params) {
+    const auto it = params.find("cpi.jump_until");
+    return it == params.end() ? std::numeric_limits<double>::infinity()
+                              : std::strtod(it->second.c_str(), nullptr);
+}
+
+/// cpi.jump_until may change on a restart as long as what the run did so far keeps to it: no
+/// jump of the run ended later than the new value (the jumps so far ended by the old value and
+/// by the checkpoint's time, `elapsed` after the run's start). True when it may (or did not
+/// change); throws InputError when the new value would be broken by the jumps already made;
+/// false when the checkpoint's time is not known (then it is physics, as other keys).
+bool jump_until_may_change(const SourceLocation& where,
+                           const std::map<std::string, std::string>& then,
+                           const std::map<std::string, std::string>& now, double elapsed) {
+    const double before = jump_until_in(then), after = jump_until_in(now);
+    if (before == after) return true;
+    if (!std::isfinite(elapsed)) return false;
+    const double kept = std::min(before, elapsed);
+    if (after >= kept - 1e-9 * std::max(1.0, kept)) return true;
+    throw InputError(
+        where,
+        fmt::format("cpi.jump_until = {:g}, but the run's jumps went on until {:g} time "
+                    "units after its start (the checkpoint is {:g} units in{}): a restart may "
+                    "end the jumps from the checkpoint on, not before it. Give "
+                    "cpi.jump_until >= {:g}",
+                    after, kept, elapsed,
+                    std::isfinite(before) ? fmt::format(", cpi.jump_until = {:g}", before)
+                                          : std::string(", jumps to the end"),
+                    kept));
 }
 
 /// The first `most` of `items` joined with "; ", and how many more there are.
@@ -151,9 +184,19 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
                                    duration->second, elapsed, time_at_checkpoint, h.driver.t_origin,
                                    h.driver.t_origin, elapsed));
     }
+    // cpi.jump_until: where the jumps end (a run that jumped so far may go on directly from its
+    // checkpoint), within what the run did so far.
+    const bool jumps_end_may_change = jump_until_may_change(
+        where, then, now,
+        std::isfinite(time_at_checkpoint) ? time_at_checkpoint - h.driver.t_origin
+                                          : std::numeric_limits<double>::quiet_NaN());
+    const auto unchecked = [&](const std::string& key) {
+        return may_change_on_restart(key) || ignored_in(now, key) ||
+               (key == "cpi.jump_until" && jumps_end_may_change);
+    };
     std::vector<std::string> changes;
     for (const auto& [key, value] : now) {
-        if (may_change_on_restart(key) || ignored_in(now, key)) continue;
+        if (unchecked(key)) continue;
         const auto it = then.find(key);
         if (it == then.end()) {
             if (as_before_the_key(key, value)) continue;
@@ -168,7 +211,7 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
         }
     }
     for (const auto& [key, value] : then)
-        if (!may_change_on_restart(key) && !ignored_in(now, key) && !now.contains(key))
+        if (!unchecked(key) && !now.contains(key))
             changes.push_back(fmt::format("{} missing (checkpoint: {})", key, value));
     if (changes.empty()) return {};
     const std::string list = joined(changes, 8);

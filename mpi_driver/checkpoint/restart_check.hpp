@@ -7,7 +7,8 @@
 /// not change the trajectory: run.duration (extend a run), output.*, checkpoint.*, restart.*,
 /// debug.*, watchdog.*, ensemble.realizations_per_rank (the rank layout; results do not
 /// depend on it), ensemble.at_rest, and bed.write, bed.read* (a restart neither writes nor reads
-/// beds). The mode and the observe.* keys (the run file's grid) never change; other
+/// beds), and cpi.jump_until as long as the jumps the run made so far keep to the new value
+/// (it ends the jumps from the checkpoint on, never before it). The mode and the observe.* keys (the run file's grid) never change; other
 /// differences are refused unless restart.allow_physics_change = true.
 
 #include <filesystem>
@@ -32,7 +33,8 @@ bool shapes_the_run_file(const std::string& key);
 /// InputError (naming `path`) if the checkpoint cannot continue this run; returns a warning
 /// (non-empty) when physics changes were allowed. `time_at_checkpoint` (the ensemble's clock in
 /// the checkpoint; NaN: not known) refuses a run.duration that ends at or before it: such a
-/// restart would have nothing to run, and would put the run's files back to the checkpoint.
+/// restart would have nothing to run, and would put the run's files back to the checkpoint; with
+/// it, cpi.jump_until may change to any value not before the jumps made so far.
 std::string check_restart(const std::filesystem::path& path, const CheckpointHeader& checkpoint,
                           const std::string& parameters_now, long realizations_now,
                           bool allow_physics_change,

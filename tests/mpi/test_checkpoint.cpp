@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <limits>
 
 #include "core/error.hpp"
 #include "core/param_table.hpp"
@@ -172,6 +173,38 @@ TEST_CASE("a restart may change run length, output and layout keys, not physics"
         check_restart("c.h5", cpi, cpi.parameters + "cpi.at_rest = hold\n", 4, false),
         Catch::Contains("cpi.at_rest = hold (not in the checkpoint, whose run did cpi.at_rest = "
                         "lift)"));
+}
+
+TEST_CASE("a restart may end the jumps (cpi.jump_until) from its checkpoint on, not before it",
+          "[mpi][checkpoint]") {
+    // A cpi run from t = 10 checkpointed at t = 310 (300 units in): its jumps went on to 300 with
+    // no key, to 250 with cpi.jump_until = 250. A new value is accepted when no jump made so far
+    // broke it (>= min(old value, 300)), refused with the bound otherwise; without the
+    // checkpoint's time it is physics like any other key.
+    CheckpointHeader h;
+    h.realizations = 4;
+    h.driver.t_origin = 10.0;
+    h.parameters = "mode = cpi\nrun.duration = 1000\n";
+    const auto restart = [&](const std::string& then, const std::string& now, double t) {
+        CheckpointHeader c = h;
+        c.parameters += then;
+        return check_restart("c.h5", c, h.parameters + now, 4, false, t);
+    };
+    CHECK(restart("", "cpi.jump_until = 300\n", 310.0).empty());  // stop jumping now
+    CHECK(restart("", "cpi.jump_until = 400\n", 310.0).empty());
+    CHECK(restart("cpi.jump_until = 250\n", "cpi.jump_until = 400\n", 310.0).empty());  // resume
+    CHECK(restart("cpi.jump_until = 250\n", "", 310.0).empty());  // to the end
+    CHECK(restart("cpi.jump_until = 400\n", "cpi.jump_until = 300\n", 310.0).empty());
+    CHECK_THROWS_WITH(restart("", "cpi.jump_until = 250\n", 310.0),
+                      Catch::Contains("c.h5") && Catch::Contains("cpi.jump_until = 250") &&
+                          Catch::Contains("went on until 300") &&
+                          Catch::Contains("cpi.jump_until >= 300"));
+    CHECK_THROWS_WITH(restart("cpi.jump_until = 250\n", "cpi.jump_until = 200\n", 310.0),
+                      Catch::Contains("cpi.jump_until >= 250"));
+    CHECK_THROWS_WITH(
+        restart("", "cpi.jump_until = 400\n", std::numeric_limits<double>::quiet_NaN()),
+        Catch::Contains("different physics") &&
+            Catch::Contains("cpi.jump_until = 400 (not in the checkpoint)"));
 }
 
 TEST_CASE("checkpoint file names sort in writing order and exclude .tmp files",
