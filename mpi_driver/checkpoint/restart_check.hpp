@@ -8,8 +8,9 @@
 /// debug.*, watchdog.*, ensemble.realizations_per_rank (the rank layout; results do not
 /// depend on it), ensemble.at_rest, and bed.write, bed.read* (a restart neither writes nor reads
 /// beds), and cpi.jump_until as long as the jumps the run made so far keep to the new value
-/// (it ends the jumps from the checkpoint on, never before it). The mode and the observe.* keys (the run file's grid) never change; other
-/// differences are refused unless restart.allow_physics_change = true.
+/// (it ends the jumps from the checkpoint on, never before it). The mode and the observe.* keys
+/// (the run file's grid) never change; other differences are refused unless
+/// restart.allow_physics_change = true.
 
 #include <filesystem>
 #include <limits>
