@@ -178,7 +178,7 @@ def reduce_run(full):
 
     out.update(t_all=[round(float(x), 6) for x in t], stops=finite(stops(full)), quiet=finite(demixing_stops(full)),
                t=[round(float(x), 6) for x in t[on_grid]],
-               icdf=np.round(full["icdf"][on_grid], 3).tolist())
+               icdf=np.round(full["icdf"][on_grid].astype(float), 3).tolist())
     return out
 
 
