@@ -83,8 +83,8 @@ BedSpec BedSpec::from_params(const Params& p, const DemScene& scene) {
         b.count = read_counts(p, scene);
         const double d_max = scene.species.max_diameter();
         const double l_min = std::min(scene.domain.lx, scene.domain.ly);
-        b.spacing =
-            p.get_or<double>("spacing", 1.07, Bounds::closed(d_max, std::max(d_max, l_min)));
+        b.spacing = p.get_or<double>("spacing", 1.07 * d_max,
+                                     Bounds::closed(d_max, std::max(d_max, l_min)));
         b.jitter = p.get_or<double>("jitter", 0.03, Bounds::non_negative());
         if (b.jitter >= 0.5 * (b.spacing - d_max) && b.jitter > 0)
             p.fail("jitter", "lets neighbouring lattice spheres overlap",

@@ -15,7 +15,7 @@ double pressure_drop(const System& system) {
     const auto* gas = dynamic_cast<const GasDrag*>(system.find_effect("gas_drag"));
     if (!gas) return 0.0;
     EFDEM_ASSERT(system.slab_fields() != nullptr);
-    return gas->pressure_drop(*system.slab_fields());
+    return gas->pressure_drop(*system.slab_fields(), system.particles());
 }
 
 double weight_per_area(const Particles& p, const Domain& domain, double g) {

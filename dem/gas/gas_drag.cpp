@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -36,6 +37,7 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
     // Thicker than 10 d_p a slab averages over a large part of any bed (the demo bed is 15.5 d_p
     // tall, the paper's 48) and the drag no longer sees its solid-fraction profile.
     s.slab_thickness = p.get_or<double>("slab_thickness", 1.0, Bounds::closed(0.1, 10.0));
+    s.polydisperse = p.get_or_choice("polydisperse", "none", {"none", "van_der_hoef"}) != "none";
 
     static const char* const kPhysical[] = {"gas_viscosity", "particle_density",
                                             "particle_diameter", "gravity"};
@@ -66,24 +68,47 @@ GasDragSpec GasDragSpec::from_params(const Params& p) {
 }
 
 namespace {
+/// The largest diameter ratio the polydisperse closure was fitted for (van der Hoef et al. 2005,
+/// Beetstra et al. 2007: 1:1.5 to 1:4).
+constexpr double kMaxDiameterRatio = 4.0;
+
+void check_diameters(const EffectSetup& s, const GasDragSpec& spec) {
+    double d_min = s.species[0].diameter, d_max = d_min;
+    for (std::size_t k = 0; k < s.species.size(); ++k) {
+        d_min = std::min(d_min, s.species[static_cast<SpeciesId>(k)].diameter);
+        d_max = std::max(d_max, s.species[static_cast<SpeciesId>(k)].diameter);
+    }
+    if (!spec.polydisperse && (d_min != 1.0 || d_max != 1.0))
+        s.root.scope("species").fail(
+            "diameter",
+            "is not 1 for every species, but gas_drag's drag law (Eq. 2) is written for one "
+            "particle size, the unit length d_p",
+            "1 for every species, or gas_drag.polydisperse = van_der_hoef for spheres of several "
+            "sizes");
+    if (spec.polydisperse && d_max > kMaxDiameterRatio * d_min * (1.0 + 1e-12))
+        s.root.scope("species").fail(
+            "diameter",
+            fmt::format("spans a diameter ratio of {:.4g}, beyond the range of "
+                        "gas_drag.polydisperse = van_der_hoef (fitted to lattice-Boltzmann "
+                        "simulations of ratios up to 1:4)",
+                        d_max / d_min),
+            fmt::format("diameters within a ratio of {:g} of each other", kMaxDiameterRatio));
+}
+
 GasDragSpec checked_spec(const EffectSetup& s) {
-    for (std::size_t k = 0; k < s.species.size(); ++k)
-        if (s.species[static_cast<SpeciesId>(k)].diameter != 1.0)
-            s.root.scope("species").fail(
-                "diameter",
-                "is not 1 for every species, but gas_drag's drag law (Eq. 2) is "
-                "written for one particle size, the unit length d_p",
-                "1 for every species when gas_drag is listed in effects");
     GasDragSpec spec = GasDragSpec::from_params(s.scope);
-    // Above the terminal velocity of an isolated sphere of the heaviest species (rho / A,
+    check_diameters(s, spec);
+    // Above the terminal velocity of an isolated sphere of the heaviest species (rho d^2 / A,
     // physics.md §3.3) the gas carries every particle to the lid: no bed is left to fluidize.
-    double rho_max = 0;
-    for (std::size_t k = 0; k < s.species.size(); ++k)
-        rho_max = std::max(rho_max, s.species[static_cast<SpeciesId>(k)].density);
-    const double terminal = rho_max / spec.A;
+    double terminal_max = 0;
+    for (std::size_t k = 0; k < s.species.size(); ++k) {
+        const Species& sp = s.species[static_cast<SpeciesId>(k)];
+        terminal_max = std::max(terminal_max, sp.density * sp.diameter * sp.diameter / spec.A);
+    }
+    const double terminal = terminal_max;
     if (spec.superficial_velocity > terminal)
         s.scope.fail("superficial_velocity",
-                     fmt::format("exceeds the terminal velocity rho/A = {:.4g} of an isolated "
+                     fmt::format("exceeds the terminal velocity rho d^2/A = {:.4g} of an isolated "
                                  "sphere of the heaviest species (A = {:.6g}): the gas would carry "
                                  "every particle to the lid",
                                  terminal, spec.A),
@@ -132,13 +157,21 @@ void GasDrag::set_parameter(std::string_view key, double value) {
 GasDrag::GasDrag(const GasDragSpec& spec, const SpeciesTable& species) : spec_(spec) {
     for (std::size_t k = 0; k < species.size(); ++k) {
         density_.push_back(species[static_cast<SpeciesId>(k)].density);
+        diameter_.push_back(species[static_cast<SpeciesId>(k)].diameter);
         species_names_.push_back(species[static_cast<SpeciesId>(k)].name);
     }
+    if (spec_.polydisperse) polydisperse_.emplace(spec_.A, spec_.law, spec_.phi_cap);
 }
 
 double GasDrag::relaxation_time() const {
-    const double rho_min = *std::min_element(density_.begin(), density_.end());
-    return rho_min * std::pow(1.0 - spec_.phi_cap, 2.65) / spec_.A;
+    // Drag per unit volume of a sphere of diameter d among spheres of Sauter mean <d>: A r /
+    // (d <d>) (one size: A r); the shortest time is that of the smallest sphere among the
+    // smallest (d = <d> = d_min) of the lightest species.
+    const double d_min = *std::min_element(diameter_.begin(), diameter_.end());
+    double shortest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < density_.size(); ++k)
+        shortest = std::min(shortest, density_[k] * diameter_[k] * d_min);
+    return shortest * std::pow(1.0 - spec_.phi_cap, 2.65) / spec_.A;
 }
 
 std::string GasDrag::relaxation_label() const {
@@ -180,6 +213,10 @@ void GasDrag::slab_coefficients(const SlabFields& slabs) {
 void GasDrag::add_forces(ForceContext& ctx) {
     EFDEM_EXPECTS(ctx.slabs != nullptr);
     const SlabFields& slabs = *ctx.slabs;
+    if (polydisperse_) {
+        polydisperse_->add_forces(slabs, ctx.particles, spec_.superficial_velocity);
+        return;
+    }
     slab_coefficients(slabs);
     Particles& p = ctx.particles;
     const std::size_t n = p.size();
@@ -203,8 +240,13 @@ void GasDrag::add_forces(ForceContext& ctx) {
     }
 }
 
-void GasDrag::pressure_gradient(const SlabFields& slabs, std::span<Vec3> out) const {
+void GasDrag::pressure_gradient(const SlabFields& slabs, const Particles& p,
+                                std::span<Vec3> out) const {
     EFDEM_EXPECTS(out.size() >= slabs.size());
+    if (polydisperse_) {
+        polydisperse_->pressure_gradient(slabs, p, spec_.superficial_velocity, out);
+        return;
+    }
     const auto phi = slabs.phi();
     const auto u_s = slabs.solid_velocity();
     for (std::size_t j = 0; j < slabs.size(); ++j) {
@@ -213,7 +255,8 @@ void GasDrag::pressure_gradient(const SlabFields& slabs, std::span<Vec3> out) co
     }
 }
 
-double GasDrag::pressure_drop(const SlabFields& slabs) const {
+double GasDrag::pressure_drop(const SlabFields& slabs, const Particles& p) const {
+    if (polydisperse_) return polydisperse_->pressure_drop(slabs, p, spec_.superficial_velocity);
     const auto phi = slabs.phi();
     const auto u_s = slabs.solid_velocity();
     double dp = 0.0;
@@ -224,9 +267,10 @@ double GasDrag::pressure_drop(const SlabFields& slabs) const {
     return dp * slabs.thickness();
 }
 
-double GasDrag::minimum_fluidization_velocity(double density, double phi) const {
+double GasDrag::minimum_fluidization_velocity(double density, double phi, double diameter) const {
     const double phi_c = std::min(phi, spec_.phi_cap);
-    return density * (1.0 - phi_c) * (1.0 - phi_c) / (spec_.A * spec_.law->resistance(phi_c));
+    return density * diameter * diameter * (1.0 - phi_c) * (1.0 - phi_c) /
+           (spec_.A * spec_.law->resistance(phi_c));
 }
 
 void GasDrag::describe(EffectReport& r) const {
@@ -250,13 +294,19 @@ void GasDrag::describe(EffectReport& r) const {
     r.add("slabs", fmt::format("thickness {:g} d_p from the floor to the highest particle; phi "
                                "capped at {:g} inside the (1-phi) factors",
                                spec_.slab_thickness, spec_.phi_cap));
+    if (spec_.polydisperse)
+        r.add("polydisperse",
+              "van_der_hoef: drag on a sphere of diameter d among spheres of Sauter mean <d> "
+              "A r(phi)/(d <d>) per unit volume (van der Hoef et al. 2005 without the cubic term: "
+              "the law above for one size)");
     for (std::size_t k = 0; k < density_.size(); ++k) {
-        const double vt = density_[k] / spec_.A;  // Stokes: m g = V A v_t
+        const double d = diameter_[k];
+        const double vt = density_[k] * d * d / spec_.A;  // Stokes: m g = V A v_t / d^2
         r.add(fmt::format("species {}", species_names_[k]),
               fmt::format("Stokes terminal velocity and relaxation time {:.4g}; settles at U_s - "
                           "{:.4g} = {:.4g} when isolated; U_mf at phi = 0.6: {:.4g}",
                           vt, vt, spec_.superficial_velocity - vt,
-                          minimum_fluidization_velocity(density_[k], 0.6)));
+                          minimum_fluidization_velocity(density_[k], 0.6, d)));
     }
     // Which species U_s fluidizes on its own: between their U_mf a bed demixes into a fluidized
     // and a packed part, and can lose its fluidization as the species that is not fluidized
@@ -281,7 +331,8 @@ void GasDrag::describe(EffectReport& r) const {
 std::vector<std::string> GasDrag::species_not_fluidized() const {
     std::vector<std::string> out;
     for (std::size_t k = 0; k < density_.size(); ++k)
-        if (spec_.superficial_velocity <= minimum_fluidization_velocity(density_[k], 0.6))
+        if (spec_.superficial_velocity <=
+            minimum_fluidization_velocity(density_[k], 0.6, diameter_[k]))
             out.push_back(species_names_[k]);
     return out;
 }

@@ -24,8 +24,11 @@
 ///   (pressure_gradient()); its z part summed over the slabs is the pressure drop.
 /// Not done: gas inertia and weight (neglected, physics.md §3.2), buoyancy (absent from Eq. 1),
 /// fluid torque, horizontal gas flow (the vector form applies Eq. 1 componentwise, §3.3).
-/// Every species must have diameter 1 (Eq. 2 is written for one particle size d_p).
+/// Spheres of several diameters: `gas_drag.polydisperse = van_der_hoef` (PolydisperseDrag,
+/// dem/gas/polydisperse_drag.hpp), whose limit for one size is this kernel; without it every
+/// species must have diameter 1 (Eq. 2 is written for one particle size d_p).
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,6 +36,7 @@
 #include "core/registry.hpp"
 #include "dem/effect.hpp"
 #include "dem/gas/drag_laws.hpp"
+#include "dem/gas/polydisperse_drag.hpp"
 
 namespace efdem::dem {
 
@@ -57,6 +61,9 @@ struct GasDragSpec {
     double superficial_velocity = 0.0;  ///< U_s [sqrt(g d_p)], upward
     double phi_cap = 0.70;              ///< cap on phi inside the (1-phi) factors
     double slab_thickness = 1.0;        ///< dz of the slab fields [d_p]
+    /// gas_drag.polydisperse = van_der_hoef: the closure for spheres of several diameters
+    /// (PolydisperseDrag); none: one size, diameter 1.
+    bool polydisperse = false;
     /// Set when A was derived from physical inputs (for reports in physical units).
     bool physical = false;
     GasProperties gas;
@@ -94,15 +101,17 @@ class GasDrag final : public Effect {
     void set_parameter(std::string_view key, double value) override;
 
     /// (-grad p)_j of the discrete gas momentum balance, one vector per slab [rho_s g]; its z
-    /// component is -dp/dz. \pre out.size() >= slabs.size().
-    void pressure_gradient(const SlabFields& slabs, std::span<Vec3> out) const;
+    /// component is -dp/dz. `p`: the particles the slabs were updated from (the polydisperse
+    /// closure reads their diameters). \pre out.size() >= slabs.size().
+    void pressure_gradient(const SlabFields& slabs, const Particles& p, std::span<Vec3> out) const;
     /// Pressure drop across the bed, sum_j dz (-dp/dz)_j [rho_s g d_p]. Equals the total
     /// vertical gas force on the particles divided by lx ly.
-    double pressure_drop(const SlabFields& slabs) const;
+    double pressure_drop(const SlabFields& slabs, const Particles& p) const;
 
-    /// Minimum fluidization velocity of a uniform packed layer of density `density` [rho_s] at
-    /// solid fraction phi (physics.md §6.1): U_mf = density (1-phi)^2/(A r(phi)).
-    double minimum_fluidization_velocity(double density, double phi) const;
+    /// Minimum fluidization velocity of a uniform packed layer of one species, of density
+    /// `density` [rho_s] and `diameter` [d_p], at solid fraction phi (physics.md §6.1):
+    /// U_mf = density diameter^2 (1-phi)^2/(A r(phi)).
+    double minimum_fluidization_velocity(double density, double phi, double diameter = 1.0) const;
     /// The species that U_s does not fluidize on their own (U_mf at phi = 0.6 at or above U_s),
     /// by name. With some species fluidized and some not, a bed can defluidize and come to rest
     /// where the others gather as it demixes.
@@ -114,10 +123,14 @@ class GasDrag final : public Effect {
     void slab_coefficients(const SlabFields& slabs);
 
     GasDragSpec spec_;
-    std::vector<double> density_;  ///< per species [rho_s], for reports
+    std::vector<double> density_;   ///< per species [rho_s], for reports
+    std::vector<double> diameter_;  ///< per species [d_p]
     std::vector<std::string> species_names_;
     std::vector<double> c_;  ///< per slab (grows, never shrinks)
     std::vector<Vec3> a_;
+    /// The closure for several diameters (spec_.polydisperse); its scratch arrays change in
+    /// the const queries (pressure_gradient, pressure_drop).
+    mutable std::optional<PolydisperseDrag> polydisperse_;
 };
 
 }  // namespace efdem::dem

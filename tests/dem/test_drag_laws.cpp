@@ -130,7 +130,7 @@ TEST_CASE("gas_drag's other inputs are checked", "[unit][gas]") {
         t.add_override("gas_drag.superficial_velocity=17.5");
         const auto e = input_error([&] { build(t); });
         CHECK(e.key() == "gas_drag.superficial_velocity");
-        CHECK_THAT(e.problem(), Catch::Contains("terminal velocity rho/A = 17.4"));
+        CHECK_THAT(e.problem(), Catch::Contains("terminal velocity rho d^2/A = 17.4"));
         CHECK_THAT(e.allowed(), Catch::Contains("[0, 17.4"));
     }
     SECTION("slabs from 0.1 to 10 d_p, two of them below the lid") {
@@ -163,6 +163,28 @@ TEST_CASE("gas_drag's other inputs are checked", "[unit][gas]") {
         const auto e = input_error([&] { build(t); });
         CHECK(e.key() == "species.diameter");
         CHECK(e.problem().find("gas_drag") != std::string::npos);
+        CHECK_THAT(e.allowed(), Catch::Contains("gas_drag.polydisperse = van_der_hoef"));
+    }
+    SECTION("several sizes: the polydisperse closure, within its ratio of 4") {
+        auto t = test::scene_table(std::string(kScene) + "gas_drag.polydisperse = van_der_hoef\n");
+        t.add_override("species.diameter=1 1.5");
+        CHECK(gas_of(build(t)).spec().polydisperse);
+        auto wide =
+            test::scene_table(std::string(kScene) + "gas_drag.polydisperse = van_der_hoef\n");
+        wide.add_override("species.diameter=0.4 2");
+        wide.add_override("domain.lx=8");
+        wide.add_override("domain.ly=8");
+        const auto e = input_error([&] { build(wide); });
+        CHECK(e.key() == "species.diameter");
+        CHECK(e.value() == "0.4 2");
+        CHECK_THAT(e.problem(), Catch::Contains("ratio of 5"));
+        CHECK_THAT(e.allowed(), Catch::Contains("ratio of 4"));
+        auto unknown =
+            test::scene_table(std::string(kScene) + "gas_drag.polydisperse = beetstra\n");
+        const auto u = input_error([&] { build(unknown); });
+        CHECK(u.key() == "gas_drag.polydisperse");
+        CHECK(u.where().line == 11);
+        CHECK_THAT(u.allowed(), Catch::Contains("van_der_hoef"));
     }
 }
 

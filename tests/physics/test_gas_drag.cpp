@@ -101,7 +101,7 @@ TEST_CASE("total gas force = area x sum_j dz (-grad p)_j, to round-off", "[physi
             if (dz <= 1.0) CHECK(phi_max > 0.7);  // the cap is exercised
             const auto* gas = dynamic_cast<const GasDrag*>(sys.find_effect("gas_drag"));
             std::vector<Vec3> grad(slabs.size());
-            gas->pressure_gradient(slabs, grad);
+            gas->pressure_gradient(slabs, sys.particles(), grad);
             Vec3 expected{};
             for (const auto& g : grad) expected += g * (l * l * dz);
             const Vec3 f = total_force(sys);
