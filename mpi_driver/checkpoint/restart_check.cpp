@@ -42,6 +42,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.finish", "duration"},  // steady: end at the end state (issue 34)
     {"cpi.relabel", "any"},      // moving: relabel moving particles first (issue 34)
     {"cpi.hand_off", "none"},    // steady: the end state goes to the steady solver (issue 34)
+    {"gas_drag.polydisperse", "none"},  // van_der_hoef: spheres of several sizes (issue 37)
 };
 // clang-format on
 
