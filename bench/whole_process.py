@@ -18,8 +18,8 @@ again by more than 1e-6 d_p). Until a case's own direct runs are there, the shor
 same seeds from an earlier study (EARLIER) stand in, and the comparison covers their span.
 
 Cost (AMD EPYC, 2 cores, R = 4): a demo-bed direct run of 1,000 units 20 min on an idle machine
-(50-90 min shared), a CPI run 10-50 min; a tall-bed direct run of 600 units at R = 8 about 2 h
-idle. The tall bed's R = 4 cases take their directs from the R = 8 ones (DIRECTS_FROM): run
+(50-90 min shared), a CPI run 10-50 min; a tall-bed direct run of 600 units at R = 8 65 min
+(2026-12-05, with builds beside it). The tall bed's R = 4 cases take their directs from the R = 8 ones (DIRECTS_FROM): run
 `--case tall_u0.41_r8 --only direct_a direct_b direct_c` for both.
 """
 import argparse
