@@ -389,7 +389,8 @@ def analyse_case(args, case):
                  else f"{float(run['simulated_time']):g} (duration)")
         summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole], "e_over_floor_quarters":
                                 [e[w] / floor[w] for w in quarters], "median": c_mean, "median_se": c_se,
-                                "off_se": off, "stops": cpi_stops, "stopped_demixing": cpi_quiet,
+                                "off_se": off, "stops": [float(x) for x in cpi_stops],
+                                "stopped_demixing": [float(x) for x in cpi_quiet],
                                 "speedup_dem": speed,
                                 "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"],
                                 "dem_time_each": dem_each, "stops_expected_by_dem_time": expected,
@@ -470,8 +471,9 @@ def analyse(args):
     os.makedirs(args.results, exist_ok=True)
     with open(os.path.join(args.results, "analysis.md"), "w") as f:
         f.write("\n".join(out))
-    with open(path, "w") as f:
+    with open(path + ".part", "w") as f:  # a failed dump never leaves half a summary
         json.dump(summary, f, indent=1, default=float)
+    os.replace(path + ".part", path)
     print("\n".join(out))
 
 
