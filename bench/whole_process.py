@@ -210,7 +210,7 @@ def load(folder, name, earlier=None):
         with open(reduction) as f:
             return from_reduction(json.load(f))
     if earlier and sr.archived(earlier):
-        return from_reduction(json.loads(json.dumps(reduce_run(load_archive(earlier)))))
+        return from_reduction(reduce_run(load_archive(earlier)))
     return None
 
 

@@ -100,12 +100,11 @@ GasDragSpec checked_spec(const EffectSetup& s) {
     check_diameters(s, spec);
     // Above the terminal velocity of an isolated sphere of the heaviest species (rho d^2 / A,
     // physics.md §3.3) the gas carries every particle to the lid: no bed is left to fluidize.
-    double terminal_max = 0;
+    double terminal = 0;
     for (std::size_t k = 0; k < s.species.size(); ++k) {
         const Species& sp = s.species[static_cast<SpeciesId>(k)];
-        terminal_max = std::max(terminal_max, sp.density * sp.diameter * sp.diameter / spec.A);
+        terminal = std::max(terminal, sp.density * sp.diameter * sp.diameter / spec.A);
     }
-    const double terminal = terminal_max;
     if (spec.superficial_velocity > terminal)
         s.scope.fail("superficial_velocity",
                      fmt::format("exceeds the terminal velocity rho d^2/A = {:.4g} of an isolated "

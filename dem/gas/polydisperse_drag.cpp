@@ -93,11 +93,4 @@ double PolydisperseDrag::pressure_drop(const SlabFields& slabs, const Particles&
     return dp * slabs.thickness();
 }
 
-double PolydisperseDrag::minimum_fluidization_velocity(double density, double diameter,
-                                                       double phi) const {
-    const double phi_c = std::min(phi, phi_cap_);
-    return density * diameter * diameter * (1.0 - phi_c) * (1.0 - phi_c) /
-           (A_ * law_->resistance(phi_c));
-}
-
 }  // namespace efdem::dem

@@ -72,10 +72,6 @@ class PolydisperseDrag {
     /// sum_j dz (-dp/dz)_j [rho_s g d_p]: the vertical gas force on the particles over lx ly.
     double pressure_drop(const SlabFields& slabs, const Particles& p, double U_s);
 
-    /// U_mf of a packed layer of one species (diameter d, density rho) at solid fraction phi:
-    /// rho d^2 (1 - phi)^2 / (A r(phi)).
-    double minimum_fluidization_velocity(double density, double diameter, double phi) const;
-
   private:
     /// Per slab: e = c/<d>, b = e (u_s + slip/e_c), q = e (slip phi_c/(<d> e_c^2) + (Phi u_s -
     /// M)/e_c), so that F_i = sum_j V_ij [(b_j - e_j v_i)/d_i + q_j]; and the total force per

@@ -170,9 +170,10 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
                                "restart.allow_physics_change changes them)",
                                joined(grid, grid.size())));
     }
+    // Time units the run had simulated at the checkpoint (NaN: not known).
+    const double elapsed = time_at_checkpoint - h.driver.t_origin;
     const auto duration = now.find("run.duration");
-    if (std::isfinite(time_at_checkpoint) && duration != now.end()) {
-        const double elapsed = time_at_checkpoint - h.driver.t_origin;
+    if (std::isfinite(elapsed) && duration != now.end()) {
         const double d = std::strtod(duration->second.c_str(), nullptr);
         if (d <= elapsed + 1e-9 * std::max(1.0, std::abs(d)))
             throw InputError(
@@ -187,10 +188,7 @@ std::string check_restart(const std::filesystem::path& path, const CheckpointHea
     }
     // cpi.jump_until: where the jumps end (a run that jumped so far may go on directly from its
     // checkpoint), within what the run did so far.
-    const bool jumps_end_may_change = jump_until_may_change(
-        where, then, now,
-        std::isfinite(time_at_checkpoint) ? time_at_checkpoint - h.driver.t_origin
-                                          : std::numeric_limits<double>::quiet_NaN());
+    const bool jumps_end_may_change = jump_until_may_change(where, then, now, elapsed);
     const auto unchecked = [&](const std::string& key) {
         return may_change_on_restart(key) || ignored_in(now, key) ||
                (key == "cpi.jump_until" && jumps_end_may_change);
