@@ -11,15 +11,12 @@
 
 #include <Eigen/Core>
 
+#include "coarse/demixing/lift_plan.hpp"
 #include "coarse/demixing/monotone_repair.hpp"
 #include "coarse/demixing/probability_grid.hpp"
 #include "core/rng.hpp"
 
 namespace efdem::coarse {
-
-/// Species labels ("colours") as colour lifting reads and writes them.
-inline constexpr std::uint8_t kHeavy = 0;
-inline constexpr std::uint8_t kLight = 1;
 
 enum class LiftStatus {
     ok,        ///< target met as given: no repair, every interval could take its light count

@@ -110,6 +110,43 @@ inline dem::Particles random_particles(int n, double l, double z_lo, double z_hi
     return p;
 }
 
+/// Species of a bed of two sizes: 0 = "small" (diameter 1), 1 = "large" (diameter `ratio`),
+/// both of density 1.
+inline dem::SpeciesTable two_size_species(double ratio) {
+    return dem::SpeciesTable({{"small", 1.0, 1.0}, {"large", 1.0, ratio}});
+}
+
+/// A loose bed of two sizes without overlaps: random sequential addition in [0, l)^2 x
+/// [0, height) (periodic in x, y), the large spheres first, each placed at the first of up to
+/// 10,000 random trials that touches nothing; standard-normal velocities times `speed`. At a
+/// solid fraction up to ~0.3 every sphere finds a place (a test error otherwise).
+inline dem::Particles two_size_loose_bed(int n_small, int n_large, double ratio, double l,
+                                         double height, std::uint32_t seed, double speed = 0.1) {
+    const auto species = two_size_species(ratio);
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::normal_distribution<double> nv(0, 1);
+    dem::Particles p;
+    const dem::Domain box{l, l};
+    for (int i = 0; i < n_small + n_large; ++i) {
+        const auto s = static_cast<dem::SpeciesId>(i < n_large ? 1 : 0);
+        const double r = species.radius(s);
+        for (int trial = 0;; ++trial) {
+            if (trial == 10000) throw std::logic_error("two_size_loose_bed: no room left");
+            const Vec3 x{l * u(gen), l * u(gen), r + (height - 2 * r) * u(gen)};
+            bool free = true;
+            for (std::size_t j = 0; j < p.size() && free; ++j) {
+                const double reach = r + p.radius()[j];
+                free = norm2(box.minimum_image(x - p.x()[j])) >= reach * reach;
+            }
+            if (!free) continue;
+            p.add(i + 1, x, Vec3{nv(gen), nv(gen), nv(gen)} * speed, s, species);
+            break;
+        }
+    }
+    return p;
+}
+
 /// A scene table from text (file name "test.cfg").
 inline ParamTable scene_table(const std::string& text) {
     return ParamTable::from_text(text, "test.cfg", EFDEM_SOURCE_DIR);

@@ -1,0 +1,128 @@
+#include "coarse/demixing/lift_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "coarse/demixing/quantiles.hpp"
+#include "core/contracts.hpp"
+
+namespace efdem::coarse {
+
+namespace {
+
+using Count = std::int64_t;
+
+/**
+ * Observed counts below each cut: `wanted` (B_0 = 0, ..., B_{m+1} = N_L) made feasible for
+ * interval populations `population` (0 <= B_{k+1} - B_k <= P_k). Feasible bounds at boundary j:
+ * L_j = max(0, N_L - (N - S_j)) <= B_j <= U_j = min(N_L, S_j), S_j = particles below it. A
+ * forward pass pushes any excess up, a backward pass pushes it down; both are feasible, and so
+ * is the floor of their mean, which splits the excess between the neighbours. A feasible
+ * `wanted` is returned unchanged.
+ */
+std::vector<Count> feasible_cumulative(const std::vector<Count>& wanted,
+                                       const std::vector<Count>& population) {
+    const std::size_t n_bounds = wanted.size();  // m + 2
+    const Count n_light = wanted.back();
+    std::vector<Count> below(n_bounds, 0);
+    for (std::size_t j = 1; j < n_bounds; ++j) below[j] = below[j - 1] + population[j - 1];
+    const Count total = below.back();
+    auto lower = [&](std::size_t j) { return std::max<Count>(0, n_light - (total - below[j])); };
+    auto upper = [&](std::size_t j) { return std::min<Count>(n_light, below[j]); };
+
+    std::vector<Count> forward(n_bounds), backward(n_bounds), result(n_bounds);
+    forward[0] = 0;
+    for (std::size_t j = 1; j < n_bounds; ++j)
+        forward[j] = std::clamp(wanted[j], std::max(forward[j - 1], lower(j)),
+                                std::min(forward[j - 1] + population[j - 1], upper(j)));
+    backward[n_bounds - 1] = n_light;
+    for (std::size_t j = n_bounds - 1; j-- > 0;)
+        backward[j] = std::clamp(wanted[j], std::max(backward[j + 1] - population[j], lower(j)),
+                                 std::min(backward[j + 1], upper(j)));
+    for (std::size_t j = 0; j < n_bounds; ++j) result[j] = (forward[j] + backward[j]) / 2;
+    return result;
+}
+
+}  // namespace
+
+std::uint32_t cuts_at_or_below(std::span<const double> cuts, double z) {
+    const double* base = cuts.data();
+    std::size_t len = cuts.size();
+    while (len > 1) {
+        const std::size_t half = len / 2;
+        base = base[half] <= z ? base + half : base;
+        len -= half;
+    }
+    return static_cast<std::uint32_t>(base - cuts.data()) + (*base <= z ? 1u : 0u);
+}
+
+Count LiftPlan::shortfall() const {
+    Count off = 0;
+    for (std::size_t j = 0; j < below.size(); ++j)
+        off = std::max(off, std::abs(below[j] - wanted[j]));
+    return off;
+}
+
+LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
+                   std::span<const std::uint8_t> colours, const ProbabilityGrid& grid) {
+    EFDEM_EXPECTS(heights.size() == colours.size());
+    EFDEM_EXPECTS(target_icdf.size() == grid.size());
+    EFDEM_EXPECTS(std::all_of(colours.begin(), colours.end(),
+                              [](std::uint8_t c) { return c == kLight || c == kHeavy; }));
+    LiftPlan plan;
+    plan.target = target_icdf;
+    plan.n_observed = static_cast<Count>(std::count(colours.begin(), colours.end(), kLight));
+    if (plan.n_observed == 0) {
+        plan.error = "there are no light particles (the light ICDF is undefined)";
+        return plan;
+    }
+    double z_min = std::numeric_limits<double>::infinity();
+    double z_max = -std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < heights.size(); ++j) {
+        if (!std::isfinite(heights[j])) {
+            plan.error = fmt::format("the height of particle {} is not finite", j);
+            return plan;
+        }
+        z_min = std::min(z_min, heights[j]);
+        z_max = std::max(z_max, heights[j]);
+    }
+    if (!(z_min < z_max)) {
+        plan.error =
+            fmt::format("all particles are at the same height {:.6g}: no ICDF can change", z_min);
+        return plan;
+    }
+    plan.repair = repair_monotone(plan.target, z_min, z_max);
+    if (!plan.repair.feasible) {
+        plan.error = plan.repair.message;
+        return plan;
+    }
+
+    // Interval of each particle, populations and current observed counts: one sequential pass.
+    const int m = grid.size();
+    const auto n_intervals = static_cast<std::size_t>(m + 1);
+    const std::span<const double> cuts(plan.target.data(), static_cast<std::size_t>(m));
+    plan.interval.resize(heights.size());
+    plan.population.assign(n_intervals, 0);
+    plan.observed_now.assign(n_intervals, 0);
+    for (std::size_t j = 0; j < heights.size(); ++j) {
+        const std::uint32_t k = cuts_at_or_below(cuts, heights[j]);
+        plan.interval[j] = k;
+        ++plan.population[k];
+        plan.observed_now[k] += colours[j] == kLight;
+    }
+
+    plan.wanted.assign(n_intervals + 1, 0);
+    for (int i = 0; i < m; ++i)
+        plan.wanted[static_cast<std::size_t>(i) + 1] =
+            count_below_quantile(grid, i, plan.n_observed);
+    plan.wanted.back() = plan.n_observed;
+    plan.below = feasible_cumulative(plan.wanted, plan.population);
+    for (std::size_t k = 0; k < n_intervals; ++k)
+        if (plan.wanted[k + 1] - plan.wanted[k] > plan.population[k]) ++plan.n_short_intervals;
+    return plan;
+}
+
+}  // namespace efdem::coarse

@@ -1,0 +1,301 @@
+#include "coarse/demixing/position_lifting.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "coarse/demixing/quantiles.hpp"
+#include "core/contracts.hpp"
+
+namespace efdem::coarse {
+
+namespace {
+
+using Count = std::int64_t;
+
+/// One exchange: a large particle from `large_interval` against a group of `group` small ones
+/// drawn from intervals small_lo..small_hi.
+struct Exchange {
+    std::size_t large_interval = 0;
+    std::size_t small_lo = 0, small_hi = 0;
+    Count group = 0;
+};
+
+/// Entry k of `list` repeated count_k times, k ascending (count_k = max(0, sign * gain_k)).
+std::vector<std::size_t> repeated_intervals(const LiftPlan& plan, int sign) {
+    std::vector<std::size_t> list;
+    for (std::size_t k = 0; k < plan.population.size(); ++k)
+        for (Count c = 0; c < sign * plan.gain(k); ++c) list.push_back(k);
+    return list;
+}
+
+/// The exchanges of step 2 (position_lifting.hpp), lowest first.
+std::vector<Exchange> plan_exchanges(const LiftPlan& plan, bool observed_is_small, double rho) {
+    const std::vector<std::size_t> losing = repeated_intervals(plan, -1);
+    const std::vector<std::size_t> gaining = repeated_intervals(plan, +1);
+    EFDEM_ASSERT(losing.size() == gaining.size());
+    const auto moves = static_cast<Count>(losing.size());
+    std::vector<Exchange> out;
+    if (observed_is_small) {
+        const auto n = static_cast<Count>(std::llround(static_cast<double>(moves) / rho));
+        for (Count t = 0; t < n; ++t) {
+            const Count first = t * moves / n, last = (t + 1) * moves / n;
+            const auto middle = static_cast<std::size_t>((2 * t + 1) * moves / (2 * n));
+            out.push_back({gaining[middle], losing[static_cast<std::size_t>(first)],
+                           losing[static_cast<std::size_t>(last - 1)], last - first});
+        }
+    } else {
+        for (Count t = 0; t < moves; ++t) {
+            const Count group = std::llround(rho * static_cast<double>(t + 1)) -
+                                std::llround(rho * static_cast<double>(t));
+            if (group == 0) continue;
+            const std::size_t k = gaining[static_cast<std::size_t>(t)];
+            out.push_back({losing[static_cast<std::size_t>(t)], k, k, group});
+        }
+    }
+    return out;
+}
+
+class Exchanger {
+  public:
+    Exchanger(const LiftPlan& plan, std::span<const Vec3> x, std::span<const std::uint8_t> colours,
+              std::uint8_t small_colour, const TwoSizes& sizes, RandomStream& rng)
+        : plan_(plan),
+          x_(x),
+          colours_(colours),
+          small_colour_(small_colour),
+          sizes_(sizes),
+          rng_(rng),
+          chosen_(x.size(), 0),
+          by_interval_(plan.population.size()),
+          quota_(plan.population.size(), 0) {
+        for (std::size_t j = 0; j < x.size(); ++j) by_interval_[plan.interval[j]].push_back(j);
+        if (small_colour == kLight)  // the small ones are observed: each interval sends its loss
+            for (std::size_t k = 0; k < quota_.size(); ++k)
+                quota_[k] = std::max<Count>(0, -plan.gain(k));
+    }
+
+    /// The particles of one exchange: {large, group...}; empty if no large particle is left.
+    std::vector<std::size_t> pick(const Exchange& e) {
+        const std::uint8_t large_colour = small_colour_ ^ 1u;
+        const std::size_t large = pick_random(e.large_interval, large_colour);
+        if (large == kNone) return {};
+        std::vector<std::size_t> out{large};
+        const bool quotas = small_colour_ == kLight;
+        std::size_t lo = e.small_lo, hi = e.small_hi;
+        for (;;) {
+            std::vector<std::size_t> candidates;
+            for (std::size_t k = lo; k <= hi; ++k)
+                for (std::size_t j : by_interval_[k])
+                    if (!chosen_[j] && colours_[j] == small_colour_ && (!quotas || quota_[k] > 0))
+                        candidates.push_back(j);
+            if (static_cast<Count>(candidates.size()) >= e.group ||
+                (lo == 0 && hi + 1 == quota_.size())) {
+                take_nearest(candidates, e, quotas, out);
+                return out;
+            }
+            lo = lo > 0 ? lo - 1 : lo;
+            hi = hi + 1 < quota_.size() ? hi + 1 : hi;
+        }
+    }
+
+    /// The group's centroid, unwrapped around its first member.
+    Vec3 centroid(std::span<const std::size_t> group) const {
+        Vec3 sum{};
+        for (std::size_t j : group) sum += separation(x_[j], x_[group[0]]);
+        return x_[group[0]] + sum * (1.0 / static_cast<double>(group.size()));
+    }
+    Vec3 offset(std::size_t j, const Vec3& from) const { return separation(x_[j], from); }
+
+  private:
+    static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
+    Vec3 separation(const Vec3& a, const Vec3& b) const {
+        Vec3 d = a - b;
+        d.x -= sizes_.lx * std::nearbyint(d.x / sizes_.lx);
+        d.y -= sizes_.ly * std::nearbyint(d.y / sizes_.ly);
+        return d;
+    }
+
+    /// A random unchosen particle of `colour` in interval k, or in the nearest interval that has
+    /// one (below first on a tie).
+    std::size_t pick_random(std::size_t k, std::uint8_t colour) {
+        const std::size_t n = by_interval_.size();
+        for (std::size_t r = 0; r < n; ++r)
+            for (const std::size_t q : {k - r, k + r}) {
+                if (q >= n) continue;  // k - r wrapped below 0, or past the top
+                std::vector<std::size_t> c;
+                for (std::size_t j : by_interval_[q])
+                    if (!chosen_[j] && colours_[j] == colour) c.push_back(j);
+                if (c.empty()) continue;
+                const std::size_t j = c[rng_.below(c.size())];
+                chosen_[j] = 1;
+                return j;
+            }
+        return kNone;
+    }
+
+    /// The group: a random seed among the candidates of the group's lowest interval (any
+    /// candidate if that one has none), then the nearest others, taking each interval's quota.
+    void take_nearest(std::vector<std::size_t>& candidates, const Exchange& e, bool quotas,
+                      std::vector<std::size_t>& out) {
+        if (candidates.empty()) return;
+        std::vector<std::size_t> in_lowest;
+        for (std::size_t j : candidates)
+            if (plan_.interval[j] == e.small_lo) in_lowest.push_back(j);
+        const std::vector<std::size_t>& seeds = in_lowest.empty() ? candidates : in_lowest;
+        const Vec3 seed = x_[seeds[rng_.below(seeds.size())]];
+        std::vector<std::pair<double, std::size_t>> by_distance;
+        by_distance.reserve(candidates.size());
+        for (std::size_t j : candidates)
+            by_distance.emplace_back(norm2(separation(x_[j], seed)), j);
+        std::sort(by_distance.begin(), by_distance.end());
+        Count taken = 0;
+        for (const auto& [d2, j] : by_distance) {
+            if (taken == e.group) break;
+            const std::size_t k = plan_.interval[j];
+            if (quotas && quota_[k] == 0) continue;
+            if (quotas) --quota_[k];
+            chosen_[j] = 1;
+            out.push_back(j);
+            ++taken;
+        }
+    }
+
+    const LiftPlan& plan_;
+    std::span<const Vec3> x_;
+    std::span<const std::uint8_t> colours_;
+    std::uint8_t small_colour_;
+    const TwoSizes& sizes_;
+    RandomStream& rng_;
+    std::vector<std::uint8_t> chosen_;
+    std::vector<std::vector<std::size_t>> by_interval_;
+    std::vector<Count> quota_;
+};
+
+Eigen::VectorXd observed_icdf(std::span<const Vec3> x, std::span<const std::uint8_t> colours,
+                              const ProbabilityGrid& grid) {
+    std::vector<double> z;
+    for (std::size_t j = 0; j < x.size(); ++j)
+        if (colours[j] == kLight) z.push_back(x[j].z);
+    return quantiles(z, grid);
+}
+
+}  // namespace
+
+PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
+                                  std::span<const Vec3> positions, std::span<const Vec3> velocities,
+                                  std::span<const std::uint8_t> colours, const TwoSizes& sizes,
+                                  const ProbabilityGrid& grid, RandomStream& rng) {
+    EFDEM_EXPECTS(positions.size() == colours.size() && velocities.size() == colours.size());
+    EFDEM_EXPECTS(sizes.observed_diameter > 0 && sizes.other_diameter > 0);
+    const double d_large = std::max(sizes.observed_diameter, sizes.other_diameter);
+    const double d_small = std::min(sizes.observed_diameter, sizes.other_diameter);
+    EFDEM_EXPECTS(d_large <= 4 * d_small);
+    EFDEM_EXPECTS(sizes.lx > 0 && sizes.ly > 0);
+
+    PositionLiftResult result;
+    result.positions.assign(positions.begin(), positions.end());
+    result.velocities.assign(velocities.begin(), velocities.end());
+    result.moved.assign(positions.size(), 0);
+    std::vector<double> heights(positions.size());
+    for (std::size_t j = 0; j < positions.size(); ++j) heights[j] = positions[j].z;
+    const LiftPlan plan = plan_lift(target_icdf, heights, colours, grid);
+    result.target = plan.error.empty() ? plan.target : target_icdf;
+    if (!plan.error.empty()) {
+        result.message = "lifting rejected, no particle moved: " + plan.error;
+        return result;
+    }
+    result.repair = plan.repair;
+    result.n_short_intervals = plan.n_short_intervals;
+    const double rho = std::pow(d_large / d_small, 3);
+    result.volume_ratio = rho;
+    const bool observed_is_small = sizes.observed_diameter <= sizes.other_diameter;
+    const std::uint8_t small_colour = observed_is_small ? kLight : kHeavy;
+    const double m_small = observed_is_small ? sizes.observed_mass : sizes.other_mass;
+    const double m_large = observed_is_small ? sizes.other_mass : sizes.observed_mass;
+    const double r_large = d_large / 2, r_small = d_small / 2;
+
+    Exchanger exchanger(plan, positions, colours, small_colour, sizes, rng);
+    std::size_t dropped = 0;
+    for (const Exchange& e : plan_exchanges(plan, observed_is_small, rho)) {
+        const std::vector<std::size_t> picked = exchanger.pick(e);
+        if (picked.size() < 2) {
+            ++dropped;
+            continue;
+        }
+        const std::size_t large = picked[0];
+        const std::span<const std::size_t> group(picked.begin() + 1, picked.end());
+        const Vec3 c = exchanger.centroid(group);
+        double rms = 0;
+        Vec3 mean_v{};
+        for (std::size_t j : group) {
+            rms += norm2(exchanger.offset(j, c));
+            mean_v += velocities[j];
+        }
+        rms = std::sqrt(rms / static_cast<double>(group.size()));
+        mean_v *= 1.0 / static_cast<double>(group.size());
+        const double fill = std::sqrt(3.0 / 5.0) * (r_large - r_small);
+        const double scale = rms > fill ? fill / rms : 1.0;
+        const Vec3 home = positions[large];
+        for (std::size_t j : group) {
+            result.positions[j] = home + exchanger.offset(j, c) * scale;
+            result.velocities[j] = velocities[large] + (velocities[j] - mean_v);
+            result.moved[j] = 1;
+        }
+        result.positions[large] = c;
+        result.velocities[large] = mean_v;
+        result.moved[large] = 1;
+        ++result.n_exchanges;
+        result.n_moved += picked.size();
+    }
+    // Masses matched: the large particle carries the group's momentum; otherwise (other
+    // densities or group sizes off the ratio) a change is left and reported.
+    Vec3 dp{};
+    double dke = 0;
+    for (std::size_t j = 0; j < positions.size(); ++j) {
+        const double m = (colours[j] == small_colour) ? m_small : m_large;
+        Vec3& xj = result.positions[j];
+        xj.x -= sizes.lx * std::floor(xj.x / sizes.lx);
+        xj.y -= sizes.ly * std::floor(xj.y / sizes.ly);
+        dp += (result.velocities[j] - velocities[j]) * m;
+        dke += 0.5 * m * (norm2(result.velocities[j]) - norm2(velocities[j]));
+    }
+    result.momentum_change = std::sqrt(norm2(dp));
+    result.kinetic_energy_change = dke;
+
+    // The solid volume of each interval of the plan, before and after [small volumes].
+    const std::span<const double> cuts(plan.target.data(), plan.target.size());
+    std::vector<double> dv(plan.population.size(), 0.0);
+    for (std::size_t j = 0; j < positions.size(); ++j) {
+        if (!result.moved[j]) continue;
+        const double v = colours[j] == small_colour ? 1.0 : rho;
+        dv[plan.interval[j]] -= v;
+        dv[cuts_at_or_below(cuts, result.positions[j].z)] += v;
+    }
+    for (double d : dv) result.max_volume_change = std::max(result.max_volume_change, std::abs(d));
+
+    result.achieved_icdf = observed_icdf(result.positions, colours, grid);
+    result.max_deviation = (result.achieved_icdf - result.target).cwiseAbs().maxCoeff();
+    const bool short_counts = plan.below != plan.wanted;
+    result.status = result.repair.changed() || short_counts || dropped > 0 ? LiftStatus::adjusted
+                                                                           : LiftStatus::ok;
+    result.message = result.repair.message;
+    auto add = [&](const std::string& what) {
+        result.message += (result.message.empty() ? "" : "; ") + what;
+    };
+    if (short_counts)
+        add(
+            fmt::format("{} interval(s) held fewer particles than their observed count (a node's "
+                        "count off by up to {})",
+                        plan.n_short_intervals, plan.shortfall()));
+    if (dropped > 0)
+        add(fmt::format("{} exchange(s) found no large particle left to move", dropped));
+    EFDEM_ENSURES(result.n_moved == static_cast<std::size_t>(
+                                        std::count(result.moved.begin(), result.moved.end(), 1)));
+    return result;
+}
+
+}  // namespace efdem::coarse
