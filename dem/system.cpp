@@ -159,6 +159,31 @@ void System::set_species(std::span<const Index> indices, std::span<const Species
     refresh_forces();
 }
 
+void System::rearranged(std::span<const std::uint8_t> moved) {
+    EFDEM_EXPECTS(moved.size() == particles_.size());
+    if (neighbors_) {
+        rebuild_neighbors();  // permutation_: new index -> index before the rebuild
+        if (history_) {
+            const auto off = neighbors_->offsets();
+            const auto ent = neighbors_->entries();
+            auto springs = history_->pairs();
+            auto was_moved = [&](std::size_t i) { return moved[permutation_[i]] != 0; };
+            for (std::size_t i = 0; i < particles_.size(); ++i)
+                for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
+                    if (was_moved(i) || was_moved(NeighborList::neighbor(ent[k])))
+                        springs[k] = Vec3{};
+            for (int w = 0; w < ContactHistory::kWalls; ++w)
+                for (std::size_t i = 0; i < particles_.size(); ++i)
+                    if (was_moved(i)) history_->wall(w)[i] = Vec3{};
+        }
+    } else if (history_) {
+        for (int w = 0; w < ContactHistory::kWalls; ++w)
+            for (std::size_t i = 0; i < particles_.size(); ++i)
+                if (moved[i]) history_->wall(w)[i] = Vec3{};
+    }
+    refresh_forces();
+}
+
 double System::translational_kinetic_energy() const {
     double e = 0;
     const auto v = particles_.v();

@@ -81,6 +81,13 @@ class System {
     /// velocities, spins and contact histories are untouched.
     void set_species(std::span<const Index> indices, std::span<const SpeciesId> species);
 
+    /// Call after positions (and velocities) were changed from outside by a rearrangement of
+    /// the particles (a lift that moves them): rebuilds the neighbour list, forgets every
+    /// tangential spring of a particle flagged in `moved` (its pair and wall contacts are new
+    /// ones) and refreshes forces. `moved`: one flag per particle, in the
+    /// current order.
+    void rearranged(std::span<const std::uint8_t> moved);
+
     /// Recomputes forces and torques for the current state without advancing contact history
     /// (as at set-up); used after the state was changed from outside.
     void refresh_forces();

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -84,6 +85,11 @@ class CoarseStepper {
      * that restrict their members can (lifts_apart()); the default is a contract violation.
      */
     virtual bool lifts_apart() const { return false; }
+    /// Why the last lift() or lift_apart() could not put the micro model at its target (a lift
+    /// that moves particles whose overlaps did not relax), or empty (the default: lifts always
+    /// succeed). The adaptive integrator handles a failed lift as a rejected jump: back to the
+    /// kept state, the next jump shorter.
+    virtual std::string lift_failure() const { return {}; }
     virtual void lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
                             double new_time);
 

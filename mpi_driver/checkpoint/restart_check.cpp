@@ -43,6 +43,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.relabel", "any"},      // moving: relabel moving particles first (issue 34)
     {"cpi.hand_off", "none"},    // steady: the end state goes to the steady solver (issue 34)
     {"gas_drag.polydisperse", "none"},  // van_der_hoef: spheres of several sizes (issue 37)
+    {"cpi.lift_by", "colours"},         // positions: exchange particles (issue 37)
 };
 // clang-format on
 

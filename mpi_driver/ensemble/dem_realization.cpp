@@ -16,8 +16,14 @@ namespace efdem::mpi_driver {
 
 DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
                                const RealizationOutput& output, bool restarting,
-                               std::optional<dem::BedObservationSettings> bed)
-    : system_(std::move(system)), observed_(observed), other_(other), output_(output), bed_(bed) {
+                               std::optional<dem::BedObservationSettings> bed,
+                               bool lift_by_positions)
+    : system_(std::move(system)),
+      observed_(observed),
+      other_(other),
+      output_(output),
+      bed_(bed),
+      lift_by_positions_(lift_by_positions) {
     const std::string stem =
         fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
     if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
@@ -57,6 +63,14 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid,
 
 LiftPayload DemRealization::lift_input() const {
     const dem::Particles& p = system_.particles();
+    if (lift_by_positions_) {
+        LiftPayload in;
+        in.reals.reserve(6 * p.size());
+        for (const std::span<const Vec3> field : {p.x(), p.v()})
+            for (const Vec3& a : field) in.reals.insert(in.reals.end(), {a.x, a.y, a.z});
+        in.bytes = coarse::heights_and_colours(p, observed_).colours;
+        return in;
+    }
     auto hc = coarse::heights_and_colours(p, observed_);
     // Then one flag per particle: moving (ColourLifter relabels those first, cpi.relabel).
     std::vector<std::uint8_t> bytes = std::move(hc.colours);
@@ -66,12 +80,27 @@ LiftPayload DemRealization::lift_input() const {
 }
 
 std::pair<std::size_t, std::size_t> DemRealization::lift_output_sizes() const {
-    return {0, system_.particles().size()};
+    const std::size_t n = system_.particles().size();
+    return {lift_by_positions_ ? 6 * n : 0, n};
 }
 
 void DemRealization::apply_lift(const LiftPayload& lifted) {
-    coarse::apply_colours(system_, lifted.bytes, observed_, other_);
-    still_samples_ = 0;  // other masses: its balance is judged again
+    if (lift_by_positions_) {
+        dem::Particles& p = system_.particles();
+        const std::size_t n = p.size();
+        EFDEM_EXPECTS(lifted.reals.size() == 6 * n && lifted.bytes.size() == n);
+        auto x = p.x();
+        auto v = p.v();
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] = {lifted.reals[3 * i], lifted.reals[3 * i + 1], lifted.reals[3 * i + 2]};
+            v[i] = {lifted.reals[3 * (n + i)], lifted.reals[3 * (n + i) + 1],
+                    lifted.reals[3 * (n + i) + 2]};
+        }
+        system_.rearranged(lifted.bytes);
+    } else {
+        coarse::apply_colours(system_, lifted.bytes, observed_, other_);
+    }
+    still_samples_ = 0;  // other masses or places: its balance is judged again
 }
 
 bool DemRealization::advance_unless_stopped(long steps, const StopCheck& stop) {

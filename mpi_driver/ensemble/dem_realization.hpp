@@ -1,8 +1,8 @@
 #pragma once
 /// \file
 /// DemRealization: a dem::System as a member of the ensemble (restriction by species ICDF,
-/// lifting by relabelling), with its optional per-realization VTK and thermo output; and
-/// ColourLifter, the root's lifting by coarse::lift_colours.
+/// lifting by relabelling or by moving particles), with its optional per-realization VTK and
+/// thermo output; and ColourLifter, the root's lifting by coarse::lift_colours.
 
 #include <memory>
 #include <optional>
@@ -35,9 +35,12 @@ class DemRealization final : public Realization {
     /// `restarting`: the state will be restored from a checkpoint, so the per-realization
     /// outputs do not record the (discarded) initial state.
     /// `bed`: also measure the bed quantities at every sample (Observation::bed).
+    /// `lift_by_positions` (cpi.lift_by = positions): lifts move particles (PositionLifter's
+    /// payloads) instead of switching their labels (ColourLifter's).
     DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
                    const RealizationOutput& output, bool restarting = false,
-                   std::optional<dem::BedObservationSettings> bed = std::nullopt);
+                   std::optional<dem::BedObservationSettings> bed = std::nullopt,
+                   bool lift_by_positions = false);
 
     long index() const override { return system_.realization(); }
     double time() const override { return system_.time(); }
@@ -52,8 +55,12 @@ class DemRealization final : public Realization {
     /// 0.1-0.2 s of one core, well inside Open MPI's 1 s between its SIGTERM and SIGKILL.
     static constexpr long kStopCheckSteps = 100;
     Observation observe(const coarse::ProbabilityGrid& grid, ReferenceNeeds needs) const override;
+    /// Colours: heights (reals), colours then moving flags (bytes). Positions: x, y, z of every
+    /// particle then its velocity (reals), colours (bytes).
     LiftPayload lift_input() const override;
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
+    /// Colours: the new labels. Positions: new positions and velocities (reals), one moved flag
+    /// per particle (bytes), then System::rearranged.
     void apply_lift(const LiftPayload& lifted) override;
     /// Still now: every particle's translational speed below kRestSpeed and its acceleration
     /// (force over mass, from the forces of the current state and effects) below
@@ -94,6 +101,7 @@ class DemRealization final : public Realization {
     dem::SpeciesId observed_, other_;
     RealizationOutput output_;
     std::optional<dem::BedObservationSettings> bed_;
+    bool lift_by_positions_ = false;
     std::optional<dem::VtkSeriesWriter> vtk_;
     std::unique_ptr<dem::ThermoLog> thermo_;
     long still_samples_ = 0;  ///< see still_samples(); part of the checkpoint

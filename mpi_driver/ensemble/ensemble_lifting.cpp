@@ -137,6 +137,8 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
     if (layout_.is_root()) {
         EFDEM_EXPECTS(target != nullptr);
         last_ = LiftRecord{};
+        last_.changed_what = lifter_.changed_what();
+        failure_.clear();
         auto is_held = [&](int r) {
             return !all_rest[static_cast<std::size_t>(r)].empty() &&
                    all_rest[static_cast<std::size_t>(r)][0] != 0;
@@ -210,6 +212,12 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             last_.messages.push_back(repaired.empty() || res.message.empty()
                                          ? repaired + res.message
                                          : repaired + "; " + res.message);
+            if (!res.failure.empty()) {
+                failure_ += fmt::format("{}realization {}: {}", failure_.empty() ? "" : "; ", r,
+                                        res.failure);
+                last_.messages.back() +=
+                    (last_.messages.back().empty() ? "" : "; ") + ("not lifted: " + res.failure);
+            }
             lifted_reals.push_back(std::move(res.payload.reals));
             lifted_bytes.push_back(std::move(res.payload.bytes));
         }

@@ -82,6 +82,9 @@ class EnsembleLifting {
 
     /// Root: what the last lift did per realization.
     const LiftRecord& last() const { return last_; }
+    /// Root: why the last lift failed for some realization ("realization r: why; ..."), or
+    /// empty. Those realizations were left as they were.
+    const std::string& last_failure() const { return failure_; }
     /// Root, with members: makes each realization's own target liftable (none: as computed).
     void set_member_repair(coarse::RepairHook repair) { member_repair_ = std::move(repair); }
 
@@ -101,6 +104,7 @@ class EnsembleLifting {
     std::vector<RandomStream> streams_;  ///< root: one per realization
     coarse::RepairHook member_repair_;
     LiftRecord last_;
+    std::string failure_;
     double seconds_ = 0;
     long count_ = 0;
 };

@@ -192,6 +192,8 @@ class EnsembleStepper final : public coarse::CoarseStepper {
 
     /// Root: what the last lift did per realization, and the last sample.
     const LiftRecord& last_lift() const { return lifting_.last(); }
+    /// Root: coarse::CoarseStepper::lift_failure, from the last lift.
+    std::string lift_failure() const override { return lifting_.last_failure(); }
     const SampleRecord& last_sample() const { return sampler_.last(); }
     /// Particle-steps done by the whole ensemble so far.
     double particle_steps() const { return particle_steps_; }

@@ -84,6 +84,10 @@ struct LiftOutcome {
     long changed = 0;          ///< labels (or entries) changed
     double max_deviation = 0;  ///< max |achieved - target| over the p-grid [d_p]
     std::string message;       ///< non-empty when the target was repaired, clipped or rejected
+    /// Non-empty when the lift could not put the realization at its target and left it as it
+    /// was (a lift that moves particles whose overlaps did not relax): why. The adaptive
+    /// integrator rejects the jump (coarse::CoarseStepper::lift_failure).
+    std::string failure;
 };
 
 class Realization {
@@ -144,6 +148,8 @@ class Lifter {
     virtual ~Lifter() = default;
     virtual LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
                              const coarse::ProbabilityGrid& grid, RandomStream& rng) const = 0;
+    /// What LiftOutcome::changed counts, for the step report.
+    virtual const char* changed_what() const { return "labels changed"; }
 };
 
 }  // namespace efdem::mpi_driver

@@ -76,7 +76,9 @@ constexpr std::pair<const char*, const char*> kStepColumns[] = {
     {"status", "outcome of the step (text)"},
     {"max_repair", "largest change the monotone repair made to the projected ICDF [d_p]"},
     {"clipped", "ICDF nodes clipped by the repair (count)"},
-    {"labels_changed", "species labels changed by lifting, summed over the realizations (count)"},
+    {"labels_changed",
+     "species labels changed by lifting (particles moved with cpi.lift_by = positions), summed "
+     "over the realizations (count)"},
     {"stability_rate", "estimated decay rate lambda [1/sqrt(d_p/g)]"},
     {"stability_amplification", "amplification factor of the step at that rate [-]"},
     {"max_slope_se",

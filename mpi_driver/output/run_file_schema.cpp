@@ -268,7 +268,7 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "text",
          "step status",
          "what the step did: projected, burst_only, stopped_unstable, too_few_periods, "
-         "invalid_burst, infeasible_projection or rejected",
+         "invalid_burst, infeasible_projection, rejected or lift_failed",
          {"t_start"}},
         {"/cpi/message",
          "text",
@@ -485,7 +485,8 @@ const std::vector<DatasetDoc>& run_file_schema() {
         {"/cpi/lift_changed",
          "1",
          "labels changed by the lift",
-         "labels lifting changed in each realization",
+         "labels lifting changed in each realization (particles it moved with cpi.lift_by = "
+         "positions)",
          {"t_start", "realization"}},
         {"/cpi/lift_max_deviation",
          "d_p",

@@ -60,7 +60,9 @@ struct FailureRecord {
 
 /// What lifting did to each realization at one coarse step.
 struct LiftRecord {
-    std::vector<long> changed;          ///< labels changed, per realization
+    std::vector<long> changed;  ///< labels changed or particles moved, per realization
+    /// What `changed` counts: "labels changed" (colour lifting) or "particles moved".
+    std::string changed_what = "labels changed";
     std::vector<double> max_deviation;  ///< max |Q_L,lifted - target| per realization [d_p]
     std::vector<std::string> messages;  ///< non-empty where a target was repaired or clipped
     std::vector<char> at_rest;  ///< 1 where the realization was at rest and left where it was

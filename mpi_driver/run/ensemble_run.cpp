@@ -14,6 +14,7 @@
 #include "mpi_driver/checkpoint/restart_check.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/ensemble/position_lifter.hpp"
 #include "mpi_driver/output/csv_recorder.hpp"
 #include "mpi_driver/output/recorder_list.hpp"
 #include "mpi_driver/output/thermo_screen.hpp"
@@ -63,6 +64,10 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
                  std::vector<dem::System> systems, const RestartData* restart,
                  const SetupWall& wall) {
     const std::optional<dem::BedObservationSettings> bed = bed_settings(s, systems.front());
+    // The same species and box in every realization: what a lift by positions needs to know.
+    const dem::SpeciesTable species = systems.front().species();
+    const dem::Domain box = systems.front().domain();
+    const bool by_positions = s.lift_by_positions && s.is_cpi();
     const RunProvenance prov = provenance(mpi, table, s, systems.front(), bed);
     if (mpi.is_root())
         for (const std::string& advice :
@@ -97,7 +102,8 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
             resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
         for (auto& sys : systems)
             local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species,
-                                                             s.observe.other, out, resume, bed));
+                                                             s.observe.other, out, resume, bed,
+                                                             by_positions));
     } catch (const std::exception& e) {
         // The run file may exist already (a CSV header on a nearly full disk): it says so.
         RunSummary failed;
@@ -139,7 +145,10 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     const double t0 =
         resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
-    const ColourLifter lifter(s.relabel_moving && s.is_cpi());
+    const ColourLifter colour_lifter(s.relabel_moving && s.is_cpi());
+    const PositionLifter position_lifter(species, s.observe.species, s.observe.other, box);
+    const Lifter& lifter =
+        by_positions ? static_cast<const Lifter&>(position_lifter) : colour_lifter;
     // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).
     EnsembleStepper stepper(layout, std::move(local), ss, *observables.primary, lifter,
                             recorders.get(), mpi.is_root() && !s.is_steady() ? &progress : nullptr);

@@ -94,6 +94,26 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // Where a bed has partly come to rest, a relabelling there kicks it back into motion
     // (bench/lift_restart.py): moving relabels the moving particles of each height interval first.
     s.relabel_moving = cpi.get_or_choice("relabel", "any", {"any", "moving"}) == "moving";
+    // positions: a bed of two sizes is lifted by exchanging particles between heights
+    // (docs/lifting_by_positions.md); colours switch labels in place (equal sizes only).
+    s.lift_by_positions =
+        cpi.get_or_choice("lift_by", "colours", {"colours", "positions"}) == "positions";
+    if (s.lift_by_positions && s.relabel_moving)
+        cpi.fail("relabel",
+                 "= moving chooses which labels a colour lift switches, and cpi.lift_by = "
+                 "positions switches none",
+                 "any with cpi.lift_by = positions, or cpi.lift_by = colours");
+    if (s.lift_by_positions && s.is_steady())
+        cpi.fail("lift_by",
+                 "= positions can fail to relax its overlaps, which only an adaptive cpi run "
+                 "handles (as a rejected jump); the steady solvers lift to every iterate",
+                 "colours in mode = steady or continuation");
+    if (s.lift_by_positions && s.is_cpi() &&
+        s.cpi.projection != coarse::CpiSettings::Projection::adaptive)
+        cpi.fail("lift_by",
+                 "= positions can fail to relax its overlaps, which only cpi.projection = "
+                 "adaptive handles (as a rejected jump, redone shorter)",
+                 "positions with cpi.projection = adaptive, or colours");
     // own: each realization jumps with its own slope (the multistep integrator measures them).
     s.cpi.multistep.lift_apart = lift == "own";
     // cpi.accuracy measures the ensemble's noise from every burst whose members a lift kept apart.
@@ -106,6 +126,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // cpi.hand_off = steady: the CPI run's end state goes to the steady solver. Read in both
     // modes like the other cpi keys (its steady.* keys then too); a direct run does not use it.
     s.hand_off = cpi.get_or_choice("hand_off", "none", {"none", "steady"}) == "steady";
+    if (s.lift_by_positions && s.hand_off)
+        cpi.fail("hand_off",
+                 "= steady hands the end state to the steady solver, which lifts to every "
+                 "iterate, and cpi.lift_by = positions can fail to relax its overlaps there",
+                 "none with cpi.lift_by = positions");
     if (s.is_steady() || s.hand_off) {
         const auto* row = coarse::observable_table().find(s.observable);
         const long dimension =
@@ -161,12 +186,14 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                                   "species.names lists {}",
                                   s.mode_name(), scene.species.size()),
                       "direct, or exactly two species");
-        for (std::size_t k = 1; k < scene.species.size(); ++k)
+        for (std::size_t k = 1; k < scene.species.size() && !s.lift_by_positions; ++k)
             if (scene.species[static_cast<dem::SpeciesId>(k)].diameter != scene.species[0].diameter)
-                root.scope("species").fail("diameter",
-                                           "differs between species: swapping labels would "
-                                           "create overlaps (physics.md §9)",
-                                           "equal diameters in cpi mode");
+                root.scope("species").fail(
+                    "diameter",
+                    "differs between species: swapping labels would create overlaps "
+                    "(physics.md §9)",
+                    "equal diameters in cpi mode with cpi.lift_by = colours (the default), or "
+                    "cpi.lift_by = positions, which exchanges particles between heights");
     }
 
     const Params output = root.scope("output");

@@ -109,6 +109,9 @@ struct RunSettings {
     /// cpi.relabel = moving: the colour lift relabels each height interval's moving particles
     /// first (ColourLifter); any (default): every candidate alike.
     bool relabel_moving = false;
+    /// cpi.lift_by = positions: lifts exchange particles between heights (PositionLifter), for
+    /// beds whose species differ in size; colours (false) switch labels in place.
+    bool lift_by_positions = false;
     /// ensemble.at_rest = pause (default): a realization at rest is not advanced, only its clock
     /// (direct and cpi runs); simulate: it is advanced like the others.
     bool pause_at_rest = true;

@@ -15,7 +15,7 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
                                 r.t_start + r.burst_length);
     if (std::isfinite(r.period)) s += fmt::format(", period T = {:.4g}", r.period);
     s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
-    if (r.lifted) s += fmt::format(", {} labels changed", changed);
+    if (r.lifted) s += fmt::format(", {} {}", changed, lift.changed_what);
     if (r.repair.changed())
         s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
     if (r.slope_standard_error.size() > 0)

@@ -296,6 +296,75 @@ TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone",
         }
 }
 
+namespace {
+/// A lift that fails when it must move the coarse state by more than `reach` (RMS over the
+/// nodes), as a lift that moves particles fails when its overlaps do not relax: the micro
+/// model is left as it was, and lift_failure() says why.
+class ShortReachLift final : public test::OuEnsembleView {
+  public:
+    ShortReachLift(test::OuEnsembleStepper toy, double reach)
+        : OuEnsembleView(std::move(toy)), reach_(reach) {}
+    void lift(const Eigen::VectorXd& target, double new_time) override {
+        const double move = rms(target - toy_.mean());
+        failure_.clear();
+        if (move > reach_) {
+            failure_ = "a move of " + std::to_string(move) + " is beyond reach";
+            ++failures_;
+            return;
+        }
+        toy_.lift(target, new_time);
+    }
+    std::string lift_failure() const override { return failure_; }
+    int failures() const { return failures_; }
+    double work() const { return toy_.work(); }
+
+  private:
+    double reach_;
+    std::string failure_;
+    int failures_ = 0;
+};
+}  // namespace
+
+TEST_CASE("a lift that fails is a rejected jump: back to the kept state, redone shorter",
+          "[unit][coarse][multistep]") {
+    // Slow decay from 3 (k = 0.02): the first jumps the tolerance allows move X by more than the
+    // lift reaches (0.2); each failure halves DT until the move is within reach.
+    const Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.02);
+    ShortReachLift stepper(
+        test::OuEnsembleStepper(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(3, 3.0), 1), 0.2);
+    MultistepSettings s;
+    s.burst.healing = 1.0;
+    s.burst.window = 2.0;
+    s.first_dt = 40.0;
+    s.control = {.tolerance = 0.5, .dt_min = 0.5, .dt_max = 40.0};
+    MultistepProjectiveIntegrator integrator(s);
+    const auto records = run_to(integrator, stepper, 60.0);
+    REQUIRE(stepper.failures() >= 1);
+    long failed = 0, projected = 0;
+    for (std::size_t i = 0; i < records.size(); ++i) {
+        const auto& r = records[i];
+        if (r.status == StepStatus::projected) {
+            ++projected;
+            // Every kept jump moved X within the lift's reach (the toy's members all sit at
+            // x_end after a noiseless burst, so the move is |X(t + DT) - x_end|).
+            CHECK(rms(r.x_projected - r.x_end) <= 0.2 + 1e-12);
+        }
+        if (r.status != StepStatus::lift_failed) continue;
+        ++failed;
+        CHECK(r.message.find("the lift failed (a move of") != std::string::npos);
+        CHECK_FALSE(r.lifted);
+        // The micro model is back where the jump started; the next attempt is shorter and starts
+        // there, with no burst run in between (nothing judged a jump that did not happen).
+        REQUIRE(i + 1 < records.size());
+        CHECK(records[i + 1].t_end == r.t_end);
+        CHECK(records[i + 1].dt < r.dt);
+        CHECK(stepper.time() >= r.t_end);
+    }
+    CHECK(failed == stepper.failures());
+    CHECK(projected >= 2);
+    CHECK(integrator.totals().rejected == failed);
+}
+
 TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the shorter DT",
           "[unit][coarse][multistep]") {
     Eigen::VectorXd k(19);

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <memory>
 
@@ -15,7 +16,9 @@
 #include "dem/system.hpp"
 #include "mpi_driver/ensemble/dem_realization.hpp"
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
+#include "mpi_driver/ensemble/position_lifter.hpp"
 #include "mpi_driver/parallel/ensemble_layout.hpp"
+#include "tests/support/dem_fixtures.hpp"
 
 using namespace efdem;
 using namespace efdem::mpi_driver;
@@ -254,5 +257,82 @@ TEST_CASE("a DEM realization at rest is held by a lift (cpi.at_rest = hold); the
         INFO("realization " << layout.first_index() + static_cast<long>(j));
         CHECK(dem[j]->time() == 3.0);  // every clock follows the jump
         CHECK((now == labels_before[j]) == (layout.first_index() + static_cast<long>(j) == 2));
+    }
+}
+
+TEST_CASE(
+    "a lift by positions moves particles of a bed of two sizes, forgets their springs, "
+    "and leaves the realization as it was when its relaxation fails",
+    "[mpi][lifting][positions]") {
+    // One realization per rank, on its own (no ensemble): a loose bed of 400 small and 50 large
+    // spheres (ratio 2) with the paper's contacts (tangential springs kept per listed pair).
+    const dem::SpeciesTable species = test::two_size_species(2.0);
+    const dem::Domain box{8.0, 8.0};
+    test::EffectList fx;
+    fx.pair(test::paper_contact(), species).wall(test::paper_contact(), species);
+    dem::System sys =
+        test::make_system(species, box, test::two_size_loose_bed(400, 50, 2.0, 8.0, 24.0, 17, 0.5),
+                          std::move(fx), 1e-4);
+    sys.run(100);
+    // A spring on every listed pair (a loose bed has few contacts): which survive the lift
+    // shows which the lift forgot.
+    for (Vec3& xi : sys.contact_history()->pairs()) xi = {1e-6, 0, 0};
+    DemRealization r(std::move(sys), 0, 1, RealizationOutput{}, false, std::nullopt, true);
+    const coarse::ProbabilityGrid grid(19);
+    const Eigen::VectorXd now = coarse::species_icdf(r.system().particles(), 0, grid);
+    Eigen::VectorXd target = now;
+    for (int i = 0; i < grid.size(); ++i) target[i] += 1.5 * std::sin(M_PI * grid.p(i));
+    const LiftPayload input = r.lift_input();
+    REQUIRE(input.reals.size() == 6 * 450);
+
+    SECTION("a relaxation that cannot finish: nothing moves, and the outcome says why") {
+        dem::OverlapRelaxationSettings one_step;
+        one_step.max_iterations = 1;
+        const PositionLifter lifter(species, 0, 1, box, one_step);
+        RandomStream rng(3, 0, "lifting");
+        const LiftOutcome out = lifter.lift(target, input, grid, rng);
+        CHECK(out.failure.find("could not remove") != std::string::npos);
+        CHECK(out.changed == 0);
+        CHECK(out.payload.reals == input.reals);
+        CHECK(std::count(out.payload.bytes.begin(), out.payload.bytes.end(), 1) == 0);
+    }
+    SECTION("a lift that succeeds") {
+        const PositionLifter lifter(species, 0, 1, box);
+        RandomStream rng(3, 0, "lifting");
+        const LiftOutcome out = lifter.lift(target, input, grid, rng);
+        REQUIRE(out.failure.empty());
+        REQUIRE(out.changed > 0);
+        CHECK(out.message.find("exchanges") != std::string::npos);
+        std::vector<dem::Tag> moved;
+        for (std::size_t i = 0; i < 450; ++i)
+            if (out.payload.bytes[i]) moved.push_back(r.system().particles().tag()[i]);
+        CHECK(static_cast<long>(moved.size()) == out.changed);
+        r.apply_lift(out.payload);
+        const dem::System& s = r.system();
+        const dem::Particles& p = s.particles();
+        // Species and their counts untouched; the ICDF is where the lifter said it put it.
+        CHECK(std::count(p.species().begin(), p.species().end(), 0) == 400);
+        CHECK(std::abs((coarse::species_icdf(p, 0, grid) - target).cwiseAbs().maxCoeff() -
+                       out.max_deviation) < 1e-12);
+        // No overlap beyond the relaxation's tolerance (1e-4 of the pair's mean diameter).
+        CHECK(s.thermo_stats().max_overlap <= 1e-4 * (1 + 1e-9));
+        // No moved particle keeps a tangential spring: its contacts are new ones.
+        const auto* list = s.neighbor_list();
+        const auto* history = s.contact_history();
+        REQUIRE(list != nullptr);
+        REQUIRE(history != nullptr);
+        auto is_moved = [&](dem::Index i) {
+            return std::find(moved.begin(), moved.end(), p.tag()[i]) != moved.end();
+        };
+        long springs_of_moved = 0, springs_of_others = 0;
+        for (std::size_t i = 0; i < p.size(); ++i)
+            for (std::uint32_t k = list->offsets()[i]; k < list->offsets()[i + 1]; ++k) {
+                if (norm2(history->pairs()[k]) == 0) continue;
+                const bool moved_pair = is_moved(static_cast<dem::Index>(i)) ||
+                                        is_moved(dem::NeighborList::neighbor(list->entries()[k]));
+                ++(moved_pair ? springs_of_moved : springs_of_others);
+            }
+        CHECK(springs_of_moved == 0);
+        CHECK(springs_of_others > 100);  // the pairs the lift did not touch keep theirs
     }
 }

@@ -418,6 +418,18 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     } else
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
+    if (const std::string why = stepper.lift_failure(); !why.empty()) {
+        // The micro model is not at X: as a rejected jump, without the burst that would judge it.
+        EFDEM_EXPECTS(settings_.adaptive);  // cpi_settings refuses lifts that can fail otherwise
+        stepper.return_to_kept_state();
+        controller_.jump_failed(rec.dt);
+        ++totals_.rejected;
+        rec.lifted = false;
+        rec.status = StepStatus::lift_failed;
+        append_message(rec, "the lift failed (" + why +
+                                "); back to the state before the jump, the next one shorter");
+        return rec;
+    }
 
     ProjectiveStepRecord after;  // the burst that judges the jump
     after.t_start = stepper.time();

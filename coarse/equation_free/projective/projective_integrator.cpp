@@ -22,6 +22,8 @@ std::string_view to_string(StepStatus status) {
             return "invalid_burst";
         case StepStatus::infeasible_projection:
             return "infeasible_projection";
+        case StepStatus::lift_failed:
+            return "lift_failed";
         case StepStatus::rejected:
             return "rejected";
     }

@@ -38,6 +38,8 @@ enum class StepStatus {
     infeasible_projection,  ///< the projected vector is not finite, or the repair hook said so
     rejected,               ///< adaptive: the burst after the jump showed its error above the
                             ///< tolerance; the micro model is back where the jump started
+    lift_failed,            ///< adaptive: the lift could not reach its target (overlaps left by
+                            ///< moving particles did not relax); back where the jump started
 };
 
 std::string_view to_string(StepStatus status);
@@ -138,10 +140,12 @@ struct ProjectiveStepRecord {
                    : slope_standard_error.maxCoeff<Eigen::PropagateNaN>();
     }
 
-    /// The step ended in a state from which the next step can go on as planned.
+    /// The step ended in a state from which the next step can go on as planned (a rejected jump
+    /// or a failed lift: the controller has shortened the next one, and below cpi.dt_min a burst
+    /// runs directly, so the run progresses).
     bool advanced() const {
         return status == StepStatus::projected || status == StepStatus::burst_only ||
-               status == StepStatus::rejected;
+               status == StepStatus::rejected || status == StepStatus::lift_failed;
     }
 };
 

@@ -1,0 +1,96 @@
+#include "mpi_driver/ensemble/position_lifter.hpp"
+
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "coarse/demixing/position_lifting.hpp"
+#include "coarse/demixing/quantiles.hpp"
+#include "core/contracts.hpp"
+
+namespace efdem::mpi_driver {
+
+namespace {
+
+std::vector<Vec3> unpack(const std::vector<double>& reals, std::size_t first, std::size_t n) {
+    std::vector<Vec3> out(n);
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = {reals[3 * (first + i)], reals[3 * (first + i) + 1], reals[3 * (first + i) + 2]};
+    return out;
+}
+
+}  // namespace
+
+PositionLifter::PositionLifter(dem::SpeciesTable species, dem::SpeciesId observed,
+                               dem::SpeciesId other, dem::Domain domain,
+                               dem::OverlapRelaxationSettings relaxation)
+    : species_(std::move(species)),
+      observed_(observed),
+      other_(other),
+      domain_(domain),
+      relaxation_(relaxation) {}
+
+LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayload& input,
+                                 const coarse::ProbabilityGrid& grid, RandomStream& rng) const {
+    const std::size_t n = input.bytes.size();
+    EFDEM_EXPECTS(input.reals.size() == 6 * n);
+    const std::vector<Vec3> x = unpack(input.reals, 0, n);
+    const std::vector<Vec3> v = unpack(input.reals, n, n);
+    const coarse::TwoSizes sizes{species_[observed_].diameter,
+                                 species_[other_].diameter,
+                                 species_.mass(observed_),
+                                 species_.mass(other_),
+                                 domain_.lx,
+                                 domain_.ly};
+    const coarse::PositionLiftResult r =
+        coarse::lift_positions(target, x, v, input.bytes, sizes, grid, rng);
+
+    LiftOutcome out;
+    out.payload.reals = input.reals;  // as it was, unless the lift is made below
+    out.payload.bytes.assign(n, 0);
+    out.max_deviation = r.max_deviation;
+    out.message = r.message;
+    if (!r.applied() || r.n_moved == 0) return out;
+
+    // The exchanged state as particles of the scene's species, relaxed with the heights held.
+    dem::Particles p;
+    p.reserve(n);
+    for (std::size_t i = 0; i < n; ++i)
+        p.add(static_cast<dem::Tag>(i), r.positions[i], r.velocities[i],
+              input.bytes[i] == coarse::kLight ? observed_ : other_, species_);
+    const dem::OverlapRelaxationReport relax = dem::relax_overlaps(p, domain_, relaxation_);
+    if (!relax.converged) {
+        out.failure = fmt::format(
+            "{} exchanges left overlaps the relaxation could not remove with the heights held "
+            "within {:g} d_p: {:.3g} of a pair's diameter after {} steps (tolerance {:g})",
+            r.n_exchanges, relaxation_.height_band, relax.max_overlap_after, relax.iterations,
+            relaxation_.tolerance);
+        return out;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 a = p.x()[i];
+        out.payload.reals[3 * i] = a.x;
+        out.payload.reals[3 * i + 1] = a.y;
+        out.payload.reals[3 * i + 2] = a.z;
+        const Vec3 b = r.velocities[i];
+        out.payload.reals[3 * (n + i)] = b.x;
+        out.payload.reals[3 * (n + i) + 1] = b.y;
+        out.payload.reals[3 * (n + i) + 2] = b.z;
+    }
+    out.payload.bytes = r.moved;
+    out.changed = static_cast<long>(r.n_moved);
+    std::vector<double> z;
+    for (std::size_t i = 0; i < n; ++i)
+        if (input.bytes[i] == coarse::kLight) z.push_back(p.x()[i].z);
+    out.max_deviation = (coarse::quantiles(z, grid) - r.target).cwiseAbs().maxCoeff();
+    const std::string what = fmt::format(
+        "{} particles moved in {} exchanges; overlaps {:.2g} -> {:.2g} of a diameter in {} "
+        "relaxation steps; kinetic energy {:+.3g} m g d_p",
+        r.n_moved, r.n_exchanges, relax.max_overlap_before, relax.max_overlap_after,
+        relax.iterations, r.kinetic_energy_change);
+    out.message = out.message.empty() ? what : out.message + "; " + what;
+    return out;
+}
+
+}  // namespace efdem::mpi_driver
