@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Plots the gas validation tier's output (tests/physics/test_gas_validation.cpp) for docs/validation.md.
+"""Plots the gas validation tier's output (tests/physics/test_gas_validation.cpp,
+test_two_size_validation.cpp) for docs/validation.md.
 
 usage: /usr/bin/python3 scripts/plot_validation.py DATA_DIR FIGURE_DIR
 
@@ -123,6 +124,53 @@ def randomization(data, out):
     fig.savefig(out / "randomization.png", dpi=110)
 
 
+def dp_sweep_sizes(data, out):
+    r = rows(data / "dp_sweep_sizes.csv")
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for k, d in enumerate(sorted({x["diameter"] for x in r}, key=float)):
+        sel = [x for x in r if x["diameter"] == d]
+        wa = float(sel[0]["weight_per_area"])
+        umf = float(sel[-1]["u_mf_darcy"])
+        u = [float(x["u_s"]) for x in sel]
+        ratio = [float(x["pressure_drop"]) / wa for x in sel]
+        sd = [float(x["pressure_drop_sd"]) / wa for x in sel]
+        axes[0].errorbar(u, ratio, yerr=sd, fmt="o-", color=f"C{k}", label=f"d = {d}")
+        axes[0].axvline(umf, color=f"C{k}", ls=":", lw=1, label=f"U_mf (Darcy) = {umf:.3f}")
+        axes[1].errorbar([x / umf for x in u], ratio, yerr=sd, fmt="o-", color=f"C{k}", label=f"d = {d}")
+    axes[0].set_xlabel("superficial gas velocity U_s  [sqrt(g d_p)]")
+    axes[1].set_xlabel("U_s / U_mf of the bed (its Darcy slope)")
+    for ax in axes:
+        ax.axhline(1, color="gray", lw=1)
+        ax.axhspan(0.97, 1.03, color="gray", alpha=0.15)
+        ax.set_ylabel("ΔP / (W/A)")
+        ax.legend(fontsize=8, loc="lower right")
+    fig.suptitle("One-size beds of 500 spheres with gas_drag.polydisperse = van_der_hoef: U_mf ∝ d²")
+    fig.tight_layout()
+    fig.savefig(out / "two_sizes_dp_sweep.png", dpi=110)
+
+
+def two_sizes_bed(data, out):
+    r = rows(data / "two_sizes_bed.csv")
+    fig, axes = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    for k, real in enumerate(sorted({x["realization"] for x in r})):
+        sel = [x for x in r if x["realization"] == real]
+        t = [float(x["time"]) for x in sel]
+        axes[0].plot(t, [float(x["pressure_drop_ratio"]) for x in sel], color=f"C{k}", lw=1,
+                     label=f"seed {real}")
+        axes[1].plot(t, [float(x["z_com_small"]) for x in sel], color=f"C{k}", label=f"small, seed {real}")
+        axes[1].plot(t, [float(x["z_com_large"]) for x in sel], color=f"C{k}", ls="--",
+                     label=f"large, seed {real}")
+    axes[0].axhline(1, color="gray", lw=1)
+    axes[0].set_ylabel("ΔP / (W/A)")
+    axes[0].legend(fontsize=8)
+    axes[1].set_ylabel("centre-of-mass height  [d_p]")
+    axes[1].set_xlabel("time  [sqrt(d_p/g)]")
+    axes[1].legend(fontsize=7, ncol=2)
+    fig.suptitle("800 spheres d = 1 and 100 of d = 2, one density, U_s = 0.6: the small rise")
+    fig.tight_layout()
+    fig.savefig(out / "two_sizes_bed.png", dpi=110)
+
+
 USAGE = "usage: /usr/bin/python3 scripts/plot_validation.py DATA_DIR FIGURE_DIR"
 
 
@@ -135,7 +183,7 @@ def main(argv):
                                           f"CSV files to $EFDEM_VALIDATION_OUT)\n{USAGE}")
     out.mkdir(parents=True, exist_ok=True)
     written = 0
-    for plot in (dp_sweep, rz_profiles, waves, spacetime, randomization):
+    for plot in (dp_sweep, rz_profiles, waves, spacetime, randomization, dp_sweep_sizes, two_sizes_bed):
         try:
             plot(data, out)
             print(f"plot_validation: {plot.__name__} written")
@@ -147,7 +195,8 @@ def main(argv):
                                               f"({type(e).__name__}: {e}); was it written by the [.validation] tier?")
     if written == 0:
         run_files.fail("plot_validation", f"no validation CSV files in {data} (dp_sweep_light.csv, rz_profiles.csv, "
-                                          "waves_u*.csv, spacetime_u*.csv, randomization_icdf.csv)")
+                                          "waves_u*.csv, spacetime_u*.csv, randomization_icdf.csv, dp_sweep_sizes.csv, "
+                                          "two_sizes_bed.csv)")
     return 0
 
 
