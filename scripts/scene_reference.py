@@ -40,6 +40,7 @@ SCENES = [
     ("examples/paper_fig2b/scene.cfg", []),
     ("examples/paper_fig4/scene.cfg", []),
     ("examples/steady_demo/scene.cfg", []),
+    ("examples/size_segregation/scene.cfg", ["mode=cpi"]),
     ("examples/tall_bed/scene_u019.cfg", ["ensemble.realizations_per_rank=2"]),
     ("examples/tall_bed/scene_u041.cfg", ["ensemble.realizations_per_rank=2"]),
     ("bench/scenes/demo_bed.cfg", []),
