@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <tuple>
 #include <utility>
@@ -363,6 +364,47 @@ TEST_CASE("a lift that fails is a rejected jump: back to the kept state, redone 
     CHECK(failed == stepper.failures());
     CHECK(projected >= 2);
     CHECK(integrator.totals().rejected == failed);
+}
+
+TEST_CASE("a lift that always fails ends in direct bursts, also where the end of the run would "
+          "stretch the redo",
+          "[unit][coarse][multistep]") {
+    // Every lift fails (reach 0). Each failure halves the next DT until it is below cpi.dt_min,
+    // and a burst runs directly: the run reaches its end. Near the end the planner may stretch a
+    // jump to reach the last burst; it must not stretch a redo beyond the halved DT (before the
+    // fix it retried the same DT for ever there).
+    const Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.02);
+    ShortReachLift stepper(
+        test::OuEnsembleStepper(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(3, 3.0), 1), 0.0);
+    MultistepSettings s;
+    s.burst.healing = 1.0;
+    s.burst.window = 2.0;
+    s.control = {.tolerance = 0.5, .dt_min = 1.5, .dt_max = 40.0};
+    MultistepProjectiveIntegrator integrator(s);
+    // Bursts of 3, a first-jump DT of 3, so the attempts start at t = 3, 6, ...: from t = 39 the
+    // 4.5 left after the next burst are less than a jump of 3 plus a burst, and the planner
+    // stretches the jump to reach the last burst (DT 4.5). When that lift fails, the redo must
+    // be at most half of it, not stretched to 4.5 again.
+    const double t_end = 46.5;
+    integrator.set_end_time(t_end);
+    int steps = 0, failed_in_a_row = 0;
+    double last_failed_dt = std::numeric_limits<double>::infinity();
+    while (stepper.time() < t_end - 1e-9 && t_end - stepper.time() >= 3.0 - 1e-9) {
+        REQUIRE(++steps < 200);  // a run that cannot end would loop here
+        const ProjectiveStepRecord r = integrator.step(stepper);
+        REQUIRE(r.advanced());
+        CHECK(r.status != StepStatus::projected);  // no lift ever succeeded
+        if (r.status == StepStatus::lift_failed) {
+            CHECK(r.dt < last_failed_dt);  // each redo shorter than the failed jump
+            last_failed_dt = r.dt;
+            CHECK(++failed_in_a_row <= 5);  // 40 -> 20 -> ... < dt_min within 5 halvings
+        } else {
+            failed_in_a_row = 0;
+            last_failed_dt = std::numeric_limits<double>::infinity();
+        }
+    }
+    CHECK(stepper.time() == Approx(t_end));
+    CHECK(stepper.failures() >= 2);
 }
 
 TEST_CASE("a rejected jump leaves no trace: reject-and-redo equals taking the shorter DT",

@@ -195,8 +195,13 @@ DtPlan StepSizeController::plan(const PlanInput& in) const {
     if (end < dt) {
         // The rule leaves room for one more burst; if the tolerance allows reaching the last
         // burst in this jump (less than one burst further), do that instead.
+        // Never beyond the cap a rejected jump or a failed lift set: a redo as long as the
+        // jump that failed would fail again (a lift that cannot relax its overlaps at this DT
+        // was retried without end at the end of a run).
         const double to_last_burst = in.end_time - (t0 + burst);
-        dt = to_last_burst > dt && to_last_burst <= p.dt_tolerance ? to_last_burst : end;
+        dt = to_last_burst > dt && to_last_burst <= p.dt_tolerance && to_last_burst <= state_.dt_cap
+                 ? to_last_burst
+                 : end;
         if (dt <= tol) return p;  // rounding: nothing left to jump (dt 0)
         p.limited_by = DtLimit::end_of_run;
     }
