@@ -366,9 +366,10 @@ TEST_CASE("a lift that fails is a rejected jump: back to the kept state, redone 
     CHECK(integrator.totals().rejected == failed);
 }
 
-TEST_CASE("a lift that always fails ends in direct bursts, also where the end of the run would "
-          "stretch the redo",
-          "[unit][coarse][multistep]") {
+TEST_CASE(
+    "a lift that always fails ends in direct bursts, also where the end of the run would "
+    "stretch the redo",
+    "[unit][coarse][multistep]") {
     // Every lift fails (reach 0). Each failure halves the next DT until it is below cpi.dt_min,
     // and a burst runs directly: the run reaches its end. Near the end the planner may stretch a
     // jump to reach the last burst; it must not stretch a redo beyond the halved DT (before the
