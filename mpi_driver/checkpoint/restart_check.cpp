@@ -44,6 +44,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.hand_off", "none"},    // steady: the end state goes to the steady solver (issue 34)
     {"gas_drag.polydisperse", "none"},  // van_der_hoef: spheres of several sizes (issue 37)
     {"cpi.lift_by", "colours"},         // positions: exchange particles (issue 37)
+    {"cpi.lift_height_band", "0.25"},   // positions: the relaxation's band (issue 37)
 };
 // clang-format on
 

@@ -146,7 +146,10 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
     const ColourLifter colour_lifter(s.relabel_moving && s.is_cpi());
-    const PositionLifter position_lifter(species, s.observe.species, s.observe.other, box);
+    dem::OverlapRelaxationSettings relaxation;
+    relaxation.height_band = s.lift_height_band;
+    const PositionLifter position_lifter(species, s.observe.species, s.observe.other, box,
+                                         relaxation);
     const Lifter& lifter =
         by_positions ? static_cast<const Lifter&>(position_lifter) : colour_lifter;
     // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).

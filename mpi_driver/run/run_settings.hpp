@@ -112,6 +112,8 @@ struct RunSettings {
     /// cpi.lift_by = positions: lifts exchange particles between heights (PositionLifter), for
     /// beds whose species differ in size; colours (false) switch labels in place.
     bool lift_by_positions = false;
+    /// cpi.lift_height_band [d_p]: how far the relaxation after an exchange may move a height.
+    double lift_height_band = 0.25;
     /// ensemble.at_rest = pause (default): a realization at rest is not advanced, only its clock
     /// (direct and cpi runs); simulate: it is advanced like the others.
     bool pause_at_rest = true;
