@@ -161,25 +161,24 @@ void System::set_species(std::span<const Index> indices, std::span<const Species
 
 void System::rearranged(std::span<const std::uint8_t> moved) {
     EFDEM_EXPECTS(moved.size() == particles_.size());
+    // The flags in the order the particles have after the rebuild (permutation_: new -> old).
+    std::vector<std::uint8_t> now(moved.begin(), moved.end());
     if (neighbors_) {
-        rebuild_neighbors();  // permutation_: new index -> index before the rebuild
-        if (history_) {
+        rebuild_neighbors();
+        for (std::size_t i = 0; i < now.size(); ++i) now[i] = moved[permutation_[i]];
+    }
+    if (history_) {
+        if (neighbors_) {
             const auto off = neighbors_->offsets();
             const auto ent = neighbors_->entries();
             auto springs = history_->pairs();
-            auto was_moved = [&](std::size_t i) { return moved[permutation_[i]] != 0; };
-            for (std::size_t i = 0; i < particles_.size(); ++i)
+            for (std::size_t i = 0; i < now.size(); ++i)
                 for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
-                    if (was_moved(i) || was_moved(NeighborList::neighbor(ent[k])))
-                        springs[k] = Vec3{};
-            for (int w = 0; w < ContactHistory::kWalls; ++w)
-                for (std::size_t i = 0; i < particles_.size(); ++i)
-                    if (was_moved(i)) history_->wall(w)[i] = Vec3{};
+                    if (now[i] || now[NeighborList::neighbor(ent[k])]) springs[k] = Vec3{};
         }
-    } else if (history_) {
         for (int w = 0; w < ContactHistory::kWalls; ++w)
-            for (std::size_t i = 0; i < particles_.size(); ++i)
-                if (moved[i]) history_->wall(w)[i] = Vec3{};
+            for (std::size_t i = 0; i < now.size(); ++i)
+                if (now[i]) history_->wall(w)[i] = Vec3{};
     }
     refresh_forces();
 }

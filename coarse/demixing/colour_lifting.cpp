@@ -14,15 +14,6 @@ namespace {
 
 using Count = std::int64_t;
 
-/// Q_L of the particles labelled light, on the grid.
-Eigen::VectorXd light_icdf(std::span<const double> heights, std::span<const std::uint8_t> colours,
-                           const ProbabilityGrid& grid) {
-    std::vector<double> light;
-    for (std::size_t j = 0; j < heights.size(); ++j)
-        if (colours[j] == kLight) light.push_back(heights[j]);
-    return quantiles(light, grid);
-}
-
 /// Switches `count` of the `candidates` (all of one colour, in index order) to the other
 /// colour, chosen uniformly by a partial Fisher-Yates shuffle: deterministic for a stream state.
 void switch_random(std::vector<std::size_t>& candidates, Count count,
@@ -77,7 +68,7 @@ LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const doub
         result.message = "lifting rejected, no label changed: " + std::move(why);
         if (std::count(colours.begin(), colours.end(), kLight) > 0 &&
             std::all_of(heights.begin(), heights.end(), [](double z) { return std::isfinite(z); }))
-            result.achieved_icdf = light_icdf(heights, colours, grid);
+            result.achieved_icdf = observed_icdf(heights, colours, grid);
         return result;
     };
 

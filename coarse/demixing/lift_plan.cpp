@@ -59,6 +59,15 @@ std::uint32_t cuts_at_or_below(std::span<const double> cuts, double z) {
     return static_cast<std::uint32_t>(base - cuts.data()) + (*base <= z ? 1u : 0u);
 }
 
+Eigen::VectorXd observed_icdf(std::span<const double> heights,
+                              std::span<const std::uint8_t> colours, const ProbabilityGrid& grid) {
+    EFDEM_EXPECTS(heights.size() == colours.size());
+    std::vector<double> z;
+    for (std::size_t j = 0; j < heights.size(); ++j)
+        if (colours[j] == kLight) z.push_back(heights[j]);
+    return quantiles(z, grid);
+}
+
 Count LiftPlan::shortfall() const {
     Count off = 0;
     for (std::size_t j = 0; j < below.size(); ++j)

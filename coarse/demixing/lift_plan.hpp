@@ -65,6 +65,11 @@ struct LiftPlan {
 LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                    std::span<const std::uint8_t> colours, const ProbabilityGrid& grid);
 
+/// Q of the heights of the particles labelled kLight, on the grid [d_p].
+/// \pre heights.size() == colours.size(); at least one kLight.
+Eigen::VectorXd observed_icdf(std::span<const double> heights,
+                              std::span<const std::uint8_t> colours, const ProbabilityGrid& grid);
+
 /// Number of cuts at or below z (the cuts sorted, m >= 1): a binary search whose halving step
 /// compiles to a conditional move (Khuong & Morin 2017), ~10 ns for m = 19 against ~30 ns for
 /// std::upper_bound, whose branches on random heights the CPU cannot predict.

@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 
-#include "coarse/demixing/quantiles.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {
@@ -175,14 +174,6 @@ class Exchanger {
     std::vector<Count> quota_;
 };
 
-Eigen::VectorXd observed_icdf(std::span<const Vec3> x, std::span<const std::uint8_t> colours,
-                              const ProbabilityGrid& grid) {
-    std::vector<double> z;
-    for (std::size_t j = 0; j < x.size(); ++j)
-        if (colours[j] == kLight) z.push_back(x[j].z);
-    return quantiles(z, grid);
-}
-
 }  // namespace
 
 PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
@@ -277,7 +268,8 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
     }
     for (double d : dv) result.max_volume_change = std::max(result.max_volume_change, std::abs(d));
 
-    result.achieved_icdf = observed_icdf(result.positions, colours, grid);
+    for (std::size_t j = 0; j < positions.size(); ++j) heights[j] = result.positions[j].z;
+    result.achieved_icdf = observed_icdf(heights, colours, grid);
     result.max_deviation = (result.achieved_icdf - result.target).cwiseAbs().maxCoeff();
     const bool short_counts = plan.below != plan.wanted;
     result.status = result.repair.changed() || short_counts || dropped > 0 ? LiftStatus::adjusted

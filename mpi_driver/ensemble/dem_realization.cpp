@@ -11,6 +11,7 @@
 #include "coarse/demixing/colour_lifting.hpp"
 #include "core/contracts.hpp"
 #include "core/error.hpp"
+#include "mpi_driver/ensemble/position_lifter.hpp"
 
 namespace efdem::mpi_driver {
 
@@ -64,12 +65,7 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid,
 LiftPayload DemRealization::lift_input() const {
     const dem::Particles& p = system_.particles();
     if (lift_by_positions_) {
-        LiftPayload in;
-        in.reals.reserve(6 * p.size());
-        for (const std::span<const Vec3> field : {p.x(), p.v()})
-            for (const Vec3& a : field) in.reals.insert(in.reals.end(), {a.x, a.y, a.z});
-        in.bytes = coarse::heights_and_colours(p, observed_).colours;
-        return in;
+        return {pack_positions(p.x(), p.v()), coarse::heights_and_colours(p, observed_).colours};
     }
     auto hc = coarse::heights_and_colours(p, observed_);
     // Then one flag per particle: moving (ColourLifter relabels those first, cpi.relabel).
@@ -89,13 +85,10 @@ void DemRealization::apply_lift(const LiftPayload& lifted) {
         dem::Particles& p = system_.particles();
         const std::size_t n = p.size();
         EFDEM_EXPECTS(lifted.reals.size() == 6 * n && lifted.bytes.size() == n);
-        auto x = p.x();
-        auto v = p.v();
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] = {lifted.reals[3 * i], lifted.reals[3 * i + 1], lifted.reals[3 * i + 2]};
-            v[i] = {lifted.reals[3 * (n + i)], lifted.reals[3 * (n + i) + 1],
-                    lifted.reals[3 * (n + i) + 2]};
-        }
+        const std::vector<Vec3> x = unpack_vectors(lifted.reals, 0, n);
+        const std::vector<Vec3> v = unpack_vectors(lifted.reals, n, n);
+        std::copy(x.begin(), x.end(), p.x().begin());
+        std::copy(v.begin(), v.end(), p.v().begin());
         system_.rearranged(lifted.bytes);
     } else {
         coarse::apply_colours(system_, lifted.bytes, observed_, other_);

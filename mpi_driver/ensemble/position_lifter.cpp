@@ -5,22 +5,29 @@
 
 #include <fmt/format.h>
 
+#include "coarse/demixing/lift_plan.hpp"
 #include "coarse/demixing/position_lifting.hpp"
-#include "coarse/demixing/quantiles.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::mpi_driver {
 
-namespace {
+std::vector<double> pack_positions(std::span<const Vec3> x, std::span<const Vec3> v) {
+    EFDEM_EXPECTS(x.size() == v.size());
+    std::vector<double> reals;
+    reals.reserve(6 * x.size());
+    for (const std::span<const Vec3> field : {x, v})
+        for (const Vec3& a : field) reals.insert(reals.end(), {a.x, a.y, a.z});
+    return reals;
+}
 
-std::vector<Vec3> unpack(const std::vector<double>& reals, std::size_t first, std::size_t n) {
+std::vector<Vec3> unpack_vectors(const std::vector<double>& reals, std::size_t first,
+                                 std::size_t n) {
+    EFDEM_EXPECTS(reals.size() >= 3 * (first + n));
     std::vector<Vec3> out(n);
     for (std::size_t i = 0; i < n; ++i)
         out[i] = {reals[3 * (first + i)], reals[3 * (first + i) + 1], reals[3 * (first + i) + 2]};
     return out;
 }
-
-}  // namespace
 
 PositionLifter::PositionLifter(dem::SpeciesTable species, dem::SpeciesId observed,
                                dem::SpeciesId other, dem::Domain domain,
@@ -35,8 +42,8 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
                                  const coarse::ProbabilityGrid& grid, RandomStream& rng) const {
     const std::size_t n = input.bytes.size();
     EFDEM_EXPECTS(input.reals.size() == 6 * n);
-    const std::vector<Vec3> x = unpack(input.reals, 0, n);
-    const std::vector<Vec3> v = unpack(input.reals, n, n);
+    const std::vector<Vec3> x = unpack_vectors(input.reals, 0, n);
+    const std::vector<Vec3> v = unpack_vectors(input.reals, n, n);
     const coarse::TwoSizes sizes{species_[observed_].diameter,
                                  species_[other_].diameter,
                                  species_.mass(observed_),
@@ -68,22 +75,13 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
             relaxation_.tolerance);
         return out;
     }
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 a = p.x()[i];
-        out.payload.reals[3 * i] = a.x;
-        out.payload.reals[3 * i + 1] = a.y;
-        out.payload.reals[3 * i + 2] = a.z;
-        const Vec3 b = r.velocities[i];
-        out.payload.reals[3 * (n + i)] = b.x;
-        out.payload.reals[3 * (n + i) + 1] = b.y;
-        out.payload.reals[3 * (n + i) + 2] = b.z;
-    }
+    out.payload.reals = pack_positions(p.x(), r.velocities);
     out.payload.bytes = r.moved;
     out.changed = static_cast<long>(r.n_moved);
-    std::vector<double> z;
-    for (std::size_t i = 0; i < n; ++i)
-        if (input.bytes[i] == coarse::kLight) z.push_back(p.x()[i].z);
-    out.max_deviation = (coarse::quantiles(z, grid) - r.target).cwiseAbs().maxCoeff();
+    std::vector<double> z(n);
+    for (std::size_t i = 0; i < n; ++i) z[i] = p.x()[i].z;
+    out.max_deviation =
+        (coarse::observed_icdf(z, input.bytes, grid) - r.target).cwiseAbs().maxCoeff();
     const std::string what = fmt::format(
         "{} particles moved in {} exchanges; overlaps {:.2g} -> {:.2g} of a diameter in {} "
         "relaxation steps; kinetic energy {:+.3g} m g d_p",

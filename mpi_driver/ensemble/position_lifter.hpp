@@ -6,12 +6,23 @@
 /// heights held. A relaxation that does not converge leaves the realization as it was and says
 /// why (LiftOutcome::failure): the adaptive integrator rejects the jump.
 
+#include <span>
+#include <vector>
+
+#include "core/vec3.hpp"
 #include "dem/beds/overlap_relaxation.hpp"
 #include "dem/domain.hpp"
 #include "dem/species.hpp"
 #include "mpi_driver/ensemble/realization.hpp"
 
 namespace efdem::mpi_driver {
+
+/// The reals of a lift by positions (DemRealization's payload both ways): x, y, z of every
+/// particle, then its velocity.
+std::vector<double> pack_positions(std::span<const Vec3> x, std::span<const Vec3> v);
+/// Vectors first .. first + n - 1 of such reals (0: the positions, n: the velocities).
+std::vector<Vec3> unpack_vectors(const std::vector<double>& reals, std::size_t first,
+                                 std::size_t n);
 
 class PositionLifter final : public Lifter {
   public:
