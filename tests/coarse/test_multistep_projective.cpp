@@ -324,20 +324,31 @@ class ShortReachLift final : public test::OuEnsembleView {
     std::string failure_;
     int failures_ = 0;
 };
+
+/// Three components decaying slowly from 3 (k = 0.02, no noise), lifted by a lift of `reach`.
+ShortReachLift slow_decay(double reach) {
+    return ShortReachLift(test::OuEnsembleStepper(Eigen::VectorXd::Constant(3, 0.02), 0.0, 2, 0.1,
+                                                  Eigen::VectorXd::Constant(3, 3.0), 1),
+                          reach);
+}
+
+/// Adaptive, bursts of 1 + 2, tolerance 0.5, DT in [dt_min, 40].
+MultistepSettings short_bursts(double dt_min) {
+    MultistepSettings s;
+    s.burst.healing = 1.0;
+    s.burst.window = 2.0;
+    s.control = {.tolerance = 0.5, .dt_min = dt_min, .dt_max = 40.0};
+    return s;
+}
 }  // namespace
 
 TEST_CASE("a lift that fails is a rejected jump: back to the kept state, redone shorter",
           "[unit][coarse][multistep]") {
     // Slow decay from 3 (k = 0.02): the first jumps the tolerance allows move X by more than the
     // lift reaches (0.2); each failure halves DT until the move is within reach.
-    const Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.02);
-    ShortReachLift stepper(
-        test::OuEnsembleStepper(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(3, 3.0), 1), 0.2);
-    MultistepSettings s;
-    s.burst.healing = 1.0;
-    s.burst.window = 2.0;
+    ShortReachLift stepper = slow_decay(0.2);
+    MultistepSettings s = short_bursts(0.5);
     s.first_dt = 40.0;
-    s.control = {.tolerance = 0.5, .dt_min = 0.5, .dt_max = 40.0};
     MultistepProjectiveIntegrator integrator(s);
     const auto records = run_to(integrator, stepper, 60.0);
     REQUIRE(stepper.failures() >= 1);
@@ -374,13 +385,8 @@ TEST_CASE(
     // and a burst runs directly: the run reaches its end. Near the end the planner may stretch a
     // jump to reach the last burst; it must not stretch a redo beyond the halved DT (before the
     // fix it retried the same DT for ever there).
-    const Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.02);
-    ShortReachLift stepper(
-        test::OuEnsembleStepper(k, 0.0, 2, 0.1, Eigen::VectorXd::Constant(3, 3.0), 1), 0.0);
-    MultistepSettings s;
-    s.burst.healing = 1.0;
-    s.burst.window = 2.0;
-    s.control = {.tolerance = 0.5, .dt_min = 1.5, .dt_max = 40.0};
+    ShortReachLift stepper = slow_decay(0.0);
+    MultistepSettings s = short_bursts(1.5);
     MultistepProjectiveIntegrator integrator(s);
     // Bursts of 3, a first-jump DT of 3, so the attempts start at t = 3, 6, ...: from t = 39 the
     // 4.5 left after the next burst are less than a jump of 3 plus a burst, and the planner

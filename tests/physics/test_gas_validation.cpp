@@ -27,6 +27,7 @@
 #include "dem/gas/slab_fields.hpp"
 #include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/validation_output.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
@@ -36,13 +37,6 @@ namespace {
 constexpr double kDt = 1.5e-4;
 constexpr double kBox = 5.0;
 const double kA = GasProperties{}.drag_number();
-
-std::filesystem::path out_dir() {
-    const char* env = std::getenv("EFDEM_VALIDATION_OUT");
-    std::filesystem::path dir = env ? env : "validation_out";
-    std::filesystem::create_directories(dir);
-    return dir;
-}
 
 /// The scene of every validation bed: the paper's model (physics.md §1, §5) in a box x box
 /// periodic cross-section.
@@ -147,26 +141,18 @@ double u_mf_uniform(double rho, double phi) {
     return rho / kA * std::pow(1 - phi, 4.65);
 }
 
-void report(const std::string& line) {
-    std::printf("validation: %s\n", line.c_str());
-    std::FILE* f = std::fopen((out_dir() / "numbers.txt").string().c_str(), "a");
-    if (f) {
-        std::fprintf(f, "%s\n", line.c_str());
-        std::fclose(f);
-    }
-}
-
 }  // namespace
 
 TEST_CASE("Delta P(U_s): Darcy below U_mf, the bed weight per area above (light bed)",
           "[.validation][gas]") {
     System s = settled_bed(500, 0, 1);
     const PackedBed b = packed_bed(s);
-    report(fmt::format(
+    test::validation_report(fmt::format(
         "light bed N=500: phi_bulk {:.4f}, H {:.3f}, W/A {:.4f}, U_mf,bed {:.4f}, "
         "U_mf §6.1 at phi_bulk {:.4f}",
         b.phi_bulk, b.height, b.weight_per_area, b.u_mf_bed, u_mf_uniform(1, b.phi_bulk)));
-    std::FILE* f = std::fopen((out_dir() / "dp_sweep_light.csv").string().c_str(), "w");
+    std::FILE* f =
+        std::fopen((test::validation_out_dir() / "dp_sweep_light.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
     std::fprintf(f,
                  "# Delta P(U_s) for increasing U_s, light bed of 500 in 5 x 5; U_mf,bed = %.5f, "
@@ -186,7 +172,7 @@ TEST_CASE("Delta P(U_s): Darcy below U_mf, the bed weight per area above (light 
         const long on_floor = s.thermo_stats().wall_contacts;
         std::fprintf(f, "%.5f,%.3f,%.5f,%.5f,%.4f,%ld\n", u, ratio, dp, sd, m.mean(m.height),
                      on_floor);
-        report(
+        test::validation_report(
             fmt::format("  U_s = {:.4f} ({:.1f} U_mf): Delta P = {:.4f} (sd {:.3f}) = {:.4f} W/A, "
                         "H = {:.3f}, particles touching the floor {}",
                         u, ratio, dp, sd, dp / b.weight_per_area, m.mean(m.height), on_floor));
@@ -225,7 +211,7 @@ TEST_CASE("U_mf of light, heavy and binary beds brackets the bed-scale predictio
                          Case{"binary", 250, 250, 1.5, 0.90}}) {
         System s = settled_bed(c.light, c.heavy, 2);
         const PackedBed b = packed_bed(s);
-        report(
+        test::validation_report(
             fmt::format("{} bed N=500: phi_bulk {:.4f}, H {:.3f}, W/A {:.4f}; U_mf,bed {:.4f} "
                         "(profile), U_mf §6.1 at phi_bulk {:.4f}",
                         c.name, b.phi_bulk, b.height, b.weight_per_area, b.u_mf_bed,
@@ -241,7 +227,7 @@ TEST_CASE("U_mf of light, heavy and binary beds brackets the bed-scale predictio
             const Series m = record(run, 10.0);
             const double dp = m.mean(m.dp) / b.weight_per_area;
             const double dh = m.mean(m.height) / b.height - 1;
-            report(
+            test::validation_report(
                 fmt::format("  {} U_s = {:.2f} U_mf,bed: Delta P = {:.4f} W/A, H/H_packed - 1 = "
                             "{:+.4f}",
                             c.name, ratio, dp, dh));
@@ -271,7 +257,8 @@ TEST_CASE(
     // paper's 0.41) are checked; light at 2.5 U_mf (0.25) is reported only: the more agitated
     // bed expands 3-5 % beyond phi_hom (phi fluctuates, and the drag is convex in phi, so the
     // same mean drag needs a lower mean phi).
-    std::FILE* f = std::fopen((out_dir() / "rz_profiles.csv").string().c_str(), "w");
+    std::FILE* f =
+        std::fopen((test::validation_out_dir() / "rz_profiles.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
     std::fprintf(
         f,
@@ -311,7 +298,7 @@ TEST_CASE(
             std::fprintf(f, "%s,%.3f,%.5f,%zu,%.5f\n", c.name, c.u, phi_hom, j, profile[j]);
         const double phi_mean = phi_sum / samples;
         const double h_sd = std::sqrt(std::max(0.0, h2_sum - h_sum * h_sum));
-        report(fmt::format(
+        test::validation_report(fmt::format(
             "Richardson-Zaki {} N={}, U_s = {:.2f}: bulk phi {:.4f}, phi_hom {:.4f} "
             "({:+.2f} %), bed height {:.3f} +- {:.3f}{}",
             c.name, c.light + c.heavy, c.u, phi_mean, phi_hom, 100 * (phi_mean / phi_hom - 1),
@@ -331,7 +318,7 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
     System packed = settled_bed(625, 625, 4);
     const PackedBed b = packed_bed(packed);
     const double phi_hom = 1 - std::pow(0.19 * kA / 1.5, 1 / 4.65);
-    report(
+    test::validation_report(
         fmt::format("binary bed N=1250: phi_bulk {:.4f}, H {:.3f}, U_mf,bed {:.4f}; homogeneous "
                     "expansion at U_s = 0.19: phi_bulk/phi_hom - 1 = {:.4f}",
                     b.phi_bulk, b.height, b.u_mf_bed, b.phi_bulk / phi_hom - 1));
@@ -342,8 +329,9 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
         const double u = k == 0 ? 0.19 : 0.41;
         System s = system_from(start, 625, 625);
         test::gas_effect(s).set_superficial_velocity(u);
-        std::FILE* st =
-            std::fopen((out_dir() / fmt::format("spacetime_u{:.2f}.csv", u)).string().c_str(), "w");
+        std::FILE* st = std::fopen(
+            (test::validation_out_dir() / fmt::format("spacetime_u{:.2f}.csv", u)).string().c_str(),
+            "w");
         REQUIRE(st != nullptr);
         std::fprintf(
             st,
@@ -367,7 +355,7 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
             probe.push_back(phi[kProbe]);
         }
         std::fclose(st);
-        m.write(out_dir() / fmt::format("waves_u{:.2f}.csv", u),
+        m.write(test::validation_out_dir() / fmt::format("waves_u{:.2f}.csv", u),
                 fmt::format("binary bed N=1250, U_s = {}", u));
         const coarse::PeriodEstimate period = coarse::estimate_period(m.t, probe);
         const double mean = m.mean(probe);
@@ -375,7 +363,7 @@ TEST_CASE("U_s = 0.19: no travelling waves, barely expanded; U_s = 0.41: waves w
         for (double x : probe) var += (x - mean) * (x - mean);
         phi_rms[k] = std::sqrt(var / static_cast<double>(probe.size()));
         const double expansion = m.mean(m.height) / b.height - 1;
-        report(
+        test::validation_report(
             fmt::format("U_s = {:.2f}: H/H_packed - 1 = {:+.4f}; phi at z = [10, 11): mean {:.4f}, "
                         "rms {:.4f}; wave period {} ({} periods in t = 30-80){}",
                         u, expansion, mean, phi_rms[k],
@@ -442,7 +430,8 @@ TEST_CASE("randomizing all velocities mid-run leaves the light-particle ICDF tra
             q[arm].push_back(m);
         }
     }
-    std::FILE* f = std::fopen((out_dir() / "randomization_icdf.csv").string().c_str(), "w");
+    std::FILE* f =
+        std::fopen((test::validation_out_dir() / "randomization_icdf.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
     std::fprintf(f,
                  "# light-particle ICDF Q_L(p), ensemble means of %d realizations, control and "
@@ -485,7 +474,7 @@ TEST_CASE("randomizing all velocities mid-run leaves the light-particle ICDF tra
     std::fclose(f);
     const double z_rms = std::sqrt(z2 / nz);
     const double drift = std::sqrt(drift2 / grid.size()), noise = std::sqrt(noise2 / grid.size());
-    report(
+    test::validation_report(
         fmt::format("velocity randomization, R = {}: z-score RMS {:.3f} over {} (p, t) points; "
                     "control drift of Q_L over 60 time units {:.3f} d_p (RMS over p), ensemble "
                     "standard error {:.3f} d_p",

@@ -22,6 +22,7 @@
 #include "dem/beds/bed_diagnostics.hpp"
 #include "dem/realization_builder.hpp"
 #include "tests/support/dem_fixtures.hpp"
+#include "tests/support/validation_output.hpp"
 
 using namespace efdem;
 using namespace efdem::dem;
@@ -29,21 +30,6 @@ using namespace efdem::dem;
 namespace {
 
 constexpr double kDt = 1.5e-4;  // t_c/24 of a small-small contact (a large pair's is longer)
-
-std::filesystem::path out_dir() {
-    const char* env = std::getenv("EFDEM_VALIDATION_OUT");
-    std::filesystem::path dir = env ? env : "validation_out";
-    std::filesystem::create_directories(dir);
-    return dir;
-}
-
-void report(const std::string& line) {
-    std::printf("validation: %s\n", line.c_str());
-    if (std::FILE* f = std::fopen((out_dir() / "numbers.txt").string().c_str(), "a")) {
-        std::fprintf(f, "%s\n", line.c_str());
-        std::fclose(f);
-    }
-}
 
 /// A settled bed of the paper's contacts and gas (at U_s = 0) with the polydisperse closure:
 /// `counts` spheres of `diameters` (one density), in a box x box periodic cross-section.
@@ -99,7 +85,8 @@ TEST_CASE(
     "Delta P(U_s) of one-size beds of d = 1 and d = 2: Darcy, the weight above U_mf, and "
     "U_mf in the ratio d^2",
     "[.validation][gas][two_sizes]") {
-    std::FILE* f = std::fopen((out_dir() / "dp_sweep_sizes.csv").string().c_str(), "w");
+    std::FILE* f =
+        std::fopen((test::validation_out_dir() / "dp_sweep_sizes.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
     std::fprintf(f,
                  "# Delta P(U_s), one-size beds of 500 spheres: d = 1 in 5 x 5, d = 2 in 10 x 10 "
@@ -139,12 +126,12 @@ TEST_CASE(
             }
             std::fprintf(f, "%g,%.5f,%.3f,%.5f,%.5f,%.5f,%.5f\n", d, ratio * u_pred, ratio, a.dp,
                          a.dp_sd, wa, u_mf[k]);
-            report(
+            test::validation_report(
                 fmt::format("  d = {}: U_s = {:.4f} ({:.1f} U_mf,pred): Delta P = {:.4f} W/A "
                             "(sd {:.3f}), H = {:.2f}",
                             d, ratio * u_pred, ratio, a.dp / wa, a.dp_sd / wa, a.height));
         }
-        report(
+        test::validation_report(
             fmt::format("one-size bed d = {}: phi_bulk {:.4f}, W/A {:.4f}, U_mf from Darcy {:.4f}, "
                         "closure at phi_bulk {:.4f}",
                         d, phi_bulk, wa, u_mf[k], u_pred));
@@ -160,7 +147,7 @@ TEST_CASE(
     // (measured: the ratio 3.58 against the closure's 3.82 at the two phi_bulk, 6 %) is the
     // looser floor and surface layers, whose share of the resistance differs: within 10 %.
     const double ratio = u_mf[1] / u_mf[0], closure_ratio = u_closure[1] / u_closure[0];
-    report(
+    test::validation_report(
         fmt::format("U_mf(d = 2) / U_mf(d = 1) = {:.4f}; the closure's at each phi_bulk {:.4f} "
                     "(d^2 = 4 at equal phi)",
                     ratio, closure_ratio));
@@ -172,7 +159,8 @@ TEST_CASE("a fluidized bed of two sizes: Delta P = W/A, and the small spheres ab
           "[.validation][gas][two_sizes]") {
     // bench/scenes/two_sizes_bed.cfg: 800 small (d = 1) and 100 large (d = 2) in 10 x 10, equal
     // volumes, one density, U_s = 0.6 (U_mf 0.12 small, 0.49 large, 0.22 the mixture).
-    std::FILE* f = std::fopen((out_dir() / "two_sizes_bed.csv").string().c_str(), "w");
+    std::FILE* f =
+        std::fopen((test::validation_out_dir() / "two_sizes_bed.csv").string().c_str(), "w");
     REQUIRE(f != nullptr);
     std::fprintf(f,
                  "# 800 d = 1 + 100 d = 2 in 10 x 10, U_s = 0.6, two realizations from the "
@@ -195,7 +183,7 @@ TEST_CASE("a fluidized bed of two sizes: Delta P = W/A, and the small spheres ab
         }
         const double ratio = ratio_sum / static_cast<double>(n_ratio);
         const double gap = gap_sum / static_cast<double>(n_gap);
-        report(
+        test::validation_report(
             fmt::format("two-size bed, seed {}: Delta P/(W/A) = {:.4f} (t > 10); z_small - "
                         "z_large = {:+.2f} d_p (t > 50)",
                         seed, ratio, gap));
