@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <fmt/format.h>
-
 #include "coarse/demixing/quantiles.hpp"
 #include "core/contracts.hpp"
 
@@ -117,13 +115,9 @@ LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const doub
     const bool short_counts = plan.below != plan.wanted;
     result.status = result.repair.changed() || short_counts ? LiftStatus::adjusted : LiftStatus::ok;
     result.message = result.repair.message;
-    if (short_counts) {
-        const Count moved = plan.shortfall();
-        result.message += fmt::format(
-            "{}{} interval(s) held fewer particles than their light count; light particles "
-            "moved to neighbouring intervals (a node's count off by up to {})",
-            result.message.empty() ? "" : "; ", result.n_short_intervals, moved);
-    }
+    if (short_counts)
+        result.message += (result.message.empty() ? "" : "; ") +
+                          plan.shortage("light", "light particles moved to neighbouring intervals");
     EFDEM_ENSURES(std::count(result.colours.begin(), result.colours.end(), kLight) ==
                   plan.n_observed);
     return result;

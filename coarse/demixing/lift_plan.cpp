@@ -75,6 +75,14 @@ Count LiftPlan::shortfall() const {
     return off;
 }
 
+std::string LiftPlan::shortage(std::string_view count_name, std::string_view remedy) const {
+    if (below == wanted) return {};
+    return fmt::format(
+        "{} interval(s) held fewer particles than their {} count{}{} (a node's count off by up "
+        "to {})",
+        n_short_intervals, count_name, remedy.empty() ? "" : "; ", remedy, shortfall());
+}
+
 LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                    std::span<const std::uint8_t> colours, const ProbabilityGrid& grid) {
     EFDEM_EXPECTS(heights.size() == colours.size());

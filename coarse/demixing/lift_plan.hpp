@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -51,6 +52,10 @@ struct LiftPlan {
     /// The largest |below - wanted| over the cuts: how many particles a node's count is off
     /// because some interval was too small (0 when every interval could take its count).
     std::int64_t shortfall() const;
+    /// "n interval(s) held fewer particles than their <count_name> count[; <remedy>] (a node's
+    /// count off by up to s)", or empty when every interval could take its count: the one
+    /// wording of the liftings' messages.
+    std::string shortage(std::string_view count_name, std::string_view remedy) const;
 };
 
 /**
