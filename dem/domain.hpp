@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/periodic.hpp"
 #include "core/vec3.hpp"
 
 namespace efdem {
@@ -31,20 +32,9 @@ struct Domain {
     double area() const { return lx * ly; }
 
     /// Maps a position into [0, lx) x [0, ly); z is unchanged.
-    Vec3 wrap(Vec3 p) const {
-        p.x -= lx * std::floor(p.x / lx);
-        p.y -= ly * std::floor(p.y / ly);
-        // floor() of a value just below 0 can produce exactly lx; keep the half-open interval.
-        if (p.x >= lx) p.x -= lx;
-        if (p.y >= ly) p.y -= ly;
-        return p;
-    }
+    Vec3 wrap(Vec3 p) const { return wrap_xy(p, lx, ly); }
     /// The periodic image of a separation vector with |dx| <= lx/2, |dy| <= ly/2.
-    Vec3 minimum_image(Vec3 d) const {
-        d.x -= lx * std::nearbyint(d.x / lx);
-        d.y -= ly * std::nearbyint(d.y / ly);
-        return d;
-    }
+    Vec3 minimum_image(Vec3 d) const { return minimum_image_xy(d, lx, ly); }
 
     /// Reads `domain.lx`, `domain.ly` (required) and `domain.lid` (optional height), each in
     /// (0, kMaxDomainLength].

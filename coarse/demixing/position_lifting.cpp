@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/contracts.hpp"
+#include "core/periodic.hpp"
 
 namespace efdem::coarse {
 
@@ -112,10 +113,7 @@ class Exchanger {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
 
     Vec3 separation(const Vec3& a, const Vec3& b) const {
-        Vec3 d = a - b;
-        d.x -= sizes_.lx * std::nearbyint(d.x / sizes_.lx);
-        d.y -= sizes_.ly * std::nearbyint(d.y / sizes_.ly);
-        return d;
+        return minimum_image_xy(a - b, sizes_.lx, sizes_.ly);
     }
 
     /// A random unchosen particle of `colour` in interval k, or in the nearest interval that has
@@ -248,9 +246,7 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
     double dke = 0;
     for (std::size_t j = 0; j < positions.size(); ++j) {
         const double m = (colours[j] == small_colour) ? m_small : m_large;
-        Vec3& xj = result.positions[j];
-        xj.x -= sizes.lx * std::floor(xj.x / sizes.lx);
-        xj.y -= sizes.ly * std::floor(xj.y / sizes.ly);
+        result.positions[j] = wrap_xy(result.positions[j], sizes.lx, sizes.ly);
         dp += (result.velocities[j] - velocities[j]) * m;
         dke += 0.5 * m * (norm2(result.velocities[j]) - norm2(velocities[j]));
     }
@@ -278,11 +274,7 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
     auto add = [&](const std::string& what) {
         result.message += (result.message.empty() ? "" : "; ") + what;
     };
-    if (short_counts)
-        add(
-            fmt::format("{} interval(s) held fewer particles than their observed count (a node's "
-                        "count off by up to {})",
-                        plan.n_short_intervals, plan.shortfall()));
+    if (short_counts) add(plan.shortage("observed", ""));
     if (dropped > 0)
         add(fmt::format("{} exchange(s) found no large particle left to move", dropped));
     EFDEM_ENSURES(result.n_moved == static_cast<std::size_t>(
