@@ -90,6 +90,11 @@ class CoarseStepper {
     /// succeed). The adaptive integrator handles a failed lift as a rejected jump: back to the
     /// kept state, the next jump shorter.
     virtual std::string lift_failure() const { return {}; }
+    /// The last lift's error in X: RMS over X's entries of (the micro model's X after the lift
+    /// - the target) [X's units], 0 when a lift puts the micro model exactly at its target (the
+    /// default). The adaptive integrator handles a lift whose error exceeds the jump's tolerance
+    /// as a failed lift (docs/error_control.md, "A lift that misses its target").
+    virtual double lift_error() const { return 0.0; }
     virtual void lift_apart(const Eigen::VectorXd& target, const Eigen::MatrixXd& member_steps,
                             double new_time);
 

@@ -221,6 +221,7 @@ LiftOutcome ColourLifter::lift(const Eigen::VectorXd& target, const LiftPayload&
     LiftOutcome out;
     out.changed = static_cast<long>(r.n_changed);
     out.max_deviation = r.max_deviation;
+    if (r.applied()) out.deviation = r.achieved_icdf - r.target;
     out.message = r.message;
     out.payload.bytes = std::move(r.colours);
     return out;

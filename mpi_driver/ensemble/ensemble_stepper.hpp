@@ -40,6 +40,7 @@
 /// in the middle of a coarse step is checkpointed where the step began, and the restarted run
 /// redoes the step exactly as the uninterrupted run did it.
 
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -194,6 +195,10 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     const LiftRecord& last_lift() const { return lifting_.last(); }
     /// Root: coarse::CoarseStepper::lift_failure, from the last lift.
     std::string lift_failure() const override { return lifting_.last_failure(); }
+    /// Root: coarse::CoarseStepper::lift_error, LiftRecord::error of the last lift (0 if none).
+    double lift_error() const override {
+        return std::isfinite(lifting_.last().error) ? lifting_.last().error : 0.0;
+    }
     const SampleRecord& last_sample() const { return sampler_.last(); }
     /// Particle-steps done by the whole ensemble so far.
     double particle_steps() const { return particle_steps_; }

@@ -58,7 +58,9 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
     out.payload.bytes.assign(n, 0);
     out.max_deviation = r.max_deviation;
     out.message = r.message;
-    if (!r.applied() || r.n_moved == 0) return out;
+    if (!r.applied()) return out;
+    out.deviation = r.achieved_icdf - r.target;
+    if (r.n_moved == 0) return out;
 
     // The exchanged state as particles of the scene's species, relaxed with the heights held.
     dem::Particles p;
@@ -73,6 +75,7 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
             "within {:g} d_p: {:.3g} of a pair's diameter after {} steps (tolerance {:g})",
             r.n_exchanges, relaxation_.height_band, relax.max_overlap_after, relax.iterations,
             relaxation_.tolerance);
+        out.deviation.resize(0);
         return out;
     }
     out.payload.reals = pack_positions(p.x(), r.velocities);
@@ -80,8 +83,8 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
     out.changed = static_cast<long>(r.n_moved);
     std::vector<double> z(n);
     for (std::size_t i = 0; i < n; ++i) z[i] = p.x()[i].z;
-    out.max_deviation =
-        (coarse::observed_icdf(z, input.bytes, grid) - r.target).cwiseAbs().maxCoeff();
+    out.deviation = coarse::observed_icdf(z, input.bytes, grid) - r.target;
+    out.max_deviation = out.deviation.cwiseAbs().maxCoeff();
     const std::string what = fmt::format(
         "{} particles moved in {} exchanges; overlaps {:.2g} -> {:.2g} of a diameter in {} "
         "relaxation steps; kinetic energy {:+.3g} m g d_p",

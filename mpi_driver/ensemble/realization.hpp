@@ -83,7 +83,10 @@ struct LiftOutcome {
     LiftPayload payload;
     long changed = 0;          ///< labels (or entries) changed
     double max_deviation = 0;  ///< max |achieved - target| over the p-grid [d_p]
-    std::string message;       ///< non-empty when the target was repaired, clipped or rejected
+    /// achieved - target at each p-node after the lift as applied [d_p]; empty when nothing was
+    /// lifted (rejected target) or the lift failed.
+    Eigen::VectorXd deviation;
+    std::string message;  ///< non-empty when the target was repaired, clipped or rejected
     /// Non-empty when the lift could not put the realization at its target and left it as it
     /// was (a lift that moves particles whose overlaps did not relax): why. The adaptive
     /// integrator rejects the jump (coarse::CoarseStepper::lift_failure).

@@ -475,6 +475,7 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
     series("/cpi/lift_changed", {r}, T::integer).append(std::span<const std::int64_t>(changed));
     series("/cpi/lift_max_deviation", {r}, T::real).append(std::span<const double>(deviation));
     series("/cpi/lift_at_rest", {r}, T::integer).append(std::span<const std::int64_t>(at_rest));
+    series("/cpi/lift_error", {}, T::real).append(lift.error);
     series("/cpi/lift_message", {}, T::text).append_text(messages);
     file_.flush();
 }

@@ -486,7 +486,7 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "1",
          "labels changed by the lift",
          "labels lifting changed in each realization (particles it moved with cpi.lift_by = "
-         "positions)",
+         "positions); at a lift_failed step what the lift did before the ensemble went back",
          {"t_start", "realization"}},
         {"/cpi/lift_max_deviation",
          "d_p",
@@ -498,6 +498,12 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "held at rest by the lift",
          "1 where the realization was at rest and left where it was (cpi.at_rest = hold)",
          {"t_start", "realization"}},
+        {"/cpi/lift_error",
+         "d_p",
+         "lift error of the mean",
+         "RMS over the p-grid of the lifted realizations' mean achieved - target ICDF (those held "
+         "at rest count 0); above the jump's tolerance the lift failed; NaN: nothing lifted",
+         {"t_start"}},
         {"/cpi/lift_message",
          "text",
          "lift message",

@@ -4,6 +4,7 @@
 /// leave it (EnsembleStepper calls sample() and failure() on the root, nothing else). The run's
 /// recorders (run_recorder.hpp) implement it; the ensemble does not know them.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,10 @@ struct LiftRecord {
     /// What `changed` counts: "labels changed" (colour lifting) or "particles moved".
     std::string changed_what = "labels changed";
     std::vector<double> max_deviation;  ///< max |Q_L,lifted - target| per realization [d_p]
+    /// The lift's error in the ensemble mean: RMS over the p-grid of the mean over the lifted
+    /// realizations (those held at rest count with 0) of achieved - target [d_p], the norm the
+    /// adaptive controller's tolerance is in; NaN when no realization was lifted.
+    double error = std::numeric_limits<double>::quiet_NaN();
     std::vector<std::string> messages;  ///< non-empty where a target was repaired or clipped
     std::vector<char> at_rest;  ///< 1 where the realization was at rest and left where it was
 };

@@ -42,7 +42,10 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
 
 void StepReportObserver::step_done(const coarse::ProjectiveRun& run,
                                    const coarse::ProjectiveStepRecord& rec) {
-    const LiftRecord lift = rec.lifted ? stepper_.last_lift() : LiftRecord{};
+    // A failed lift is recorded too (what it did, its error, why each realization was not
+    // lifted), although the ensemble went back to the state before the jump.
+    const bool attempted = rec.lifted || rec.status == coarse::StepStatus::lift_failed;
+    const LiftRecord lift = attempted ? stepper_.last_lift() : LiftRecord{};
     if (recorder_) recorder_->coarse_step(rec, lift);
     log::info("{}", describe_step(run.state().coarse_steps, rec, lift));
 }

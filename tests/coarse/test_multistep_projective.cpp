@@ -298,38 +298,49 @@ TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone",
 }
 
 namespace {
-/// A lift that fails when it must move the coarse state by more than `reach` (RMS over the
-/// nodes), as a lift that moves particles fails when its overlaps do not relax: the micro
-/// model is left as it was, and lift_failure() says why.
+/// A lift that cannot move the coarse state by more than `reach` (RMS over the nodes). With
+/// Beyond::fail it then fails, as a lift that moves particles fails when its overlaps do not
+/// relax: the micro model is left as it was, and lift_failure() says why. With
+/// Beyond::fall_short it moves as far as it reaches and reports what is left as lift_error(), as
+/// a lift with too few particles of a class where the target puts them.
 class ShortReachLift final : public test::OuEnsembleView {
   public:
-    ShortReachLift(test::OuEnsembleStepper toy, double reach)
-        : OuEnsembleView(std::move(toy)), reach_(reach) {}
+    enum class Beyond { fail, fall_short };
+    ShortReachLift(test::OuEnsembleStepper toy, double reach, Beyond beyond)
+        : OuEnsembleView(std::move(toy)), reach_(reach), beyond_(beyond) {}
     void lift(const Eigen::VectorXd& target, double new_time) override {
         const double move = rms(target - toy_.mean());
         failure_.clear();
-        if (move > reach_) {
+        error_ = 0.0;
+        if (move <= reach_) {
+            toy_.lift(target, new_time);
+        } else if (beyond_ == Beyond::fail) {
             failure_ = "a move of " + std::to_string(move) + " is beyond reach";
             ++failures_;
-            return;
+        } else {
+            toy_.lift(toy_.mean() + (reach_ / move) * (target - toy_.mean()), new_time);
+            error_ = move - reach_;
         }
-        toy_.lift(target, new_time);
     }
     std::string lift_failure() const override { return failure_; }
+    double lift_error() const override { return error_; }
     int failures() const { return failures_; }
     double work() const { return toy_.work(); }
 
   private:
     double reach_;
+    Beyond beyond_;
     std::string failure_;
+    double error_ = 0.0;
     int failures_ = 0;
 };
 
 /// Three components decaying slowly from 3 (k = 0.02, no noise), lifted by a lift of `reach`.
-ShortReachLift slow_decay(double reach) {
+ShortReachLift slow_decay(double reach,
+                          ShortReachLift::Beyond beyond = ShortReachLift::Beyond::fail) {
     return ShortReachLift(test::OuEnsembleStepper(Eigen::VectorXd::Constant(3, 0.02), 0.0, 2, 0.1,
                                                   Eigen::VectorXd::Constant(3, 3.0), 1),
-                          reach);
+                          reach, beyond);
 }
 
 /// Adaptive, bursts of 1 + 2, tolerance 0.5, DT in [dt_min, 40].
@@ -373,6 +384,38 @@ TEST_CASE("a lift that fails is a rejected jump: back to the kept state, redone 
         CHECK(stepper.time() >= r.t_end);
     }
     CHECK(failed == stepper.failures());
+    CHECK(projected >= 2);
+    CHECK(integrator.totals().rejected == failed);
+}
+
+TEST_CASE("a lift that falls short of its target by more than the tolerance is a failed lift",
+          "[unit][coarse][multistep]") {
+    // The lift moves X at most 0.2 (RMS) and leaves the rest as its error. A jump whose move
+    // exceeds 0.2 + tolerance (0.5) leaves the micro model further from X than the jump may be
+    // off in all: it must be handled as a failed lift (before the rule, such a jump was kept:
+    // the noiseless burst after it sees no curvature, only a state that is not X).
+    ShortReachLift stepper = slow_decay(0.2, ShortReachLift::Beyond::fall_short);
+    MultistepSettings s = short_bursts(0.5);
+    s.first_dt = 40.0;
+    MultistepProjectiveIntegrator integrator(s);
+    const auto records = run_to(integrator, stepper, 60.0);
+    long failed = 0, projected = 0;
+    for (std::size_t i = 0; i < records.size(); ++i) {
+        const auto& r = records[i];
+        if (r.status == StepStatus::projected) {
+            ++projected;
+            // What the lift missed (move - reach) stayed within the tolerance.
+            CHECK(rms(r.x_projected - r.x_end) <= 0.2 + s.control.tolerance + 1e-12);
+        }
+        if (r.status != StepStatus::lift_failed) continue;
+        ++failed;
+        CHECK(r.message.find("more than the jump's tolerance 0.5") != std::string::npos);
+        CHECK(rms(r.x_projected - r.x_end) > 0.2 + s.control.tolerance);
+        REQUIRE(i + 1 < records.size());
+        CHECK(records[i + 1].t_end == r.t_end);  // back to the kept state, redone shorter
+        CHECK(records[i + 1].dt < r.dt);
+    }
+    CHECK(failed >= 1);
     CHECK(projected >= 2);
     CHECK(integrator.totals().rejected == failed);
 }

@@ -127,6 +127,13 @@ TEST_CASE("lifting through the driver keeps species counts and moves the ICDF to
             // largest gap next to 19 nodes stays below ~5 times that; 0.15 d_p bounds it.
             CHECK(lift.max_deviation[r] < 0.15);
         }
+        // The error of the ensemble mean (RMS over the nodes of the mean deviation) is bounded
+        // by the largest single deviation: |mean_r d_ri| <= max_r max_i |d_ri|. It is what the
+        // adaptive integrator compares with the jump's tolerance.
+        REQUIRE(std::isfinite(lift.error));
+        CHECK(lift.error >= 0.0);
+        CHECK(lift.error <=
+              *std::max_element(lift.max_deviation.begin(), lift.max_deviation.end()));
         // Realization 0's light median is now the target's 11 (to that resolution), measured
         // independently of the lifting's own report.
         const Eigen::VectorXd achieved =
@@ -314,6 +321,11 @@ TEST_CASE(
         CHECK(std::count(p.species().begin(), p.species().end(), 0) == 400);
         CHECK(std::abs((coarse::species_icdf(p, 0, grid) - target).cwiseAbs().maxCoeff() -
                        out.max_deviation) < 1e-12);
+        // The deviation per node it reports (what the lift's error of the mean is made of) is
+        // the one measured after the relaxation, node by node.
+        REQUIRE(out.deviation.size() == target.size());
+        CHECK((coarse::species_icdf(p, 0, grid) - target - out.deviation).cwiseAbs().maxCoeff() <
+              1e-12);
         // No overlap beyond the relaxation's tolerance (1e-4 of the pair's mean diameter).
         CHECK(s.thermo_stats().max_overlap <= 1e-4 * (1 + 1e-9));
         // No moved particle keeps a tangential spring: its contacts are new ones.

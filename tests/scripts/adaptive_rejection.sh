@@ -12,7 +12,10 @@ mpiflags=("$@")
 here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-common=(mode=cpi cpi.projection=adaptive cpi.tolerance=0.1 cpi.dt_min=0.5 run.duration=24
+# Tolerance 0.2: the colour lift of this 256-sphere bed leaves the ensemble mean 0.05-0.13 d_p
+# (RMS) from X (measured 2026-12-05); at 0.1 some lifts fail as missing their target
+# (docs/error_control.md §4) and the forced attempt would not be the jump this test compares.
+common=(mode=cpi cpi.projection=adaptive cpi.tolerance=0.2 cpi.dt_min=0.5 run.duration=24
         ensemble.realizations_per_rank=2 output.directory="$work" cpi.debug.force_attempt=3)
 for kind in reject shrink; do
   timeout 300 "$mpiexec" -n 2 "$@" "$efdem" "$here/tiny_scene.cfg" "${common[@]}" cpi.debug.force=$kind \

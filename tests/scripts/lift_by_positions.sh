@@ -26,6 +26,8 @@ with h5py.File(f"{work}/efdem.h5", "r") as f:
     t_end, dt = f["cpi/t_end"][:], f["cpi/dt"][:]
     changed = f["cpi/lift_changed"][:]
     messages = [m.decode() for m in f["cpi/lift_message"][:]]
+    lift_error = f["cpi/lift_error"][:]
+    step_messages = [m.decode() for m in f["cpi/message"][:]]
 jumps = [i for i, s in enumerate(status) if s == "projected" and dt[i] > 0]
 if not jumps:
     sys.exit(f"FAIL: no projective jump was kept ({status})")
@@ -35,6 +37,12 @@ for i in jumps:
     for word in ("exchanges", "relaxation steps", "kinetic energy"):
         if messages[i].count(word) != changed.shape[1]:
             sys.exit(f"FAIL: the lift record does not say '{word}' for every realization: {messages[i]!r}")
+    # A kept jump's lift left the ensemble mean within the tolerance (cpi.tolerance = 1) of X.
+    if not 0 <= lift_error[i] <= 1.0:
+        sys.exit(f"FAIL: a kept jump's lift error {lift_error[i]} is not in [0, tolerance 1]")
+for i, s in enumerate(status):
+    if s == "lift_failed" and "tolerance" in step_messages[i] and not lift_error[i] > 1.0:
+        sys.exit(f"FAIL: a lift failed on the tolerance with lift error {lift_error[i]}")
 worst = 0.0
 for r in range(changed.shape[1]):
     with open(f"{work}/efdem_r{r:04d}_thermo.csv") as fh:

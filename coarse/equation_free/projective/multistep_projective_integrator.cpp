@@ -418,7 +418,16 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     } else
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
-    if (const std::string why = stepper.lift_failure(); !why.empty()) {
+    std::string why = stepper.lift_failure();
+    if (why.empty() && settings_.adaptive && stepper.lift_error() > c.tolerance)
+        // The lift alone spent more than the jump may: whatever the burst after it measured,
+        // the jump's error would exceed the tolerance (too few particles of a class where the
+        // target puts them, docs/error_control.md "A lift that misses its target").
+        why = fmt::format(
+            "it left the ensemble mean {:.3g} d_p (RMS) from the projected X, more than the jump's "
+            "tolerance {:.3g}",
+            stepper.lift_error(), c.tolerance);
+    if (!why.empty()) {
         // The micro model is not at X: as a rejected jump, without the burst that would judge it.
         EFDEM_EXPECTS(settings_.adaptive);  // cpi_settings refuses lifts that can fail otherwise
         stepper.return_to_kept_state();
