@@ -6,10 +6,15 @@ S x R realizations at one budget of core-hours.
 
     /usr/bin/python3 bench/equal_compute.py                      # the four slope studies
     /usr/bin/python3 bench/equal_compute.py bench/results/slope_study_r8_u0.19_t200
+    /usr/bin/python3 bench/equal_compute.py --out docs/equal_compute_whole_process \
+        bench/results/whole_process/tall_u0.41_r8+bench/results/whole_process/tall_u0.41_r4
 
 Reads the run files a study of bench/slope_study.py made (direct_a/b/c.h5: three direct ensembles
 with their own seeds, and its CPI runs; the run files are not in git, the study's command in its
-analysis.md regenerates them). Writes docs/equal_compute.md and docs/equal_compute.png.
+analysis.md regenerates them). A study given as DIRECTS+CPI takes the direct runs from the
+folder DIRECTS and the CPI runs from both (bench/whole_process.py keeps its R = 4 CPI runs of the
+tall bed beside the R = 8 directs whose halves are their floor). Writes docs/equal_compute.md and
+docs/equal_compute.png.
 
 How:
 * The three direct ensembles are independent draws of the same process (same bed, own seeds), so
@@ -89,8 +94,11 @@ def members_at(t_ref, members, t):
     return keep, np.stack(out, axis=1)
 
 
-def analyse_study(folder):
+def analyse_study(spec):
+    folder, *cpi_folders = spec.split("+")
     name = os.path.basename(os.path.normpath(folder))
+    if cpi_folders:
+        name = os.path.basename(os.path.dirname(os.path.normpath(folder))) + "_" + name
     directs = [load(os.path.join(folder, d + ".h5")) for d in DIRECTS if os.path.exists(os.path.join(folder, d + ".h5"))]
     if len(directs) < 3:
         print(f"{name}: {len(directs)} direct run file(s), 3 needed; skipped")
@@ -107,7 +115,7 @@ def analyse_study(folder):
     direct = {s: {"compute": s * span, "e": am.subset_errors(pool, s),
                   "e_last": am.subset_errors(pool[last], s)} for s in sizes}
     cpi = {}
-    for path in sorted(glob.glob(os.path.join(folder, "*.h5"))):
+    for path in sorted(p for f in [folder, *cpi_folders] for p in glob.glob(os.path.join(f, "*.h5"))):
         run_name = os.path.basename(path)[:-3]
         if run_name in DIRECTS:
             continue
@@ -120,14 +128,16 @@ def analyse_study(folder):
         sel = r["t"] >= t[0] + 0.75 * span
         var_last = float(np.mean(ref[sel].var(axis=1, ddof=1)))
         compute = r["realizations"] * r["dem_time"] * (1.0 + r["overhead"] / r["wall"])
+        # A run that ended early (at its end state) is held against direct over its own span.
+        span_r = min(span, float(r["t"][-1] - t[0]))
         e = am.error_against_truth(r["mean"], ref)
         e_last = am.error_against_truth(r["mean"][sel], ref[sel])
         cpi[run_name] = {
             "R": r["realizations"], "compute": compute, "e": e, "e_last": e_last,
-            "error_ratio": math.sqrt(var * span / compute) / e if e > 0 else math.inf,
-            "error_ratio_last": math.sqrt(var_last * span / compute) / e_last if e_last > 0 else math.inf,
-            "compute_ratio": var * span / e ** 2 / compute if e > 0 else math.inf,
-            "compute_ratio_last": var_last * span / e_last ** 2 / compute if e_last > 0 else math.inf}
+            "error_ratio": math.sqrt(var * span_r / compute) / e if e > 0 else math.inf,
+            "error_ratio_last": math.sqrt(var_last * span_r / compute) / e_last if e_last > 0 else math.inf,
+            "compute_ratio": var * span_r / e ** 2 / compute if e > 0 else math.inf,
+            "compute_ratio_last": var_last * span_r / e_last ** 2 / compute if e_last > 0 else math.inf}
     return {"name": name, "N": n, "span": span, "cost": cost, "direct": direct, "cpi": cpi,
             "var": float(np.mean(pool.var(axis=1, ddof=1))), "var_last": float(np.mean(pool[last].var(axis=1, ddof=1)))}
 
@@ -167,7 +177,7 @@ def plot(studies, path):
         ax.loglog(grid, np.sqrt(s["var"] * s["span"] / grid), "k:", lw=1, label="sqrt(var T / C)")
         for name, r in s["cpi"].items():
             ax.loglog([r["compute"]], [r["e"]], "o", label=f"{name} (R {r['R']})")
-        ax.set_title(s["name"].replace("slope_study_", ""), fontsize=9)
+        ax.set_title(s["name"].replace("slope_study_", "").replace("whole_process_", "whole process, "), fontsize=9)
         ax.set_xlabel("DEM compute [realization x time units]")
         ax.set_ylabel("RMS error against the ensemble's mean [d_p]")
         ax.legend(fontsize=6)
@@ -181,12 +191,15 @@ def main():
     p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "equal_compute"),
                    help="writes OUT.md and OUT.png")
     args = p.parse_args()
-    folders = args.folders or [os.path.join(HERE, "results", s) for s in STUDIES]
+    folders = args.folders or ["+".join(os.path.join(HERE, "results", f) for f in s.split("+")) for s in STUDIES]
     studies = [s for s in (analyse_study(f) for f in folders) if s]
     if not studies:
         raise SystemExit("equal_compute: no study with three direct run files")
-    text_ = ("# Error at equal compute: direct ensembles and CPI\n\nMade by `/usr/bin/python3 bench/equal_compute.py` "
-             "from the run files of the slope studies (regenerate those with the command in each "
+    command = " ".join(["/usr/bin/python3 bench/equal_compute.py"] + (
+        ["--out", os.path.relpath(args.out, os.path.join(HERE, ".."))] if args.folders else []) +
+        [os.path.relpath(f, os.path.join(HERE, "..")) for f in args.folders])
+    text_ = (f"# Error at equal compute: direct ensembles and CPI\n\nMade by `{command}` "
+             "from the studies' run files (regenerate those with the command in each "
              "study's analysis.md). Method: the script's docstring.\n\n" + "\n".join(table(s) for s in studies))
     with open(args.out + ".md", "w") as f:
         f.write(text_)
