@@ -16,6 +16,9 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
     if (std::isfinite(r.period)) s += fmt::format(", period T = {:.4g}", r.period);
     s += fmt::format(", DT = {:.4g}, {}", r.dt, coarse::to_string(r.status));
     if (r.lifted) s += fmt::format(", {} {}", changed, lift.changed_what);
+    // The lift's own error in X (the burst after the jump does not measure it).
+    if (r.lifted && std::isfinite(lift.error))
+        s += fmt::format(", lift error {:.3g} d_p", lift.error);
     if (r.repair.changed())
         s += fmt::format(", repaired (max {:.3g} d_p)", r.repair.max_adjustment);
     if (r.slope_standard_error.size() > 0)

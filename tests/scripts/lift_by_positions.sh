@@ -15,6 +15,9 @@ timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$scene" mode=cpi cpi.lift
   cpi.projection=adaptive cpi.tolerance=1 output.thermo_interval=0.25 output.directory="$work" \
   > "$work/run.log" 2>&1 || { cat "$work/run.log"; echo "FAIL: the cpi.lift_by = positions run failed"; exit 1; }
 /usr/bin/python3 "$here/check_run_file.py" "$work/efdem.h5" > /dev/null || { echo "FAIL: efdem.h5 layout"; exit 1; }
+# The step report of a kept jump says how far the lift left the ensemble from X.
+grep -q "projected, .* particles moved, lift error [0-9.e-]* d_p" "$work/run.log" \
+  || { grep "coarse step" "$work/run.log"; echo "FAIL: no kept jump's report gives its lift error"; exit 1; }
 /usr/bin/python3 - "$work" <<'PY' || exit 1
 import csv
 import sys
