@@ -85,11 +85,14 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
     for (std::size_t i = 0; i < n; ++i) z[i] = p.x()[i].z;
     out.deviation = coarse::observed_icdf(z, input.bytes, grid) - r.target;
     out.max_deviation = out.deviation.cwiseAbs().maxCoeff();
+    // The deviation before and after the relaxation tells the exchange's error from what the
+    // relaxation moved (max over the p-grid, d_p).
     const std::string what = fmt::format(
         "{} particles moved in {} exchanges; overlaps {:.2g} -> {:.2g} of a diameter in {} "
-        "relaxation steps; kinetic energy {:+.3g} m g d_p",
+        "relaxation steps; largest deviation from the target {:.2g} -> {:.2g} d_p; kinetic "
+        "energy {:+.3g} m g d_p",
         r.n_moved, r.n_exchanges, relax.max_overlap_before, relax.max_overlap_after,
-        relax.iterations, r.kinetic_energy_change);
+        relax.iterations, r.max_deviation, out.max_deviation, r.kinetic_energy_change);
     out.message = out.message.empty() ? what : out.message + "; " + what;
     return out;
 }

@@ -37,7 +37,7 @@ if not jumps:
 for i in jumps:
     if not (changed[i] > 0).all():
         sys.exit(f"FAIL: a kept jump moved no particle in some realization: {changed[i]}")
-    for word in ("exchanges", "relaxation steps", "kinetic energy"):
+    for word in ("exchanges", "relaxation steps", "largest deviation from the target", "kinetic energy"):
         if messages[i].count(word) != changed.shape[1]:
             sys.exit(f"FAIL: the lift record does not say '{word}' for every realization: {messages[i]!r}")
     # A kept jump's lift left the ensemble mean within the tolerance (cpi.tolerance = 1) of X.
