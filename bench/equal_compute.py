@@ -119,6 +119,8 @@ def analyse_study(spec):
         run_name = os.path.basename(path)[:-3]
         if run_name in DIRECTS:
             continue
+        if os.path.dirname(path) != os.path.normpath(folder):  # runs of a second folder: named by it
+            run_name += f" ({os.path.basename(os.path.dirname(path))})"
         r = load(path)
         if r["mode"] != "cpi" or not r["status"].startswith("completed"):
             continue
