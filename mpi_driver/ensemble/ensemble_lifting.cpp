@@ -1,12 +1,12 @@
 #include "mpi_driver/ensemble/ensemble_lifting.hpp"
 
-#include <cmath>
 #include <limits>
 #include <string>
 
 #include <fmt/format.h>
 #include <mpi.h>
 
+#include "coarse/equation_free/projective/multistep_projection.hpp"  // rms
 #include "core/contracts.hpp"
 #include "mpi_driver/ensemble/reference_rows.hpp"
 
@@ -174,9 +174,9 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             if (members) steps = centred_steps(request.member_steps, moving, target->size());
         }
         long k = 0;  // the lifted realizations so far: row k of the steps
-        // The lift's error in the ensemble mean: those held at rest are at their own X_r (0).
+        // The lift's error in the ensemble mean over the k lifted: those held at rest are at
+        // their own X_r (0).
         Eigen::VectorXd deviation_sum = Eigen::VectorXd::Zero(target->size());
-        long deviation_count = 0;
         for (int r = 0; r < layout_.size(); ++r) {
             if (!lifted_here(r) || is_held(r)) {
                 last_.changed.push_back(0);
@@ -187,10 +187,7 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
                                     : kHeld);
                 lifted_reals.emplace_back();
                 lifted_bytes.emplace_back();
-                if (lifted_here(r)) {
-                    ++k;
-                    ++deviation_count;
-                }
+                if (lifted_here(r)) ++k;
                 continue;
             }
             Eigen::VectorXd x = *target;
@@ -215,7 +212,6 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
                                            streams_[static_cast<std::size_t>(r)]);
             last_.changed.push_back(res.changed);
             last_.max_deviation.push_back(res.max_deviation);
-            ++deviation_count;
             if (res.failure.empty() && res.deviation.size() == target->size())
                 deviation_sum += res.deviation;
             last_.at_rest.push_back(0);
@@ -231,10 +227,8 @@ void EnsembleLifting::lift(Realizations& local, const std::vector<char>& active,
             lifted_reals.push_back(std::move(res.payload.reals));
             lifted_bytes.push_back(std::move(res.payload.bytes));
         }
-        if (deviation_count > 0 && target->size() > 0)
-            last_.error =
-                std::sqrt((deviation_sum / static_cast<double>(deviation_count)).squaredNorm() /
-                          static_cast<double>(target->size()));
+        if (k > 0 && target->size() > 0)
+            last_.error = coarse::rms(deviation_sum / static_cast<double>(k));
     }
     const auto my_reals = layout_.scatter_arrays(lifted_reals, out_reals);
     const auto my_bytes = layout_.scatter_arrays(lifted_bytes, out_bytes);
