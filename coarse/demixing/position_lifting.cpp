@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/demixing/rank_windows.hpp"
 #include "core/contracts.hpp"
 #include "core/periodic.hpp"
 
@@ -31,32 +32,36 @@ std::vector<std::size_t> repeated_intervals(const LiftPlan& plan, int sign) {
     return list;
 }
 
-/// The exchanges of step 2 (position_lifting.hpp), lowest first.
-std::vector<Exchange> plan_exchanges(const LiftPlan& plan, bool observed_is_small, double rho) {
+/// Size of the t-th of a run of groups of rho small particles on average: round(rho (t + 1))
+/// - round(rho t), so that T groups hold round(rho T) in all.
+Count group_size(double rho, std::size_t t) {
+    return std::llround(rho * static_cast<double>(t + 1)) -
+           std::llround(rho * static_cast<double>(t));
+}
+
+/// The exchanges of step 2a (position_lifting.hpp, the small species observed), lowest first.
+std::vector<Exchange> plan_exchanges(const LiftPlan& plan, double rho) {
     const std::vector<std::size_t> losing = repeated_intervals(plan, -1);
     const std::vector<std::size_t> gaining = repeated_intervals(plan, +1);
     EFDEM_ASSERT(losing.size() == gaining.size());
     const auto moves = static_cast<Count>(losing.size());
     std::vector<Exchange> out;
-    if (observed_is_small) {
-        const auto n = static_cast<Count>(std::llround(static_cast<double>(moves) / rho));
-        for (Count t = 0; t < n; ++t) {
-            const Count first = t * moves / n, last = (t + 1) * moves / n;
-            const auto middle = static_cast<std::size_t>((2 * t + 1) * moves / (2 * n));
-            out.push_back({gaining[middle], losing[static_cast<std::size_t>(first)],
-                           losing[static_cast<std::size_t>(last - 1)], last - first});
-        }
-    } else {
-        for (Count t = 0; t < moves; ++t) {
-            const Count group = std::llround(rho * static_cast<double>(t + 1)) -
-                                std::llround(rho * static_cast<double>(t));
-            if (group == 0) continue;
-            const std::size_t k = gaining[static_cast<std::size_t>(t)];
-            out.push_back({losing[static_cast<std::size_t>(t)], k, k, group});
-        }
+    const auto n = static_cast<Count>(std::llround(static_cast<double>(moves) / rho));
+    for (Count t = 0; t < n; ++t) {
+        const Count first = t * moves / n, last = (t + 1) * moves / n;
+        const auto middle = static_cast<std::size_t>((2 * t + 1) * moves / (2 * n));
+        out.push_back({gaining[middle], losing[static_cast<std::size_t>(first)],
+                       losing[static_cast<std::size_t>(last - 1)], last - first});
     }
     return out;
 }
+
+/// One exchange to make: the large particle, its group of small ones, where the large one goes.
+struct Move {
+    std::size_t large = 0;
+    std::vector<std::size_t> group;
+    Vec3 destination{};
+};
 
 class Exchanger {
   public:
@@ -99,6 +104,43 @@ class Exchanger {
             lo = lo > 0 ? lo - 1 : lo;
             hi = hi + 1 < quota_.size() ? hi + 1 : hi;
         }
+    }
+
+    /**
+     * `count` unchosen small particles about height z, from the plan's interval that holds z
+     * (widened by one interval each side while too few, then `far` is set): a random seed among
+     * those, then the nearest to the point at the seed's x, y and height z. Drawn from the
+     * interval the large particle goes to, the group keeps that interval's solid volume.
+     */
+    std::vector<std::size_t> group_at_height(double z, Count count, bool& far) {
+        const std::size_t k =
+            cuts_at_or_below(std::span<const double>(plan_.target.data(), plan_.target.size()), z);
+        far = false;
+        std::vector<std::size_t> near;
+        for (std::size_t lo = k, hi = k;; far = true) {
+            near.clear();
+            for (std::size_t q = lo; q <= hi; ++q)
+                for (std::size_t j : by_interval_[q])
+                    if (!chosen_[j] && colours_[j] == small_colour_) near.push_back(j);
+            if (static_cast<Count>(near.size()) >= count || (lo == 0 && hi + 1 == quota_.size()))
+                break;
+            lo = lo > 0 ? lo - 1 : lo;
+            hi = hi + 1 < quota_.size() ? hi + 1 : hi;
+        }
+        if (near.empty()) return {};
+        const Vec3 seed = x_[near[rng_.below(near.size())]];
+        const Vec3 centre{seed.x, seed.y, z};
+        std::vector<std::pair<double, std::size_t>> by_distance;
+        for (std::size_t j : near) by_distance.emplace_back(norm2(separation(x_[j], centre)), j);
+        const auto take = std::min<std::size_t>(static_cast<std::size_t>(count), near.size());
+        std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<long>(take),
+                          by_distance.end());
+        std::vector<std::size_t> group;
+        for (std::size_t q = 0; q < take; ++q) {
+            chosen_[by_distance[q].second] = 1;
+            group.push_back(by_distance[q].second);
+        }
+        return group;
     }
 
     /// The group's centroid, unwrapped around its first member.
@@ -198,25 +240,77 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
         return result;
     }
     result.repair = plan.repair;
-    result.n_short_intervals = plan.n_short_intervals;
     const double rho = std::pow(d_large / d_small, 3);
     result.volume_ratio = rho;
     const bool observed_is_small = sizes.observed_diameter <= sizes.other_diameter;
     const std::uint8_t small_colour = observed_is_small ? kLight : kHeavy;
+    result.n_short_intervals = observed_is_small ? plan.n_short_intervals : 0;
     const double m_small = observed_is_small ? sizes.observed_mass : sizes.other_mass;
     const double m_large = observed_is_small ? sizes.other_mass : sizes.observed_mass;
     const double r_large = d_large / 2, r_small = d_small / 2;
 
     Exchanger exchanger(plan, positions, colours, small_colour, sizes, rng);
-    std::size_t dropped = 0;
-    for (const Exchange& e : plan_exchanges(plan, observed_is_small, rho)) {
-        const std::vector<std::size_t> picked = exchanger.pick(e);
-        if (picked.size() < 2) {
-            ++dropped;
-            continue;
+    std::size_t dropped = 0, far = 0;
+    std::vector<Move> moves;
+    if (observed_is_small) {
+        for (const Exchange& e : plan_exchanges(plan, rho)) {
+            const std::vector<std::size_t> picked = exchanger.pick(e);
+            if (picked.size() < 2) {
+                ++dropped;
+                continue;
+            }
+            Move mv{picked[0], {picked.begin() + 1, picked.end()}, {}};
+            mv.destination = exchanger.centroid(mv.group);
+            moves.push_back(std::move(mv));
         }
-        const std::size_t large = picked[0];
-        const std::span<const std::size_t> group(picked.begin() + 1, picked.end());
+    } else {
+        // Step 2b: rank by rank. The observed particles sorted by height; those outside their
+        // rank's window leave, lowest first, for the free ranks, lowest first.
+        std::vector<std::size_t> observed;
+        double z_low = r_large, z_high = heights[0];
+        for (std::size_t j = 0; j < heights.size(); ++j) {
+            z_high = std::max(z_high, heights[j]);
+            if (colours[j] != kLight) continue;
+            observed.push_back(j);
+            z_low = std::min(z_low, heights[j]);
+        }
+        std::sort(observed.begin(), observed.end(),
+                  [&](std::size_t a, std::size_t b) { return heights[a] < heights[b]; });
+        std::vector<double> sorted(observed.size());
+        for (std::size_t q = 0; q < observed.size(); ++q) sorted[q] = heights[observed[q]];
+        const RankWindows windows =
+            rank_windows(plan.target, grid, static_cast<Count>(observed.size()), sizes.resolution,
+                         z_low, z_high);
+        const std::vector<Count> kept = ranks_kept(sorted, windows);
+        std::vector<std::uint8_t> taken(observed.size(), 0);
+        std::vector<std::size_t> leaving;
+        for (std::size_t q = 0; q < observed.size(); ++q) {
+            if (kept[q] < 0)
+                leaving.push_back(observed[q]);
+            else
+                taken[static_cast<std::size_t>(kept[q])] = 1;
+        }
+        std::vector<std::size_t> free_ranks;
+        for (std::size_t k = 0; k < taken.size(); ++k)
+            if (!taken[k]) free_ranks.push_back(k);
+        EFDEM_ASSERT(free_ranks.size() == leaving.size());
+        for (std::size_t t = 0; t < leaving.size(); ++t) {
+            const double z = windows.desired[free_ranks[t]];
+            bool widened = false;
+            Move mv{leaving[t], exchanger.group_at_height(z, group_size(rho, t), widened), {}};
+            far += widened;
+            if (mv.group.empty()) {
+                ++dropped;
+                continue;
+            }
+            const Vec3 c = exchanger.centroid(mv.group);
+            mv.destination = {c.x, c.y, z};
+            moves.push_back(std::move(mv));
+        }
+    }
+    for (const Move& mv : moves) {
+        const std::size_t large = mv.large;
+        const std::span<const std::size_t> group(mv.group);
         const Vec3 c = exchanger.centroid(group);
         double rms = 0;
         Vec3 mean_v{};
@@ -234,11 +328,11 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
             result.velocities[j] = velocities[large] + (velocities[j] - mean_v);
             result.moved[j] = 1;
         }
-        result.positions[large] = c;
+        result.positions[large] = mv.destination;
         result.velocities[large] = mean_v;
         result.moved[large] = 1;
         ++result.n_exchanges;
-        result.n_moved += picked.size();
+        result.n_moved += 1 + group.size();
     }
     // Masses matched: the large particle carries the group's momentum; otherwise (other
     // densities or group sizes off the ratio) a change is left and reported.
@@ -267,7 +361,7 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
     for (std::size_t j = 0; j < positions.size(); ++j) heights[j] = result.positions[j].z;
     result.achieved_icdf = observed_icdf(heights, colours, grid);
     result.max_deviation = (result.achieved_icdf - result.target).cwiseAbs().maxCoeff();
-    const bool short_counts = plan.below != plan.wanted;
+    const bool short_counts = observed_is_small && plan.below != plan.wanted;
     result.status = result.repair.changed() || short_counts || dropped > 0 ? LiftStatus::adjusted
                                                                            : LiftStatus::ok;
     result.message = result.repair.message;
@@ -276,7 +370,13 @@ PositionLiftResult lift_positions(const Eigen::VectorXd& target_icdf,
     };
     if (short_counts) add(plan.shortage("observed", ""));
     if (dropped > 0)
-        add(fmt::format("{} exchange(s) found no large particle left to move", dropped));
+        add(fmt::format("{} exchange(s) found no {} particle left to move", dropped,
+                        observed_is_small ? "large" : "small"));
+    if (far > 0)
+        add(
+            fmt::format("{} exchange(s) took small particles from beyond the interval of the "
+                        "large one's new height",
+                        far));
     EFDEM_ENSURES(result.n_moved == static_cast<std::size_t>(
                                         std::count(result.moved.begin(), result.moved.end(), 1)));
     return result;

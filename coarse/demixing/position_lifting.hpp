@@ -30,6 +30,9 @@ struct TwoSizes {
     double other_mass = 1.0;         ///< [rho_s d_p^3]
     double lx = 1.0;                 ///< periodic lengths of the box [d_p]
     double ly = 1.0;
+    /// The large species observed: how far [d_p] an observed particle may lie from its rank's
+    /// height and stay where it is (step 2b); every node then ends within it of the target.
+    double resolution = 0.1;
 };
 
 struct PositionLiftResult {

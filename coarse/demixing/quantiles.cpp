@@ -10,24 +10,6 @@ namespace efdem::coarse {
 
 namespace {
 
-/// Where node i falls in a sorted sample of n points: Q(p_i) = (1 - fraction) z[lower] +
-/// fraction z[lower + 1] (0-based), with fraction = 0 when the node sits on a point or beyond
-/// the end points.
-struct NodeRank {
-    std::int64_t lower = 0;
-    double fraction = 0.0;
-};
-
-NodeRank node_rank(const ProbabilityGrid& grid, int i, std::int64_t n) {
-    // r = (2 (i+1) n - (m+1)) / (2 (m+1)), exact in 64-bit integers for any realistic n.
-    const std::int64_t num = 2 * grid.numerator(i) * n - grid.denominator();
-    const std::int64_t den = 2 * grid.denominator();
-    if (num <= 0) return {0, 0.0};
-    const std::int64_t lower = num / den;
-    if (lower >= n - 1) return {n - 1, 0.0};
-    return {lower, static_cast<double>(num % den) / static_cast<double>(den)};
-}
-
 /// Q(p_i) from a sequence in which at least the order statistics node_rank() names are in
 /// their sorted places (a sorted vector, or one prepared by select_order_statistics()).
 Eigen::VectorXd evaluate_nodes(std::span<const double> z, const ProbabilityGrid& grid) {
@@ -53,6 +35,17 @@ void select_order_statistics(std::vector<double>& v, std::span<const std::int64_
 }
 
 }  // namespace
+
+NodeRank node_rank(const ProbabilityGrid& grid, int i, std::int64_t n) {
+    EFDEM_EXPECTS(n >= 1);
+    // r = (2 (i+1) n - (m+1)) / (2 (m+1)), exact in 64-bit integers for any realistic n.
+    const std::int64_t num = 2 * grid.numerator(i) * n - grid.denominator();
+    const std::int64_t den = 2 * grid.denominator();
+    if (num <= 0) return {0, 0.0};
+    const std::int64_t lower = num / den;
+    if (lower >= n - 1) return {n - 1, 0.0};
+    return {lower, static_cast<double>(num % den) / static_cast<double>(den)};
+}
 
 Eigen::VectorXd quantiles_from_order_statistics(
     std::int64_t n, const ProbabilityGrid& grid,

@@ -17,6 +17,15 @@
 
 namespace efdem::coarse {
 
+/// Where node i falls in a sorted sample of n points: Q(p_i) = (1 - fraction) z[lower] +
+/// fraction z[lower + 1] (0-based), with fraction = 0 when the node sits on a point or beyond
+/// the end points. \pre n >= 1.
+struct NodeRank {
+    std::int64_t lower = 0;
+    double fraction = 0.0;
+};
+NodeRank node_rank(const ProbabilityGrid& grid, int i, std::int64_t n);
+
 /// Q(p) of heights already sorted ascending. \pre sorted non-empty, ascending, finite; 0 <= p <= 1.
 double quantile_sorted(std::span<const double> sorted, double p);
 

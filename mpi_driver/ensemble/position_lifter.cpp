@@ -31,12 +31,15 @@ std::vector<Vec3> unpack_vectors(const std::vector<double>& reals, std::size_t f
 
 PositionLifter::PositionLifter(dem::SpeciesTable species, dem::SpeciesId observed,
                                dem::SpeciesId other, dem::Domain domain,
-                               dem::OverlapRelaxationSettings relaxation)
+                               dem::OverlapRelaxationSettings relaxation, double resolution)
     : species_(std::move(species)),
       observed_(observed),
       other_(other),
       domain_(domain),
-      relaxation_(relaxation) {}
+      relaxation_(relaxation),
+      resolution_(resolution) {
+    EFDEM_EXPECTS(resolution > 0);
+}
 
 LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayload& input,
                                  const coarse::ProbabilityGrid& grid, RandomStream& rng) const {
@@ -49,7 +52,8 @@ LiftOutcome PositionLifter::lift(const Eigen::VectorXd& target, const LiftPayloa
                                  species_.mass(observed_),
                                  species_.mass(other_),
                                  domain_.lx,
-                                 domain_.ly};
+                                 domain_.ly,
+                                 resolution_};
     const coarse::PositionLiftResult r =
         coarse::lift_positions(target, x, v, input.bytes, sizes, grid, rng);
 

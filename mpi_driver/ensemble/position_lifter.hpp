@@ -27,9 +27,12 @@ std::vector<Vec3> unpack_vectors(const std::vector<double>& reals, std::size_t f
 class PositionLifter final : public Lifter {
   public:
     /// The species table and box of the realizations (the same in every one); `observed`,
-    /// `other`: the species whose ICDF is the coarse variable, and the other.
+    /// `other`: the species whose ICDF is the coarse variable, and the other. When the observed
+    /// species is the larger, `resolution` [d_p] is how far each observed particle may lie from
+    /// its rank's height after the exchange (coarse::TwoSizes::resolution).
     PositionLifter(dem::SpeciesTable species, dem::SpeciesId observed, dem::SpeciesId other,
-                   dem::Domain domain, dem::OverlapRelaxationSettings relaxation = {});
+                   dem::Domain domain, dem::OverlapRelaxationSettings relaxation = {},
+                   double resolution = 0.1);
     /// input: DemRealization::lift_input with lift_by_positions (x, v; colours). Output: new
     /// x, v (reals) and one moved flag per particle (bytes); changed = particles moved;
     /// max_deviation after the relaxation; the message says what the exchange and the
@@ -43,6 +46,7 @@ class PositionLifter final : public Lifter {
     dem::SpeciesId observed_, other_;
     dem::Domain domain_;
     dem::OverlapRelaxationSettings relaxation_;
+    double resolution_;
 };
 
 }  // namespace efdem::mpi_driver

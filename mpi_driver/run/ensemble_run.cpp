@@ -149,7 +149,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     dem::OverlapRelaxationSettings relaxation;
     relaxation.height_band = s.lift_height_band;
     const PositionLifter position_lifter(species, s.observe.species, s.observe.other, box,
-                                         relaxation);
+                                         relaxation, s.lift_resolution);
     const Lifter& lifter =
         by_positions ? static_cast<const Lifter&>(position_lifter) : colour_lifter;
     // A steady solve goes back in time (kept states): its progress is per iterate (steady_driver).

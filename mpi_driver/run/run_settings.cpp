@@ -100,9 +100,14 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         cpi.get_or_choice("lift_by", "colours", {"colours", "positions"}) == "positions";
     // How far the relaxation after an exchange may move a height (docs/lifting_by_positions.md):
     // the lift's accuracy against the relaxations that can finish in a packed region.
-    if (s.lift_by_positions)
+    if (s.lift_by_positions) {
         s.lift_height_band =
             cpi.get_or<double>("lift_height_band", 0.25, Bounds::open_closed(0.0, 2.0));
+        // The large species observed: how far each of its particles may end from its rank's
+        // height after the exchange (docs/lifting_by_positions.md "Rank by rank").
+        s.lift_resolution =
+            cpi.get_or<double>("lift_resolution", 0.1, Bounds::open_closed(0.0, 1.0));
+    }
     if (s.lift_by_positions && s.relabel_moving)
         cpi.fail("relabel",
                  "= moving chooses which labels a colour lift switches, and cpi.lift_by = "

@@ -114,6 +114,9 @@ struct RunSettings {
     bool lift_by_positions = false;
     /// cpi.lift_height_band [d_p]: how far the relaxation after an exchange may move a height.
     double lift_height_band = 0.25;
+    /// cpi.lift_resolution [d_p]: the large species observed, how far an observed particle may
+    /// lie from its rank's height after the exchange.
+    double lift_resolution = 0.1;
     /// ensemble.at_rest = pause (default): a realization at rest is not advanced, only its clock
     /// (direct and cpi runs); simulate: it is advanced like the others.
     bool pause_at_rest = true;
