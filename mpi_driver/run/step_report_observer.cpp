@@ -25,9 +25,10 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
         s += fmt::format(", slope s.e. max {:.3g}", r.max_slope_standard_error());
     if (const coarse::ControllerRecord& c = r.controller; c.adaptive && r.lifted)
         s += fmt::format(
-            ", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}), DT "
-            "set by {}",
+            ", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}{}), "
+            "DT set by {}",
             c.error(), c.error() / c.tolerance, c.statistical, c.truncation,
+            c.lift > 0 ? fmt::format(", lift {:.3g}", c.lift) : std::string(),
             coarse::to_string(c.limited_by));
     else if (c.active && r.lifted)
         s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})",

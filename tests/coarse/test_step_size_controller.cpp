@@ -242,6 +242,14 @@ TEST_CASE("judge: accept within the tolerance, reject above it, and the redo rul
         c.direct_burst_done();
         CHECK(std::isinf(c.state().dt_cap));
     }
+    SECTION("the lift's own error counts: within the tolerance alone, above it with the lift") {
+        // 0.03 statistical is within 0.05; with a lift that left X 0.03 away it is 0.06.
+        CHECK(c.judge(20.0, {0.03, 0.0, 0.0}, model(0.0)).accepted);
+        const JumpVerdict v = c.judge(20.0, {0.03, 0.0, 0.03}, model(0.0));
+        CHECK(!v.accepted);
+        CHECK_THAT(v.message, Catch::Contains("error 0.06 = 1.20 x tolerance (statistical 0.03, "
+                                              "truncation 0, lift 0.03)"));
+    }
     SECTION("a forced rejection halves DT") {
         const JumpVerdict v = c.judge(40.0, {0.01, 0.0}, model(0.0), true);
         CHECK(!v.accepted);

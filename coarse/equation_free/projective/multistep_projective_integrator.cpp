@@ -418,6 +418,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     } else
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
+    if (std::isfinite(stepper.lift_error())) c.lift = stepper.lift_error();
     std::string why = stepper.lift_failure();
     if (why.empty() && settings_.adaptive && stepper.lift_error() > c.tolerance)
         // The lift alone spent more than the jump may: whatever the burst after it measured,
@@ -484,7 +485,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     const JumpErrorModel posterior = basis.model(t_end_, curvature);
     const JumpVerdict verdict =
-        controller_.judge(rec.dt, {c.statistical, c.truncation}, posterior, forced_reject);
+        controller_.judge(rec.dt, {c.statistical, c.truncation, c.lift}, posterior, forced_reject);
     if (verdict.accepted) {
         if (settings_.adaptive) stepper.confirm_kept_state();
         if (!verdict.message.empty()) append_message(rec, verdict.message);
@@ -496,7 +497,9 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
             pool_.commit(pool_.estimate(1), rec.dt);
         }
         if (budget_ && budget_->ready()) {
-            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation);
+            // The lift's error is charged as a bias, like the truncation part: it need not
+            // average out over the jumps (a relaxation that moves heights one way).
+            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation + c.lift);
             c.budget_spent = budget_->spent(t_end_ + rec.dt);
         }
         accept_burst(m, c);

@@ -100,7 +100,10 @@ struct ControllerRecord {
     double dt_tolerance = nan, dt_tolerance_2r = nan, dt_tolerance_4r = nan;
     /// What set DT (the run file and the log hold its text: to_string(DtLimit)).
     DtLimit limited_by = DtLimit::none;
-    double error() const { return statistical + truncation; }
+    /// The lift's own error in X (CoarseStepper::lift_error(), RMS; 0 when it reached X),
+    /// judged with the other two.
+    double lift = 0.0;
+    double error() const { return statistical + truncation + lift; }
 };
 
 /// Everything one outer step did, for output, diagnosis and tests. Times in sqrt(d_p/g).

@@ -251,9 +251,10 @@ JumpVerdict StepSizeController::judge(double dt, const JumpError& error,
     ++state_.consecutive_rejections;
     v.message = fmt::format(
         "step rejected{}: error {:.3g} = {:.2f} x tolerance (statistical {:.3g}, "
-        "truncation {:.3g}); back to t = {:.6g}, next DT <= {:.4g}",
+        "truncation {:.3g}{}); back to t = {:.6g}, next DT <= {:.4g}",
         forced_reject ? " (forced)" : "", e, e / s.tolerance, error.statistical, error.truncation,
-        posterior.t0, state_.dt_cap);
+        error.lift > 0 ? fmt::format(", lift {:.3g}", error.lift) : std::string(), posterior.t0,
+        state_.dt_cap);
     return v;
 }
 

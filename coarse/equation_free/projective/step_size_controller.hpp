@@ -49,7 +49,11 @@ struct JumpErrorModel {
 struct JumpError {
     double statistical = 0.0;  ///< RMS of sqrt(sum_k W_k^2 se_k^2 (+ 2 W c, pooled))
     double truncation = 0.0;   ///< |D| |integral omega|
-    double total() const { return statistical + truncation; }
+    /// How far the lift left the micro model's mean from the projected X (RMS): the burst after
+    /// the jump measures curvature from where the lift put the state, so this part is not in
+    /// the other two.
+    double lift = 0.0;
+    double total() const { return statistical + truncation + lift; }
 };
 
 /// Per component, the statistical part of a jump of `dt` under `model` (before se_scale):
