@@ -90,6 +90,20 @@ TEST_CASE("plan: DT from the tolerance, capped by dt_max; what more realizations
     CHECK(r.dt == Approx(std::sqrt(800.0)).epsilon(kBisection));
 }
 
+TEST_CASE("plan: the tolerance the last lift spent is reserved, at most half of it",
+          "[unit][coarse][controller]") {
+    StepSizeController c(setup());
+    PlanInput in = input(model(1e-3));  // se 1e-3: DT = target / se
+    in.lift_reserve = 0.01;             // target 0.04 - 0.01 = 0.03
+    CHECK(c.plan(in).dt == Approx(30.0).epsilon(kBisection));
+    in.lift_reserve = 0.5;  // more than the tolerance: only half the target is reserved
+    CHECK(c.plan(in).dt == Approx(20.0).epsilon(kBisection));
+    // The redo after a rejection plans for the rejected jump's own lift error: the curvature
+    // 8e-4 after it allows sqrt(2 x (0.04 - 0.02) / 8e-4) = sqrt(50) with a lift error of 0.02.
+    REQUIRE_FALSE(c.judge(40.0, {0.04, 0.0, 0.02}, model(0.0, 8e-4)).accepted);
+    CHECK(c.state().dt_cap == Approx(std::sqrt(50.0)).epsilon(kBisection));
+}
+
 TEST_CASE("plan: the first jump is capped by cpi.dt, or by one burst without a curvature",
           "[unit][coarse][controller]") {
     // No curvature measured yet (NaN): at most max(dt_min, burst) = 20.

@@ -322,7 +322,8 @@ double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec,
                                        .hold = hold_kind_,
                                        .hold_message = hold_,
                                        .end_time = end_time(),
-                                       .jump_end = jump_end()});
+                                       .jump_end = jump_end(),
+                                       .lift_reserve = lift_reserve_});
     ControllerRecord& c = rec.controller;
     c.limited_by = p.limited_by;
     c.dt_tolerance = p.dt_tolerance;
@@ -419,6 +420,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
     if (std::isfinite(stepper.lift_error())) c.lift = stepper.lift_error();
+    lift_reserve_ = c.lift;  // what the next jump plans for
     std::string why = stepper.lift_failure();
     if (why.empty() && settings_.adaptive && stepper.lift_error() > c.tolerance)
         // The lift alone spent more than the jump may: whatever the burst after it measured,
@@ -587,6 +589,7 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.totals = totals_;
     s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
     s.healing = healing_;
+    s.lift_reserve = lift_reserve_;
     s.member_deviation = member_deviation_;
     if (budget_) s.budget = budget_->state();
     if (settings_.window_auto) {
@@ -602,6 +605,7 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     curvature_only_front_ = false;
     pool_.restore({});
     healing_ = settings_.burst.healing;
+    lift_reserve_ = 0.0;
     window_ = settings_.burst.window;
     fast_time2_ = std::numeric_limits<double>::quiet_NaN();
     noise_measurements_ = 0;
@@ -631,6 +635,8 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     pool_.restore({s.pool.begin() + static_cast<std::ptrdiff_t>(skip), s.pool.end()});
     // Checkpoints before cpi.healing_auto have no healing: the configured one.
     healing_ = std::isnan(s.healing) ? settings_.burst.healing : s.healing;
+    // Checkpoints before the lift reserve: none (the next lift measures it).
+    lift_reserve_ = std::isnan(s.lift_reserve) ? 0.0 : s.lift_reserve;
     // Checkpoints of runs without cpi.window_auto (or before it) have no window: the configured.
     if (settings_.window_auto && !std::isnan(s.window)) {
         window_ = s.window;

@@ -50,6 +50,9 @@ struct MultistepState {
     /// The healing of the next burst (cpi.healing_auto changes it); NaN in checkpoints written
     /// before it: the configured cpi.healing.
     double healing = std::numeric_limits<double>::quiet_NaN();
+    /// The last lift's error in X, which the next jump plans for (PlanInput::lift_reserve);
+    /// NaN in checkpoints written before it: none.
+    double lift_reserve = std::numeric_limits<double>::quiet_NaN();
     /// cpi.window_auto: the window of the next burst, the running fast-noise constant and the
     /// bursts it was measured on (window_noise.hpp); NaN / 0 in checkpoints of runs without it
     /// (or written before it).

@@ -15,6 +15,13 @@
 
 namespace efdem::coarse {
 
+namespace {
+/// The part of safety x tolerance left for the lift: its expected error, at most half.
+double reserved(const StepSizeSettings& s, double lift) {
+    return std::min(std::max(lift, 0.0), 0.5 * s.safety * s.tolerance);
+}
+}  // namespace
+
 Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt) {
     EFDEM_EXPECTS(dt >= 0.0 && !model.nodes.empty());
     const std::vector<double> w = projection_weights(model.nodes, model.t0, dt);
@@ -136,7 +143,7 @@ DtPlan StepSizeController::plan(const PlanInput& in) const {
         return p;
     }
     JumpErrorModel model = in.model;
-    const double target = s.safety * s.tolerance;
+    const double target = s.safety * s.tolerance - reserved(s, in.lift_reserve);
     p.dt_tolerance = largest_dt_within(model, target, s.dt_max);
     model.se_scale = 1.0 / std::sqrt(2.0);
     p.dt_tolerance_2r = largest_dt_within(model, target, s.dt_max);
@@ -244,7 +251,8 @@ JumpVerdict StepSizeController::judge(double dt, const JumpError& error,
     // Rejected: the next step jumps less far, planned with the curvature the burst after the
     // jump showed. A redo that this curvature would not allow even at dt_min is not tried: the
     // next step runs one burst directly (cap 0) instead of a jump known to exceed the tolerance.
-    const double redo = largest_dt_within(posterior, s.safety * s.tolerance, dt);
+    const double redo =
+        largest_dt_within(posterior, s.safety * s.tolerance - reserved(s, error.lift), dt);
     state_.dt_cap = forced_reject     ? 0.5 * dt
                     : redo < s.dt_min ? 0.0
                                       : std::max(s.dt_min, std::min(redo, 0.5 * dt));

@@ -137,6 +137,10 @@ struct PlanInput {
     /// cpi.jump_until: no jump ends later than this; from it on every step is a burst of
     /// direct simulation (infinite: no such time).
     double jump_end = std::numeric_limits<double>::infinity();
+    /// The part of the tolerance the lift is expected to spend (the last lift's error in X,
+    /// JumpError::lift), planned for so that the jump is not rejected for it; at most half of
+    /// safety x tolerance is reserved, so a jump can always be planned.
+    double lift_reserve = 0.0;
 };
 
 /// What plan() decided.
