@@ -224,7 +224,7 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     double healing_;  ///< the healing of the next burst (cpi.healing_auto: from the evidence)
     /// The last lift's error in X: the part of the next jump's tolerance planned for the lift.
     double lift_reserve_ = 0.0;
-    double window_;   ///< cpi.window_auto: the window of the next burst
+    double window_;  ///< cpi.window_auto: the window of the next burst
     /// cpi.window_auto: running mean of the bursts' fast-noise constant c (window_noise.hpp)
     /// over the last window_evidence measurements, and how many there were.
     double fast_time2_ = std::numeric_limits<double>::quiet_NaN();

@@ -44,8 +44,8 @@ bool MultistepState::operator==(const MultistepState& o) const {
            t.direct == u.direct && t.dt_taken == u.dt_taken && t.dt_tolerance == u.dt_tolerance &&
            t.dt_tolerance_2r == u.dt_tolerance_2r && t.dt_tolerance_4r == u.dt_tolerance_4r &&
            t.statistical == u.statistical && t.truncation == u.truncation &&
-           same_or_nan(healing, o.healing) && same_or_nan(lift_reserve, o.lift_reserve) && same_or_nan(window, o.window) &&
-           same_or_nan(window_fast_time2, o.window_fast_time2) &&
+           same_or_nan(healing, o.healing) && same_or_nan(lift_reserve, o.lift_reserve) &&
+           same_or_nan(window, o.window) && same_or_nan(window_fast_time2, o.window_fast_time2) &&
            window_measurements == o.window_measurements &&
            same(member_deviation, o.member_deviation) &&
            same_or_nan(budget.variance, o.budget.variance) &&
