@@ -70,20 +70,27 @@ struct PositionLiftResult {
  *
  * 1. plan_lift: the repaired target, the intervals between its nodes and the observed count
  *    each must gain or lose (as colour lifting).
- * 2. The observed particles that must move are listed by interval, lowest first, for the
- *    intervals that lose them and those that gain them. With v_L/v_S = rho >= 1 the volume ratio
- *    of the large species to the small, each exchange trades one large particle against a group
- *    of about rho small ones: if the observed species is the small one, its M moves are cut
- *    into T = round(M / rho) consecutive groups (sizes differing by at most one), each group
- *    exchanged against a large particle of the interval its moves go to (the T picked evenly
- *    along the receiving list); if it is the large one, each of its moves is one exchange, with a
- *    group of round(rho (t + 1)) - round(rho t) small particles from the interval it goes to.
- *    Lowest with lowest: the monotone matching, as colour lifting's switches are.
+ * 2. With v_L/v_S = rho >= 1 the volume ratio of the large species to the small, each exchange
+ *    trades one large particle against a group of about rho small ones.
+ *    a. The small species observed: the observed particles that must move are listed by
+ *       interval, lowest first, for the intervals that lose them and those that gain them; the
+ *       M moves are cut into T = round(M / rho) consecutive groups (sizes differing by at most
+ *       one), each group exchanged against a large particle of the interval its moves go to
+ *       (the T picked evenly along the receiving list). Lowest with lowest: the monotone
+ *       matching, as colour lifting's switches are.
+ *    b. The large species observed, rank by rank (rank_windows.hpp): the observed particles
+ *       that lie in their rank's window (sizes.resolution) stay; the others, lowest first, go to
+ *       the free ranks' heights, lowest first, each against a group of
+ *       round(rho (t + 1)) - round(rho t) small particles from the interval of that height.
+ *       Every node then ends within sizes.resolution of the target (however few the observed
+ *       particles: counts alone leave a node anywhere between its neighbours' heights).
  * 3. A group is compact: a random seed among its interval's candidates, then the nearest others
  *    (periodic in x, y) in the intervals of its moves (wider by one interval each side while too
- *    few). The large particle goes to the group's centroid; the group goes to the large
- *    particle's place, its offsets from the centroid scaled so that their RMS is that of points
- *    filling the large particle's sphere (sqrt(3/5) (R_L - r_S)), never enlarged. Velocities:
+ *    few; in 2b nearest to the point at the seed's x, y and the new height). The large particle
+ *    goes to the group's centroid (2b: the centroid's x, y at its rank's height); the group goes
+ *    to the large particle's place, its offsets from the centroid scaled so that their RMS is
+ *    that of points filling the large particle's sphere (sqrt(3/5) (R_L - r_S)), never
+ *    enlarged. Velocities:
  *    the large particle takes the group's mean velocity, each of the group the large
  *    particle's plus its own deviation from that mean: momentum and kinetic energy are exact
  *    when the group's mass equals the large particle's (otherwise the change is reported).
@@ -93,9 +100,10 @@ struct PositionLiftResult {
  *
  * The exchange leaves overlaps of up to R_L - r_S where a group was squeezed into a large
  * particle's place and where a large one took a group's: dem::relax_overlaps removes them.
- * Accuracy: the observed count below each node is off by at most about rho/2 from the plan's
- * (the rounding of the groups), and each moved particle lies within R_L of where the plan puts
- * it; measured in tests/coarse/test_position_lifting.cpp.
+ * Accuracy: small observed, the count below each node is off by at most about rho/2 from the
+ * plan's (the rounding of the groups) and each moved particle lies within R_L of where the plan
+ * puts it; large observed, every node within sizes.resolution of the target (unless a group
+ * found no small particle left); measured in tests/coarse/test_position_lifting.cpp.
  *
  * \pre positions, velocities, colours of one size; colours in {kHeavy, kLight};
  *      target_icdf.size() == grid.size(); the two diameters > 0 with a ratio of at most 4.
