@@ -72,6 +72,10 @@ CASES = {
         # its own offset) and missed X by 0.23-1.6 d_p: members move each by the increment only.
         "positions_members_tol0.3_band0.5": {**POSITIONS, "cpi.tolerance": 0.3, "cpi.lift": "members",
                                              "cpi.lift_height_band": 0.5},
+        # The slope pooled over the last bursts (docs/error_control.md): at the floor the jumps'
+        # statistical error is what limits DT.
+        "positions_pooled_tol0.3_band0.5": {**POSITIONS, "cpi.tolerance": 0.3, "cpi.slope": "pooled",
+                                            "cpi.lift_height_band": 0.5},
     }, {"observe.species": "large"}),
 }
 KEPT = ("simulated_time", "dem_time", "particle_steps", "wall_seconds", "lift_seconds", "end_status")
