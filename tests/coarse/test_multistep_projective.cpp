@@ -431,6 +431,27 @@ TEST_CASE("a lift that falls short of its target by more than the tolerance is a
     CHECK(integrator.totals().rejected == rejected + failed);
 }
 
+TEST_CASE("cpi.lift_error = ignored: the lift's error is neither judged nor planned for",
+          "[unit][coarse][multistep]") {
+    // The same short-reach lift: with the lift's error ignored, jumps that it leaves short of X
+    // are kept on their own error (what runs did before cpi.lift_error), and the record carries
+    // no lift part.
+    ShortReachLift stepper = slow_decay(0.2, ShortReachLift::Beyond::fall_short);
+    MultistepSettings s = short_bursts(0.5);
+    s.first_dt = 40.0;
+    s.count_lift_error = false;
+    MultistepProjectiveIntegrator integrator(s);
+    const auto records = run_to(integrator, stepper, 60.0);
+    long kept_short = 0;
+    for (const auto& r : records) {
+        if (r.status != StepStatus::projected) continue;
+        CHECK(r.controller.lift == 0.0);
+        kept_short += rms(r.x_projected - r.x_end) > 0.2 + 1e-9;
+    }
+    CHECK(kept_short >= 1);
+    CHECK(integrator.save_state().value().lift_reserve == 0.0);
+}
+
 TEST_CASE(
     "a lift that always fails ends in direct bursts, also where the end of the run would "
     "stretch the redo",

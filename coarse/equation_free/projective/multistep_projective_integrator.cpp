@@ -419,10 +419,13 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     } else
         stepper.lift(x, t_end_ + rec.dt);
     rec.lifted = true;
-    if (std::isfinite(stepper.lift_error())) c.lift = stepper.lift_error();
-    lift_reserve_ = c.lift;  // what the next jump plans for
+    const double lift_error = std::isfinite(stepper.lift_error()) ? stepper.lift_error() : 0.0;
+    if (settings_.count_lift_error) {
+        c.lift = lift_error;
+        lift_reserve_ = lift_error;  // what the next jump plans for
+    }
     std::string why = stepper.lift_failure();
-    if (why.empty() && settings_.adaptive && stepper.lift_error() > c.tolerance)
+    if (why.empty() && settings_.adaptive && lift_error > c.tolerance)
         // The lift alone spent more than the jump may: whatever the burst after it measured,
         // the jump's error would exceed the tolerance (too few particles of a class where the
         // target puts them, docs/error_control.md "A lift that misses its target").

@@ -94,6 +94,10 @@ struct MultistepSettings {
     /// as truncation error only when it is resolved above its own noise (mean_significance.hpp);
     /// true ("counted", what runs before it did): its debiased norm always counts.
     bool count_noisy_curvature = false;
+    /// cpi.lift_error = counted (default): a kept jump's error includes the lift's own error in X
+    /// (CoarseStepper::lift_error()), and the next DT plans for the last one (lift reserve);
+    /// ignored: neither (a lift still fails when its error alone exceeds the tolerance).
+    bool count_lift_error = true;
     /// cpi.lift = own: every jump lifts the members apart (CoarseStepper::lift_apart), member r
     /// moved by DT times its own slope's deviation from the ensemble slope (from the last
     /// accepted burst's window) on top of the common increment: a member that has stopped
