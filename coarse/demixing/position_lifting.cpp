@@ -89,21 +89,18 @@ class Exchanger {
         if (large == kNone) return {};
         std::vector<std::size_t> out{large};
         const bool quotas = small_colour_ == kLight;
-        std::size_t lo = e.small_lo, hi = e.small_hi;
-        for (;;) {
-            std::vector<std::size_t> candidates;
-            for (std::size_t k = lo; k <= hi; ++k)
-                for (std::size_t j : by_interval_[k])
-                    if (!chosen_[j] && colours_[j] == small_colour_ && (!quotas || quota_[k] > 0))
-                        candidates.push_back(j);
-            if (static_cast<Count>(candidates.size()) >= e.group ||
-                (lo == 0 && hi + 1 == quota_.size())) {
-                take_nearest(candidates, e, quotas, out);
-                return out;
-            }
-            lo = lo > 0 ? lo - 1 : lo;
-            hi = hi + 1 < quota_.size() ? hi + 1 : hi;
-        }
+        bool widened = false;
+        const std::vector<std::size_t> near =
+            candidates(e.small_lo, e.small_hi, e.group, quotas, widened);
+        if (near.empty()) return out;
+        // A random seed among the candidates of the group's lowest interval (any candidate if
+        // that one has none).
+        std::vector<std::size_t> in_lowest;
+        for (std::size_t j : near)
+            if (plan_.interval[j] == e.small_lo) in_lowest.push_back(j);
+        const std::vector<std::size_t>& seeds = in_lowest.empty() ? near : in_lowest;
+        take_nearest(near, x_[seeds[rng_.below(seeds.size())]], e.group, quotas, out);
+        return out;
     }
 
     /**
@@ -115,31 +112,11 @@ class Exchanger {
     std::vector<std::size_t> group_at_height(double z, Count count, bool& far) {
         const std::size_t k =
             cuts_at_or_below(std::span<const double>(plan_.target.data(), plan_.target.size()), z);
-        far = false;
-        std::vector<std::size_t> near;
-        for (std::size_t lo = k, hi = k;; far = true) {
-            near.clear();
-            for (std::size_t q = lo; q <= hi; ++q)
-                for (std::size_t j : by_interval_[q])
-                    if (!chosen_[j] && colours_[j] == small_colour_) near.push_back(j);
-            if (static_cast<Count>(near.size()) >= count || (lo == 0 && hi + 1 == quota_.size()))
-                break;
-            lo = lo > 0 ? lo - 1 : lo;
-            hi = hi + 1 < quota_.size() ? hi + 1 : hi;
-        }
-        if (near.empty()) return {};
-        const Vec3 seed = x_[near[rng_.below(near.size())]];
-        const Vec3 centre{seed.x, seed.y, z};
-        std::vector<std::pair<double, std::size_t>> by_distance;
-        for (std::size_t j : near) by_distance.emplace_back(norm2(separation(x_[j], centre)), j);
-        const auto take = std::min<std::size_t>(static_cast<std::size_t>(count), near.size());
-        std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<long>(take),
-                          by_distance.end());
+        const std::vector<std::size_t> near = candidates(k, k, count, false, far);
         std::vector<std::size_t> group;
-        for (std::size_t q = 0; q < take; ++q) {
-            chosen_[by_distance[q].second] = 1;
-            group.push_back(by_distance[q].second);
-        }
+        if (near.empty()) return group;
+        const Vec3 seed = x_[near[rng_.below(near.size())]];
+        take_nearest(near, {seed.x, seed.y, z}, count, false, group);
         return group;
     }
 
@@ -176,24 +153,37 @@ class Exchanger {
         return kNone;
     }
 
-    /// The group: a random seed among the candidates of the group's lowest interval (any
-    /// candidate if that one has none), then the nearest others, taking each interval's quota.
-    void take_nearest(std::vector<std::size_t>& candidates, const Exchange& e, bool quotas,
-                      std::vector<std::size_t>& out) {
-        if (candidates.empty()) return;
-        std::vector<std::size_t> in_lowest;
-        for (std::size_t j : candidates)
-            if (plan_.interval[j] == e.small_lo) in_lowest.push_back(j);
-        const std::vector<std::size_t>& seeds = in_lowest.empty() ? candidates : in_lowest;
-        const Vec3 seed = x_[seeds[rng_.below(seeds.size())]];
+    /// The unchosen small particles of intervals lo..hi (with `quotas`, of intervals whose quota
+    /// is not spent), the range widened by one interval each side while fewer than `count`
+    /// (then `widened` is set) until it spans every interval.
+    std::vector<std::size_t> candidates(std::size_t lo, std::size_t hi, Count count, bool quotas,
+                                        bool& widened) const {
+        widened = false;
+        for (;; widened = true) {
+            std::vector<std::size_t> out;
+            for (std::size_t k = lo; k <= hi; ++k)
+                for (std::size_t j : by_interval_[k])
+                    if (!chosen_[j] && colours_[j] == small_colour_ && (!quotas || quota_[k] > 0))
+                        out.push_back(j);
+            if (static_cast<Count>(out.size()) >= count || (lo == 0 && hi + 1 == quota_.size()))
+                return out;
+            lo = lo > 0 ? lo - 1 : lo;
+            hi = hi + 1 < quota_.size() ? hi + 1 : hi;
+        }
+    }
+
+    /// Up to `count` of `candidates`, nearest to `centre` first (periodic in x, y), taking each
+    /// interval's quota with `quotas`; marked chosen and appended to `out`.
+    void take_nearest(const std::vector<std::size_t>& candidates, const Vec3& centre, Count count,
+                      bool quotas, std::vector<std::size_t>& out) {
         std::vector<std::pair<double, std::size_t>> by_distance;
         by_distance.reserve(candidates.size());
         for (std::size_t j : candidates)
-            by_distance.emplace_back(norm2(separation(x_[j], seed)), j);
+            by_distance.emplace_back(norm2(separation(x_[j], centre)), j);
         std::sort(by_distance.begin(), by_distance.end());
         Count taken = 0;
         for (const auto& [d2, j] : by_distance) {
-            if (taken == e.group) break;
+            if (taken == count) break;
             const std::size_t k = plan_.interval[j];
             if (quotas && quota_[k] == 0) continue;
             if (quotas) --quota_[k];
