@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "coarse/equation_free/projective/step_size_controller.hpp"  // error_parts
 #include "core/log.hpp"
 
 namespace efdem::mpi_driver {
@@ -24,15 +25,13 @@ std::string describe_step(long n, const coarse::ProjectiveStepRecord& r, const L
     if (r.slope_standard_error.size() > 0)
         s += fmt::format(", slope s.e. max {:.3g}", r.max_slope_standard_error());
     if (const coarse::ControllerRecord& c = r.controller; c.adaptive && r.lifted)
-        s += fmt::format(
-            ", error {:.3g} d_p = {:.2f} of tolerance (statistical {:.3g}, truncation {:.3g}{}), "
-            "DT set by {}",
-            c.error(), c.error() / c.tolerance, c.statistical, c.truncation,
-            c.lift > 0 ? fmt::format(", lift {:.3g}", c.lift) : std::string(),
-            coarse::to_string(c.limited_by));
+        s += fmt::format(", error {:.3g} d_p = {:.2f} of tolerance ({}), DT set by {}", c.error(),
+                         c.error() / c.tolerance,
+                         coarse::error_parts(c.statistical, c.truncation, c.lift),
+                         coarse::to_string(c.limited_by));
     else if (c.active && r.lifted)
-        s += fmt::format(", error estimate {:.3g} d_p (statistical {:.3g}, truncation {:.3g})",
-                         c.error(), c.statistical, c.truncation);
+        s += fmt::format(", error estimate {:.3g} d_p ({})", c.error(),
+                         coarse::error_parts(c.statistical, c.truncation, c.lift));
     if (const coarse::ControllerRecord& c = r.controller;
         c.active && r.lifted && c.slope_source == coarse::SlopeSource::pooled)
         s += fmt::format(

@@ -31,6 +31,11 @@ Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt) {
     return charged_error(model.nodes.front().se, model.committed, w[0]);
 }
 
+std::string error_parts(double statistical, double truncation, double lift) {
+    return fmt::format("statistical {:.3g}, truncation {:.3g}{}", statistical, truncation,
+                       lift > 0 ? fmt::format(", lift {:.3g}", lift) : std::string());
+}
+
 JumpError jump_error(const JumpErrorModel& model, double dt) {
     JumpError e;
     e.statistical = model.se_scale * rms(statistical_error(model, dt));
@@ -258,11 +263,10 @@ JumpVerdict StepSizeController::judge(double dt, const JumpError& error,
                                       : std::max(s.dt_min, std::min(redo, 0.5 * dt));
     ++state_.consecutive_rejections;
     v.message = fmt::format(
-        "step rejected{}: error {:.3g} = {:.2f} x tolerance (statistical {:.3g}, "
-        "truncation {:.3g}{}); back to t = {:.6g}, next DT <= {:.4g}",
-        forced_reject ? " (forced)" : "", e, e / s.tolerance, error.statistical, error.truncation,
-        error.lift > 0 ? fmt::format(", lift {:.3g}", error.lift) : std::string(), posterior.t0,
-        state_.dt_cap);
+        "step rejected{}: error {:.3g} = {:.2f} x tolerance ({}); back to t = {:.6g}, next DT <= "
+        "{:.4g}",
+        forced_reject ? " (forced)" : "", e, e / s.tolerance,
+        error_parts(error.statistical, error.truncation, error.lift), posterior.t0, state_.dt_cap);
     return v;
 }
 

@@ -56,6 +56,10 @@ struct JumpError {
     double total() const { return statistical + truncation + lift; }
 };
 
+/// "statistical s, truncation t[, lift l]" (the lift only when > 0): the parts of a jump's error
+/// as the rejection message and the step report write them.
+std::string error_parts(double statistical, double truncation, double lift);
+
 /// Per component, the statistical part of a jump of `dt` under `model` (before se_scale):
 /// sqrt(sum_k W_k^2 se_k^2), or for a pooled slope the charged sqrt(DT^2 se^2 + 2 DT c).
 /// \pre dt >= 0, model.nodes non-empty.
