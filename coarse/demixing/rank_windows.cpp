@@ -16,10 +16,12 @@ RankWindows rank_windows(const Eigen::VectorXd& target, const ProbabilityGrid& g
     const int m = grid.size();
     // Fractional rank of each node and the target's slope per rank there (central; one-sided
     // at the ends; zero with one node).
+    std::vector<NodeRank> nodes(static_cast<std::size_t>(m));
     std::vector<double> r(static_cast<std::size_t>(m));
     for (int i = 0; i < m; ++i) {
-        const NodeRank nr = node_rank(grid, i, n);
-        r[static_cast<std::size_t>(i)] = static_cast<double>(nr.lower) + nr.fraction;
+        const auto ui = static_cast<std::size_t>(i);
+        nodes[ui] = node_rank(grid, i, n);
+        r[ui] = static_cast<double>(nodes[ui].lower) + nodes[ui].fraction;
     }
     auto slope = [&](int i) {
         const int a = std::max(i - 1, 0), b = std::min(i + 1, m - 1);
@@ -50,7 +52,7 @@ RankWindows rank_windows(const Eigen::VectorXd& target, const ProbabilityGrid& g
     }
     // The defining ranks about their node: (1 - f) d_lower + f d_lower+1 = target_i exactly.
     for (int i = 0; i < m; ++i) {
-        const NodeRank nr = node_rank(grid, i, n);
+        const NodeRank& nr = nodes[static_cast<std::size_t>(i)];
         const auto lo = static_cast<std::size_t>(nr.lower);
         const double g = slope(i);
         w.desired[lo] = target[i] - nr.fraction * g;
