@@ -47,6 +47,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.lift_height_band", "0.25"},   // positions: the relaxation's band (issue 37)
     {"cpi.lift_resolution", "0.1"},     // positions, large observed: rank windows (issue 37)
     {"cpi.lift_error", "ignored"},      // counted: in the jump's error (issue 37)
+    {"cpi.relabel_nodes", "random"},    // matched: node-aware colour lift (issue 34)
 };
 // clang-format on
 

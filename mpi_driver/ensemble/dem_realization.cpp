@@ -215,9 +215,9 @@ LiftOutcome ColourLifter::lift(const Eigen::VectorXd& target, const LiftPayload&
     const std::span<const std::uint8_t> bytes(input.bytes);
     const std::size_t n = input.reals.size();
     EFDEM_EXPECTS(bytes.size() == 2 * n);
-    coarse::LiftResult r =
-        coarse::lift_colours(target, input.reals, bytes.first(n), grid, rng,
-                             prefer_moving_ ? bytes.subspan(n) : std::span<const std::uint8_t>{});
+    coarse::LiftResult r = coarse::lift_colours(
+        target, input.reals, bytes.first(n), grid, rng,
+        prefer_moving_ ? bytes.subspan(n) : std::span<const std::uint8_t>{}, relabel_);
     LiftOutcome out;
     out.changed = static_cast<long>(r.n_changed);
     out.max_deviation = r.max_deviation;

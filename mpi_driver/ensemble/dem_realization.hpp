@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "coarse/demixing/colour_lifting.hpp"
 #include "dem/beds/bed_observation.hpp"
 #include "dem/io/thermo_log.hpp"
 #include "dem/io/vtk_writer.hpp"
@@ -109,15 +110,19 @@ class DemRealization final : public Realization {
 
 /// Minimal-change recolouring (physics.md §9) of one realization: payload in = heights (reals)
 /// and colours then moving flags (bytes, DemRealization::lift_input), payload out = colours.
-/// `prefer_moving` (cpi.relabel = moving): each interval relabels its moving particles first.
+/// `prefer_moving` (cpi.relabel = moving): each interval relabels its moving particles first;
+/// `relabel` (cpi.relabel_nodes): which particles switch (coarse::Relabel).
 class ColourLifter final : public Lifter {
   public:
-    explicit ColourLifter(bool prefer_moving = false) : prefer_moving_(prefer_moving) {}
+    explicit ColourLifter(bool prefer_moving = false,
+                          coarse::Relabel relabel = coarse::Relabel::at_nodes)
+        : prefer_moving_(prefer_moving), relabel_(relabel) {}
     LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
                      const coarse::ProbabilityGrid& grid, RandomStream& rng) const override;
 
   private:
     bool prefer_moving_;
+    coarse::Relabel relabel_;
 };
 
 }  // namespace efdem::mpi_driver

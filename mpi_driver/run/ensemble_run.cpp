@@ -145,7 +145,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     const double t0 =
         resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
-    const ColourLifter colour_lifter(s.relabel_moving && s.is_cpi());
+    const ColourLifter colour_lifter(s.relabel_moving && s.is_cpi(), s.relabel_at_nodes
+                                                                         ? coarse::Relabel::at_nodes
+                                                                         : coarse::Relabel::random);
     dem::OverlapRelaxationSettings relaxation;
     relaxation.height_band = s.lift_height_band;
     const PositionLifter position_lifter(species, s.observe.species, s.observe.other, box,

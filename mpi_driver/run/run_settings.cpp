@@ -94,6 +94,12 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // Where a bed has partly come to rest, a relabelling there kicks it back into motion
     // (bench/lift_restart.py): moving relabels the moving particles of each height interval first.
     s.relabel_moving = cpi.get_or_choice("relabel", "any", {"any", "moving"}) == "moving";
+    // A node of the ICDF is the mean of two particles' heights: which particles of an interval
+    // end as its lowest and highest light ones decides how far the lift misses it (the lift's
+    // error is charged to the jump, docs/error_control.md §6). matched picks them; random is
+    // the paper's minimal relabelling.
+    s.relabel_at_nodes =
+        cpi.get_or_choice("relabel_nodes", "matched", {"matched", "random"}) == "matched";
     // positions: a bed of two sizes is lifted by exchanging particles between heights
     // (docs/lifting_by_positions.md); colours switch labels in place (equal sizes only).
     s.lift_by_positions =

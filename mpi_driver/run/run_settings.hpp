@@ -109,6 +109,10 @@ struct RunSettings {
     /// cpi.relabel = moving: the colour lift relabels each height interval's moving particles
     /// first (ColourLifter); any (default): every candidate alike.
     bool relabel_moving = false;
+    /// cpi.relabel_nodes = matched (default): the colour lift pins each ICDF node's defining
+    /// ranks on the particles that meet it best (coarse::Relabel::at_nodes); random: every
+    /// switch drawn at random (the fewest switches, the paper's lift).
+    bool relabel_at_nodes = true;
     /// cpi.lift_by = positions: lifts exchange particles between heights (PositionLifter), for
     /// beds whose species differ in size; colours (false) switch labels in place.
     bool lift_by_positions = false;

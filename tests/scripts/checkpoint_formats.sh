@@ -58,13 +58,14 @@ EOF
   done
 }
 
-# cpi.noisy_curvature = counted, cpi.at_rest = lift, cpi.lift_error = ignored: what the stored
-# checkpoints' runs did (the rejection in them came from a curvature within its noise; they
-# lifted every realization; the lift's error in X was not part of a jump's).
+# cpi.noisy_curvature = counted, cpi.at_rest = lift, cpi.lift_error = ignored,
+# cpi.relabel_nodes = random: what the stored checkpoints' runs did (the rejection in them came
+# from a curvature within its noise; they lifted every realization; the lift's error in X was not
+# part of a jump's; the colour lift drew every switch at random).
 adaptive=(mode=cpi cpi.projection=adaptive cpi.integrator=adams_bashforth2 cpi.tolerance=0.06
           cpi.dt_min=0.5 run.duration=24 cpi.noisy_curvature=counted cpi.at_rest=lift
-          cpi.lift_error=ignored)
-fixed=(mode=cpi cpi.at_rest=lift)
+          cpi.lift_error=ignored cpi.relabel_nodes=random)
+fixed=(mode=cpi cpi.at_rest=lift cpi.relabel_nodes=random)
 run 2 "$work/adaptive-ref.log" "$@" "$efdem" "$scene" "${adaptive[@]}" ensemble.realizations_per_rank=2 \
   output.directory="$work" output.prefix=adaptive-ref checkpoint.interval=2 checkpoint.keep=10
 run 2 "$work/fixed-ref.log" "$@" "$efdem" "$scene" "${fixed[@]}" ensemble.realizations_per_rank=2 \
