@@ -86,7 +86,7 @@ struct LiftResult {
  *    light ones, and a node whose count was shifted by a short interval is pinned next to its
  *    cut; a target equal to the current ICDF still changes no label (its current pair is exact).
  *    Measured on the demo bed's first jump (4 realizations of 1,000 spheres): RMS lift error
- *    of the ensemble mean 0.067 -> 0.033 d_p, 56 -> 105 labels switched per realization.
+ *    of the ensemble mean 0.067 -> 0.033 d_p, 48-72 -> 98-108 labels switched per realization.
  * 5. achieved_icdf = Q_L of the new labels. With feasible counts, each achieved node lies
  *    between the highest light particle below z*_i and the lowest at or above it: the
  *    target is met to within the local spacing of the light particle heights, which is the
