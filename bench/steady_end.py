@@ -42,7 +42,7 @@ The runs of section 2 (demo bed at U_s = 0.41, R = 4 on 2 ranks; run files not i
     mpirun -n 2 build/mpi_driver/efdem $H cpi.observable=ranks seed=515 output.prefix=ranks_300_s2
     mpirun -n 2 build/mpi_driver/efdem $H output.prefix=icdf_300          # the ICDF, lift mean
 
-Writes bench/results/steady_end.md.
+Writes bench/results/steady_end.md, or the file --out names (a study beside the committed one).
 """
 import argparse
 import math
@@ -289,13 +289,18 @@ def main():
     p.add_argument("--after", type=float, default=200.0, help="time from which the direct run is steady")
     p.add_argument("--last", type=float, default=100.0, help="span of a CPI run without a steady end")
     p.add_argument("--hand-off", nargs="*", default=[], help="cpi runs made with cpi.hand_off = steady")
+    p.add_argument("--out", default=os.path.join(RESULTS, "steady_end.md"),
+                   help="where the Markdown goes (default bench/results/steady_end.md)")
     args = p.parse_args()
     lines = ["# The fluidized end state of cpi.finish = steady\n",
              "Made by `/usr/bin/python3 bench/steady_end.py"
              + (f" --cpi {' '.join(os.path.relpath(c) for c in args.cpi)}" if args.cpi else "")
              + (f" --hand-off {' '.join(os.path.relpath(c) for c in args.hand_off)}" if args.hand_off else "")
              + (f" --reference {os.path.relpath(args.reference)} --after {args.after:g}"
-                if args.cpi or args.hand_off else "") + "`.\n",
+                if args.cpi or args.hand_off else "")
+             + (f" --out {os.path.relpath(args.out)}"
+                if os.path.abspath(args.out) != os.path.join(RESULTS, "steady_end.md") else "")
+             + "`.\n",
              "## 1. The drift test on direct ensembles\n",
              f"Bursts emulated as {WINDOW:g}-unit windows every {EVERY:g} units; pool of {POOL}; t:z at the "
              f"last window's end; steady at z <= {Z_STEADY:g} at {CONFIRM} checks in a row.\n",
@@ -318,7 +323,7 @@ def main():
         lines += ["### When each run reached the direct time average\n"] + arrivals(args, args.hand_off) + [""]
     text = "\n".join(lines) + "\n"
     print(text)
-    with open(os.path.join(RESULTS, "steady_end.md"), "w") as f:
+    with open(args.out, "w") as f:
         f.write(text)
 
 
