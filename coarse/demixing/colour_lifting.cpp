@@ -25,22 +25,24 @@ void switch_random(std::vector<std::size_t>& candidates, Count count,
 }
 
 /**
- * Relabels positions [first, last) of an interval's sorted particles so that exactly `wanted`
- * of them are light, switching the fewest: the excess colour's particles drawn at random,
- * the `moving` ones first when flags are given.
+ * Relabels positions [first, last) of one interval's particles (`members`: sorted by height, or
+ * in index order) so that exactly `wanted` of them are light, switching the fewest: the excess
+ * colour's particles drawn at random (partial Fisher-Yates in the order of `members`, so
+ * deterministic for a stream state), the `moving` ones first when flags are given. Returns the
+ * labels switched.
  */
-void relabel_run(std::span<const std::size_t> sorted, std::size_t first, std::size_t last,
-                 Count wanted, std::span<const std::uint8_t> colours,
-                 std::span<const std::uint8_t> moving, std::vector<std::uint8_t>& out,
-                 RandomStream& rng) {
+Count relabel_run(std::span<const std::size_t> members, std::size_t first, std::size_t last,
+                  Count wanted, std::span<const std::uint8_t> colours,
+                  std::span<const std::uint8_t> moving, std::vector<std::uint8_t>& out,
+                  RandomStream& rng) {
     Count light = 0;
-    for (std::size_t p = first; p < last; ++p) light += colours[sorted[p]] == kLight ? 1 : 0;
+    for (std::size_t p = first; p < last; ++p) light += colours[members[p]] == kLight ? 1 : 0;
     const Count excess = light - wanted;
     EFDEM_ASSERT(wanted >= 0 && wanted <= static_cast<Count>(last - first));
-    if (excess == 0) return;
+    if (excess == 0) return 0;
     std::vector<std::size_t> first_drawn, rest;
     for (std::size_t p = first; p < last; ++p) {
-        const std::size_t j = sorted[p];
+        const std::size_t j = members[p];
         if ((colours[j] == kLight) == (excess > 0))
             (moving.empty() || moving[j] ? first_drawn : rest).push_back(j);
     }
@@ -48,6 +50,7 @@ void relabel_run(std::span<const std::size_t> sorted, std::size_t first, std::si
         std::min<Count>(std::abs(excess), static_cast<Count>(first_drawn.size()));
     switch_random(first_drawn, from_first, out, rng);
     switch_random(rest, std::abs(excess) - from_first, out, rng);
+    return std::abs(excess);
 }
 
 /**
@@ -80,42 +83,17 @@ Eigen::VectorXd achieved_light_icdf(std::span<const double> heights,
 }
 
 /// Relabel::random: each interval switches |gain| particles of the colour it has too many of,
-/// drawn at random (the moving ones first). Returns the labels switched.
-std::size_t switch_at_random(const LiftPlan& plan, std::span<const double> heights,
-                             std::span<const std::uint8_t> colours,
+/// drawn at random among them in index order (the moving ones first). Returns the labels
+/// switched.
+std::size_t switch_at_random(const LiftPlan& plan, std::span<const std::uint8_t> colours,
                              std::span<const std::uint8_t> moving, std::vector<std::uint8_t>& out,
                              RandomStream& rng) {
-    const std::size_t n_intervals = plan.population.size();
-    const std::vector<std::uint32_t>& interval = plan.interval;
-    // The candidates are collected in one sequential pass (index order, so the draw is
-    // deterministic), then drawn without replacement.
-    std::vector<Count> excess(n_intervals);
-    std::vector<std::vector<std::size_t>> candidates(n_intervals);
-    for (std::size_t k = 0; k < n_intervals; ++k) {
-        excess[k] = -plan.gain(k);
-        if (excess[k] != 0)
-            candidates[k].reserve(static_cast<std::size_t>(
-                excess[k] > 0 ? plan.observed_now[k] : plan.population[k] - plan.observed_now[k]));
-    }
-    // With `moving`, an interval's moving candidates are drawn first, the still ones only for
-    // what is left: the same counts, labels changed where the bed moves.
-    std::vector<std::vector<std::size_t>> still(moving.empty() ? 0 : n_intervals);
-    for (std::size_t j = 0; j < heights.size(); ++j) {
-        const Count e = excess[interval[j]];
-        if (e == 0 || (colours[j] == kLight) != (e > 0)) continue;
-        (moving.empty() || moving[j] ? candidates : still)[interval[j]].push_back(j);
-    }
-    std::size_t changed = 0;
-    for (std::size_t k = 0; k < n_intervals; ++k) {
-        if (excess[k] == 0) continue;
-        const Count first =
-            std::min<Count>(std::abs(excess[k]), static_cast<Count>(candidates[k].size()));
-        switch_random(candidates[k], first, out, rng);
-        if (first < std::abs(excess[k]))
-            switch_random(still[k], std::abs(excess[k]) - first, out, rng);
-        changed += static_cast<std::size_t>(std::abs(excess[k]));
-    }
-    return changed;
+    const std::vector<std::vector<std::size_t>> members = particles_by_interval(plan);
+    Count changed = 0;
+    for (std::size_t k = 0; k < members.size(); ++k)
+        changed += relabel_run(members[k], 0, members[k].size(), plan.below[k + 1] - plan.below[k],
+                               colours, moving, out, rng);
+    return static_cast<std::size_t>(changed);
 }
 
 /// Relabel::at_nodes: each node's defining ranks pinned on the particles that meet it best
@@ -128,22 +106,24 @@ std::size_t switch_at_nodes(const LiftPlan& plan, std::span<const double> height
     const IntervalOrder order = order_intervals(plan, heights);
     const std::vector<RankPin> pins = pin_node_ranks(plan, order, heights, colours, grid, moving);
     auto pin = pins.begin();
+    Count changed = 0;
     for (std::size_t k = 0; k < order.size(); ++k) {
         std::size_t start = 0;
         Count placed = 0;  // observed particles of interval k below position `start`
         for (; pin != pins.end() && pin->interval == k; ++pin) {
-            relabel_run(order[k], start, pin->position, pin->offset - placed, colours, moving, out,
-                        rng);
-            out[order[k][pin->position]] = kLight;
+            changed += relabel_run(order[k], start, pin->position, pin->offset - placed, colours,
+                                   moving, out, rng);
+            const std::size_t j = order[k][pin->position];
+            changed += colours[j] == kLight ? 0 : 1;
+            out[j] = kLight;
             placed = pin->offset + 1;
             start = pin->position + 1;
         }
-        relabel_run(order[k], start, order[k].size(), plan.below[k + 1] - plan.below[k] - placed,
-                    colours, moving, out, rng);
+        changed +=
+            relabel_run(order[k], start, order[k].size(),
+                        plan.below[k + 1] - plan.below[k] - placed, colours, moving, out, rng);
     }
-    std::size_t changed = 0;
-    for (std::size_t j = 0; j < colours.size(); ++j) changed += out[j] != colours[j] ? 1 : 0;
-    return changed;
+    return static_cast<std::size_t>(changed);
 }
 
 }  // namespace
@@ -172,7 +152,7 @@ LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const doub
     result.n_changed =
         relabel == Relabel::at_nodes
             ? switch_at_nodes(plan, heights, colours, grid, moving, result.colours, rng)
-            : switch_at_random(plan, heights, colours, moving, result.colours, rng);
+            : switch_at_random(plan, colours, moving, result.colours, rng);
 
     result.achieved_icdf =
         achieved_light_icdf(heights, result.colours, plan.interval, plan.below, grid);

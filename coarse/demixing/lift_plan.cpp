@@ -59,6 +59,15 @@ std::uint32_t cuts_at_or_below(std::span<const double> cuts, double z) {
     return static_cast<std::uint32_t>(base - cuts.data()) + (*base <= z ? 1u : 0u);
 }
 
+std::vector<std::vector<std::size_t>> particles_by_interval(const LiftPlan& plan) {
+    EFDEM_EXPECTS(plan.error.empty());
+    std::vector<std::vector<std::size_t>> out(plan.population.size());
+    for (std::size_t k = 0; k < out.size(); ++k)
+        out[k].reserve(static_cast<std::size_t>(plan.population[k]));
+    for (std::size_t j = 0; j < plan.interval.size(); ++j) out[plan.interval[j]].push_back(j);
+    return out;
+}
+
 Eigen::VectorXd observed_icdf(std::span<const double> heights,
                               std::span<const std::uint8_t> colours, const ProbabilityGrid& grid) {
     EFDEM_EXPECTS(heights.size() == colours.size());

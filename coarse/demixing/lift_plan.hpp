@@ -70,6 +70,10 @@ struct LiftPlan {
 LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                    std::span<const std::uint8_t> colours, const ProbabilityGrid& grid);
 
+/// The particles of each of the plan's m + 1 intervals, in index order: one sequential pass.
+/// \pre plan without error.
+std::vector<std::vector<std::size_t>> particles_by_interval(const LiftPlan& plan);
+
 /// Q of the heights of the particles labelled kLight, on the grid [d_p].
 /// \pre heights.size() == colours.size(); at least one kLight.
 Eigen::VectorXd observed_icdf(std::span<const double> heights,

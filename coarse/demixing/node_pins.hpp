@@ -19,7 +19,7 @@ namespace efdem::coarse {
 /// The particles of each of the plan's m + 1 intervals, ascending in height (ties by index).
 using IntervalOrder = std::vector<std::vector<std::size_t>>;
 
-/// `plan.interval` sorted into buckets: O(N log(N / m)).
+/// particles_by_interval(plan), each interval sorted by height: O(N log(N / m)).
 IntervalOrder order_intervals(const LiftPlan& plan, std::span<const double> heights);
 
 /// A rank of the observed species fixed on one particle: the particle is (made) observed and

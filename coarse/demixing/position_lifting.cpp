@@ -74,9 +74,8 @@ class Exchanger {
           sizes_(sizes),
           rng_(rng),
           chosen_(x.size(), 0),
-          by_interval_(plan.population.size()),
+          by_interval_(particles_by_interval(plan)),
           quota_(plan.population.size(), 0) {
-        for (std::size_t j = 0; j < x.size(); ++j) by_interval_[plan.interval[j]].push_back(j);
         if (small_colour == kLight)  // the small ones are observed: each interval sends its loss
             for (std::size_t k = 0; k < quota_.size(); ++k)
                 quota_[k] = std::max<Count>(0, -plan.gain(k));
