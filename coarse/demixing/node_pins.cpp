@@ -128,6 +128,10 @@ class Pinner {
         } best;
         std::optional<Room> room_v;
         if (upper >= 0) room_v = room(upper);
+        // In another interval the upper rank's candidates do not depend on u: found once.
+        const bool same_interval = room_v && room_v->interval == room_u.interval;
+        const std::vector<Count> vs_apart =
+            room_v && !same_interval ? candidates(*room_v, target, filtered) : std::vector<Count>{};
         auto consider = [&](Count u, Count v, double node) {
             const double error = std::abs(node - target);
             const int switches = (u_fixed || observed(room_u.interval, u) ? 0 : 1) +
@@ -142,20 +146,21 @@ class Pinner {
                 consider(u, -1, zu);
                 continue;
             }
-            Room rv = *room_v;
-            if (rv.interval == room_u.interval) rv.low = std::max(rv.low, u + 1);
-            if (rv.low > rv.high) continue;
-            std::vector<Count> vs = candidates(rv, target, filtered);
-            if (rv.interval == room_u.interval && allowed(rv.interval, u + 1, filtered))
-                vs.push_back(u + 1);  // the tightest pair is always within the room
-            for (const Count v : vs) consider(u, v, zu + fraction * (height(rv.interval, v) - zu));
+            std::vector<Count> vs = vs_apart;
+            if (same_interval) {
+                Room rv = *room_v;
+                rv.low = std::max(rv.low, u + 1);
+                if (rv.low > rv.high) continue;
+                vs = candidates(rv, target, filtered);
+                if (allowed(rv.interval, u + 1, filtered))
+                    vs.push_back(u + 1);  // the tightest pair is always within the room
+            }
+            for (const Count v : vs)
+                consider(u, v, zu + fraction * (height(room_v->interval, v) - zu));
         }
         if (best.u < 0) return false;
         if (!u_fixed) add_pin(room_u, best.u);
-        if (room_v) {
-            Room rv = *room_v;
-            add_pin(rv, best.v);
-        }
+        if (room_v) add_pin(*room_v, best.v);
         return true;
     }
 
@@ -181,10 +186,7 @@ class Pinner {
 
 IntervalOrder order_intervals(const LiftPlan& plan, std::span<const double> heights) {
     EFDEM_EXPECTS(plan.interval.size() == heights.size());
-    IntervalOrder order(plan.population.size());
-    for (std::size_t k = 0; k < order.size(); ++k)
-        order[k].reserve(static_cast<std::size_t>(plan.population[k]));
-    for (std::size_t j = 0; j < heights.size(); ++j) order[plan.interval[j]].push_back(j);
+    IntervalOrder order = particles_by_interval(plan);
     for (auto& bucket : order)
         std::sort(bucket.begin(), bucket.end(), [&](std::size_t a, std::size_t b) {
             return heights[a] < heights[b] || (heights[a] == heights[b] && a < b);
