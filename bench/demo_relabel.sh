@@ -10,9 +10,9 @@
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$src/build}
-shift || true
-seeds=("${@:-2 3 4}")
-read -r -a seeds <<< "${seeds[*]}"
+[ $# -gt 0 ] && shift
+[ $# -gt 0 ] || set -- 2 3 4
+seeds=("$@")
 out=$src/runs/demo_relabel
 mkdir -p "$out"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
