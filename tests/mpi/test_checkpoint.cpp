@@ -153,13 +153,30 @@ TEST_CASE("a restart may change run length, output and layout keys, not physics"
         check_restart("c.h5", h, h.parameters + "cpi.noisy_curvature = ignored\n", 4, false),
         Catch::Contains("cpi.noisy_curvature = ignored (not in the checkpoint, whose run did "
                         "cpi.noisy_curvature = counted)"));
-    // cpi.at_rest acts only in a cpi run: a direct run continues from a checkpoint written
-    // before the key whatever its value; a cpi run only at the old behaviour (lift).
+    // The cpi block acts only in a cpi (or steady) run: a direct run continues from a checkpoint
+    // written before a cpi key whatever its value (cpi.relabel_nodes = matched is not what such
+    // checkpoints did), and with any cpi value changed; a cpi run only at the old behaviour.
     CheckpointHeader direct = h, cpi = h;
-    direct.parameters += "mode = direct\n";
+    direct.parameters += "mode = direct\ncpi.tolerance = 0.16\n";
     cpi.parameters += "mode = cpi\n";
     CHECK(check_restart("c.h5", direct, direct.parameters + "cpi.at_rest = hold\n", 4, false)
               .empty());
+    CHECK(check_restart("c.h5", direct,
+                        h.parameters + "mode = direct\ncpi.tolerance = 0.32\n"
+                                       "cpi.relabel_nodes = matched\n",
+                        4, false)
+              .empty());
+    CHECK(check_restart("c.h5", direct, h.parameters + "mode = direct\n", 4, false).empty());
+    CHECK_THROWS_WITH(
+        check_restart("c.h5", cpi, cpi.parameters + "cpi.relabel_nodes = matched\n", 4, false),
+        Catch::Contains("cpi.relabel_nodes = matched (not in the checkpoint, whose run did "
+                        "cpi.relabel_nodes = random)"));
+    // Physics stays physics in a direct run.
+    CHECK_THROWS_WITH(check_restart("c.h5", direct,
+                                    "dt = 1e-4\npair_contact.kn = 3e5\nrun.duration = 6\n"
+                                    "mode = direct\ncpi.tolerance = 0.16\n",
+                                    4, false),
+                      Catch::Contains("pair_contact.kn = 3e5 (checkpoint: 2e5)"));
     CHECK(check_restart("c.h5", cpi, cpi.parameters + "cpi.at_rest = lift\n", 4, false).empty());
     // A restart continues a run in its own mode, whatever restart.allow_physics_change says (a
     // direct checkpoint continued as cpi ended in an HDF5 error creating /cpi).
