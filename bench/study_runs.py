@@ -1,7 +1,10 @@
 """What the resumable studies in bench/ share: one efdem run per folder, skipped when its run file
 says "completed"; an incomplete one continues from its newest checkpoint (every run writes them:
 a direct run every 100 samples, a CPI run after every coarse step; a restart is bit for bit the
-uninterrupted run, mpi:restart_equality), or starts again when it has none or efdem refuses it.
+uninterrupted run, mpi:restart_equality), or starts again when it has none. When efdem refuses
+the checkpoint (another version, other keys) the study stops there and changes nothing: hours
+of a run are not thrown away for a key a newer efdem added. EFDEM_STUDY_ON_REFUSAL=restart
+moves the refused attempt aside (NAME.refused-<time>/) and starts the run again.
 
 Settled beds are reused: the first run of a bed (scene, ranks and the keys that shape the bed:
 seed, species, box, contacts, bed.*) keeps its settled beds (bed.write) in FOLDER/beds/<key>/,
@@ -81,6 +84,17 @@ def bed_overrides(np_, scene, folder, overrides):
     return {"bed.write": name, "output.overwrite": "true"}
 
 
+def refusal(log):
+    """The error line efdem wrote to LOG when it refused a checkpoint (the last one), or a pointer
+    to the log."""
+    try:
+        with open(log, errors="replace") as f:
+            errors = [line.strip() for line in f if "error" in line.lower()]
+        return errors[-1] if errors else f"see {log}"
+    except OSError:
+        return f"see {log}"
+
+
 def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None, beds=True):
     """mpirun -np NP efdem SCENE mode=MODE output.* KEY=VALUE... into FOLDER/NAME/ (command.txt,
     NAME.log, NAME.h5), continued from the newest checkpoint of an earlier attempt when there is
@@ -105,12 +119,22 @@ def run_case(efdem, np_, scene, folder, name, mode, overrides, label=None, beds=
         with open(os.path.join(d, name + ".log"), "a") as log:
             code = subprocess.call(cmd + [f"restart={checkpoint}"], stdout=log, stderr=subprocess.STDOUT,
                                    env=env)
-        if code == 2:  # efdem refused the checkpoint (another version, other keys): start again
-            print(f"  {label}: the checkpoint was refused (see {name}.log): started again", flush=True)
+        if code == 2:  # efdem refused the checkpoint (another version, other keys)
+            reason = refusal(os.path.join(d, name + ".log"))
+            if os.environ.get("EFDEM_STUDY_ON_REFUSAL", "stop") != "restart":
+                print(f"  {label}: efdem refused {os.path.basename(checkpoint)}: {reason}\n"
+                      f"  {label}: nothing was changed in {d}; fix the cause and run again to "
+                      f"continue, or run with EFDEM_STUDY_ON_REFUSAL=restart to keep this attempt "
+                      f"in {name}.refused-<time>/ and start the run again", flush=True)
+                return False
+            aside = f"{d}.refused-{dt_.datetime.now(dt_.timezone.utc):%Y%m%dT%H%M%S}"
+            os.rename(d, aside)
+            print(f"  {label}: efdem refused the checkpoint ({reason}); that attempt is kept in "
+                  f"{aside}; started again", flush=True)
             code = None
     if code is None:
         if os.path.isdir(d):
-            shutil.rmtree(d)  # an incomplete run without a usable checkpoint: start it again
+            shutil.rmtree(d)  # an incomplete run without any checkpoint: start it again
         os.makedirs(d)
         with open(os.path.join(d, "command.txt"), "w") as f:
             f.write(" ".join(cmd) + "\n")

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # The resumable studies of bench/ (bench/study_runs.py run_case): a run that an earlier attempt
 # left incomplete continues from its newest checkpoint, and the result is bit for bit the
-# uninterrupted run's (compare_runs.py); a checkpoint efdem refuses (here: not HDF5) makes the
-# run start again and complete. The incomplete attempt is made by marking a completed run's file
+# uninterrupted run's (compare_runs.py). The incomplete attempt is made by marking a completed run's file
 # 'running' and deleting the checkpoints after the first: what a kill leaves, since a restart
-# takes the output files from the checkpoint.
+# takes the output files from the checkpoint. A checkpoint efdem refuses (here: not HDF5) stops
+# the run and keeps its files; EFDEM_STUDY_ON_REFUSAL=restart keeps them aside and starts again.
 #   study_resume.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 source "$(dirname "$0")/lib.sh" "$@"
 src=$(cd "$here/../.." && pwd)
@@ -46,18 +46,35 @@ if code != 0:
     fail("the continued run differs from the uninterrupted one")
 print("PASS: an incomplete study run continues from its checkpoint, bit for bit the uninterrupted run")
 
-# A checkpoint efdem refuses: the run starts again and completes, equal to the reference too.
+# A checkpoint efdem refuses (another version, other keys): the study stops that run and changes
+# nothing in its folder (hours of a run are not thrown away for a key a newer efdem added); with
+# EFDEM_STUDY_ON_REFUSAL=restart the refused attempt is moved aside, kept whole, and the run starts
+# again and completes, equal to the reference.
 with h5py.File(sr.run_file(work, "d"), "a") as f:
     f.attrs["end_status"] = "running"
 first = sorted(glob.glob(os.path.join(work, "d", "d_ckpt_*.h5")))[-1]
 for c in glob.glob(os.path.join(work, "d", "d_ckpt_*.h5")):
     os.remove(c)
 open(first, "w").write("not a checkpoint\n")
+def snapshot(folder):
+    return {n: open(os.path.join(folder, n), "rb").read() for n in sorted(os.listdir(folder))
+            if n != "d.log"}
+before = snapshot(os.path.join(work, "d"))
+if run():
+    fail("a run whose checkpoint was refused counted as completed")
+if snapshot(os.path.join(work, "d")) != before:
+    fail("a refused checkpoint changed the run's folder (a file removed or rewritten)")
+print("PASS: a refused checkpoint stops the study run and keeps every file of its attempt")
+os.environ["EFDEM_STUDY_ON_REFUSAL"] = "restart"
 if not run():
     fail("the run whose checkpoint was refused did not start again and complete")
+del os.environ["EFDEM_STUDY_ON_REFUSAL"]
+aside = glob.glob(os.path.join(work, "d.refused-*"))
+if len(aside) != 1 or snapshot(aside[0]) != before:
+    fail(f"the refused attempt was not kept whole beside the new one: {aside}")
 if subprocess.call(["/usr/bin/python3", compare, ref, sr.run_file(work, "d")]) != 0:
     fail("the run started again differs from the reference")
-print("PASS: a refused checkpoint makes the study run start again")
+print("PASS: on request the refused attempt is kept aside and the study run starts again")
 
 # Settled beds reused: the first run of the bed kept them (bed.write), and the runs after it start
 # from them: the attempt started again above, and a run of the same bed in another folder (same
