@@ -144,7 +144,9 @@ LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const doub
         return result;
     };
 
-    LiftPlan plan = plan_lift(target_icdf, heights, colours, grid);
+    LiftPlan plan =
+        plan_lift(target_icdf, heights, colours, grid,
+                  relabel == Relabel::at_nodes ? CountPlan::nearest : CountPlan::halves);
     if (!plan.error.empty()) return reject(plan.error);
     result.target = plan.target;
     result.repair = plan.repair;

@@ -26,14 +26,16 @@ enum class LiftStatus {
                ///< heights equal
 };
 
-/// Which particles of a height interval switch label (the counts are the same either way).
+/// Which particles of a height interval switch label, and where a short interval's excess goes.
 enum class Relabel {
     /// Those that define each node of the ICDF are chosen to meet its target (node_pins.hpp);
     /// the rest at random. A few more switches than `random`; the nodes land within the gaps
     /// of all particles, not of the observed ones, and a short interval's excess is placed
-    /// next to the cut rather than anywhere in its neighbour.
+    /// next to the cut rather than anywhere in its neighbour. The counts: the feasible ones
+    /// nearest the target's (CountPlan::nearest), so a segregated bed is not mixed to place it.
     at_nodes,
-    /// All at random: the fewest switches (physics.md §9, the paper's).
+    /// All at random: the fewest switches (physics.md §9, the paper's); the counts by
+    /// CountPlan::halves.
     random,
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -43,6 +44,79 @@ std::vector<Count> feasible_cumulative(const std::vector<Count>& wanted,
         backward[j] = std::clamp(wanted[j], std::max(backward[j + 1] - population[j], lower(j)),
                                  std::min(backward[j + 1], upper(j)));
     for (std::size_t j = 0; j < n_bounds; ++j) result[j] = (forward[j] + backward[j]) / 2;
+    return result;
+}
+
+/**
+ * The feasible counts nearest `wanted`: B minimizing sum_j |B_j - W_j| (the lights placed
+ * across a cut other than the target asks), then sum_j (B_j - W_j)^2 (an excess that can go
+ * either way is split between the neighbours, not always sent one way), over L_j <= B_j <= U_j,
+ * 0 <= B_{j+1} - B_j <= P_j (the bounds of feasible_cumulative). Where a short interval sits in
+ * a run of full ones (a segregated bed: every particle above a cut light), the halves split
+ * sends half the excess down the whole run, each cut off by it; this puts it where one cut
+ * absorbs it (least squares alone would still send one particle down every cut: 18 cuts off by
+ * one cost less than the 19th particle on the one cut). Dynamic programming over the m + 2
+ * cuts: cost_j(b) = c(b - W_j) + min of cost_{j-1} over [b - P_{j-1}, b], the window minimum
+ * by a monotone queue; O(sum of the bounds' ranges) <= O(m N_L) time and memory, run only when
+ * `wanted` is infeasible. Exact integers; ties go to the count nearest W_j, then the lower.
+ */
+std::vector<Count> nearest_feasible_cumulative(const std::vector<Count>& wanted,
+                                               const std::vector<Count>& population) {
+    using Cost = std::pair<Count, Count>;  // (sum |d|, sum d^2), compared lexicographically
+    const auto plus = [](const Cost& c, Count d) {
+        return Cost{c.first + std::abs(d), c.second + d * d};
+    };
+    const std::size_t n_bounds = wanted.size();
+    const Count n_light = wanted.back();
+    std::vector<Count> below(n_bounds, 0);
+    for (std::size_t j = 1; j < n_bounds; ++j) below[j] = below[j - 1] + population[j - 1];
+    const Count total = below.back();
+    std::vector<Count> lo(n_bounds), hi(n_bounds);
+    bool feasible = true;
+    for (std::size_t j = 0; j < n_bounds; ++j) {
+        lo[j] = std::max<Count>(0, n_light - (total - below[j]));
+        hi[j] = std::min<Count>(n_light, below[j]);
+        feasible = feasible && wanted[j] >= lo[j] && wanted[j] <= hi[j] &&
+                   (j == 0 ||
+                    (wanted[j] >= wanted[j - 1] && wanted[j] - wanted[j - 1] <= population[j - 1]));
+    }
+    if (feasible) return wanted;
+    // cost[j][b - lo[j]]; every b in [lo_j, hi_j] has a non-empty window (the bounds nest).
+    std::vector<std::vector<Cost>> cost(n_bounds);
+    cost[0].assign(1, Cost{0, 0});
+    std::vector<Count> queue;  // the window's candidates b', their costs increasing
+    for (std::size_t j = 1; j < n_bounds; ++j) {
+        const auto& prev = cost[j - 1];
+        const auto at = [&](Count b) { return prev[static_cast<std::size_t>(b - lo[j - 1])]; };
+        auto& now = cost[j];
+        now.resize(static_cast<std::size_t>(hi[j] - lo[j] + 1));
+        queue.clear();
+        std::size_t head = 0;
+        Count next = lo[j - 1];  // the next b' to enter the window
+        for (Count b = lo[j]; b <= hi[j]; ++b) {
+            for (; next <= std::min(hi[j - 1], b); ++next) {
+                while (queue.size() > head && at(queue.back()) >= at(next)) queue.pop_back();
+                queue.push_back(next);
+            }
+            while (queue[head] < b - population[j - 1]) ++head;
+            now[static_cast<std::size_t>(b - lo[j])] = plus(at(queue[head]), b - wanted[j]);
+        }
+    }
+    std::vector<Count> result(n_bounds);
+    result[n_bounds - 1] = n_light;
+    for (std::size_t j = n_bounds - 1; j > 0; --j) {
+        const auto at = [&](Count b) {
+            return cost[j - 1][static_cast<std::size_t>(b - lo[j - 1])];
+        };
+        const Count b = result[j];
+        const Count from = std::max(lo[j - 1], b - population[j - 1]), to = std::min(hi[j - 1], b);
+        Count best = from;
+        for (Count c = from + 1; c <= to; ++c)
+            if (at(c) < at(best) ||
+                (at(c) == at(best) && std::abs(c - wanted[j - 1]) < std::abs(best - wanted[j - 1])))
+                best = c;
+        result[j - 1] = best;
+    }
     return result;
 }
 
@@ -93,7 +167,8 @@ std::string LiftPlan::shortage(std::string_view count_name, std::string_view rem
 }
 
 LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
-                   std::span<const std::uint8_t> colours, const ProbabilityGrid& grid) {
+                   std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
+                   CountPlan counts) {
     EFDEM_EXPECTS(heights.size() == colours.size());
     EFDEM_EXPECTS(target_icdf.size() == grid.size());
     EFDEM_EXPECTS(std::all_of(colours.begin(), colours.end(),
@@ -145,7 +220,9 @@ LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> h
         plan.wanted[static_cast<std::size_t>(i) + 1] =
             count_below_quantile(grid, i, plan.n_observed);
     plan.wanted.back() = plan.n_observed;
-    plan.below = feasible_cumulative(plan.wanted, plan.population);
+    plan.below = counts == CountPlan::nearest
+                     ? nearest_feasible_cumulative(plan.wanted, plan.population)
+                     : feasible_cumulative(plan.wanted, plan.population);
     for (std::size_t k = 0; k < n_intervals; ++k)
         if (plan.wanted[k + 1] - plan.wanted[k] > plan.population[k]) ++plan.n_short_intervals;
     return plan;

@@ -24,6 +24,20 @@ namespace efdem::coarse {
 inline constexpr std::uint8_t kHeavy = 0;
 inline constexpr std::uint8_t kLight = 1;
 
+/// How a target whose counts some interval cannot hold (more observed particles asked for than
+/// it has particles) is made feasible: where the excess goes.
+enum class CountPlan {
+    /// A forward pass pushes any excess up, a backward pass down, the floor of their mean splits
+    /// it between the neighbours (the paper's lift; position lifting).
+    halves,
+    /// The feasible counts nearest the wanted ones in least squares over the cuts: the excess goes
+    /// where the fewest cuts move least. In a segregated bed, where every interval above a cut is
+    /// full, `halves` moves half of a short interval's excess down through every full interval
+    /// below it (each node off by it: a lift that mixes the bed); `nearest` puts it into the one
+    /// interval with room. The colour lift's default (Relabel::at_nodes).
+    nearest,
+};
+
 struct LiftPlan {
     /// Non-empty when no lift can be made (non-finite target or heights, no observed particle,
     /// all heights equal); then nothing below is set.
@@ -40,9 +54,8 @@ struct LiftPlan {
     /// Observed count below each cut the target asks for: B_0 = 0, B_i = round(p_{i-1} N_L)
     /// (count_below_quantile), B_{m+1} = N_L (m + 2 entries).
     std::vector<std::int64_t> wanted;
-    /// `wanted` made feasible for the populations (0 <= B_{k+1} - B_k <= population_k): a
-    /// forward pass pushes any excess up, a backward pass down, the floor of their mean splits it
-    /// between the neighbours. Equal to `wanted` when every interval can take its count.
+    /// `wanted` made feasible for the populations (0 <= B_{k+1} - B_k <= population_k), by the
+    /// plan's CountPlan. Equal to `wanted` when every interval can take its count.
     std::vector<std::int64_t> below;
     /// Intervals that held fewer particles than their wanted observed count.
     int n_short_intervals = 0;
@@ -63,12 +76,14 @@ struct LiftPlan {
  *        at `heights` to `target_icdf`.
  *
  * Cost: O(N log m), one sequential pass over the particles: a branch-free binary search among
- * the m cuts per particle (cuts_at_or_below).
+ * the m cuts per particle (cuts_at_or_below); with CountPlan::nearest and a target some
+ * interval cannot hold, O(m N_L) more for the counts.
  * \pre heights.size() == colours.size(); colours in {kHeavy, kLight};
  *      target_icdf.size() == grid.size().
  */
 LiftPlan plan_lift(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
-                   std::span<const std::uint8_t> colours, const ProbabilityGrid& grid);
+                   std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
+                   CountPlan counts = CountPlan::halves);
 
 /// The particles of each of the plan's m + 1 intervals, in index order: one sequential pass.
 /// \pre plan without error.
