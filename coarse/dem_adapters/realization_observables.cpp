@@ -1,6 +1,7 @@
 #include "coarse/dem_adapters/realization_observables.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "coarse/demixing/quantiles.hpp"
 #include "coarse/demixing/whole_bed_profile.hpp"
@@ -44,12 +45,7 @@ Eigen::VectorXd whole_bed_profile(const dem::Particles& p) {
     EFDEM_EXPECTS(p.size() >= 1);
     std::vector<double> z(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) z[i] = p.x()[i].z;
-    std::sort(z.begin(), z.end());
-    Eigen::VectorXd out(kWholeBedNodes);
-    out[0] = z.front();
-    out.segment(1, kWholeBedNodes - 2) = quantiles_sorted(z, whole_bed_interior_grid());
-    out[kWholeBedNodes - 1] = z.back();
-    return out;
+    return profile_of_heights(std::move(z));
 }
 
 double centre_of_mass_height(const dem::Particles& p) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "coarse/demixing/quantiles.hpp"
 #include "core/contracts.hpp"
 
 namespace efdem::coarse {
@@ -18,6 +19,16 @@ namespace {
 
 ProbabilityGrid whole_bed_interior_grid() {
     return ProbabilityGrid(static_cast<int>(kWholeBedNodes) - 2);
+}
+
+Eigen::VectorXd profile_of_heights(std::vector<double> heights) {
+    EFDEM_EXPECTS(!heights.empty());
+    std::sort(heights.begin(), heights.end());
+    Eigen::VectorXd out(kWholeBedNodes);
+    out[0] = heights.front();
+    out.segment(1, kWholeBedNodes - 2) = quantiles_sorted(heights, whole_bed_interior_grid());
+    out[kWholeBedNodes - 1] = heights.back();
+    return out;
 }
 
 Eigen::VectorXd whole_bed_ranks() {

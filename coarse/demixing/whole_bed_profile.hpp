@@ -12,6 +12,8 @@
 /// through it. Every particle height lies in [Q(0), Q(1)], so every height has a rank.
 /// Heights in d_p, ranks dimensionless. Generic: no DEM, no MPI.
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "coarse/demixing/probability_grid.hpp"
@@ -25,6 +27,9 @@ inline constexpr Eigen::Index kWholeBedNodes = 101;
 
 /// The interior nodes' grid (p = 0.01, ..., 0.99).
 ProbabilityGrid whole_bed_interior_grid();
+
+/// The profile of a bed whose particle centres are at `heights` (any order; at least one).
+Eigen::VectorXd profile_of_heights(std::vector<double> heights);
 
 /// The ranks u_k of the profile's entries: 0, 0.01, ..., 0.99, 1.
 Eigen::VectorXd whole_bed_ranks();
