@@ -88,6 +88,10 @@ WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.
          "cpi.observable": "ranks"}
 TALL_WAVES = {
     "ranks_tol": {**WAVES, "cpi.tolerance": 0.64},
+    # ranks_tol again after the colour lift's count plan changed (the nearest feasible counts,
+    # 2026-12-06): ranks_tol's lifts mixed the segregating bed (every node low, the lag of its
+    # middle quarters); same keys, the efdem version is the difference
+    "ranks_tol_counts": {**WAVES, "cpi.tolerance": 0.64},
     "ranks_accuracy": {**WAVES, "cpi.accuracy": 1.5},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own). The R = 4 cases of
