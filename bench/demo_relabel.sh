@@ -7,6 +7,9 @@
 # (an interrupted one is run again from the start, output.overwrite).
 #
 #   bash bench/demo_relabel.sh [build dir] [seed...]     (default: build, seeds 2 3 4)
+#
+# RULES (default "matched random") limits the rules; TAG is appended to each CPI run's name, so a
+# later efdem's runs stand beside an earlier one's (TAG=_counts: after the count plan changed).
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$src/build}
@@ -21,15 +24,17 @@ efdem() { mpirun -np 2 --oversubscribe "$build/mpi_driver/efdem" "$scene" output
   output.overwrite=true "$@" > /dev/null 2>&1; }
 done_run() { grep -qs "^completed" "$out/$1_log.txt"; }
 done_run direct || efdem mode=direct seed=1 output.prefix=direct
+rules=${RULES:-matched random}
+tag=${TAG:-}
 for seed in "${seeds[@]}"; do
-  for relabel in matched random; do
-    name=cpi_${relabel}_s$seed
+  for relabel in $rules; do
+    name=cpi_${relabel}${tag}_s$seed
     done_run "$name" || efdem mode=cpi seed="$seed" cpi.relabel_nodes=$relabel output.prefix="$name"
   done
 done
 for seed in "${seeds[@]}"; do
-  for relabel in matched random; do
-    name=cpi_${relabel}_s$seed
+  for relabel in $rules; do
+    name=cpi_${relabel}${tag}_s$seed
     echo "== $name =="
     /usr/bin/python3 "$src/scripts/demo_summary.py" "$out/direct.h5" "$out/$name.h5" \
       | grep -E "floor of this comparison|DEM-time speed-up|jump kept|mean DT kept"
