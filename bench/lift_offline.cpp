@@ -21,6 +21,7 @@
 #include "coarse/demixing/quantiles.hpp"
 #include "coarse/demixing/rank_observable.hpp"
 #include "coarse/demixing/whole_bed_profile.hpp"
+#include "coarse/equation_free/ensemble_statistics.hpp"
 #include "core/rng.hpp"
 
 using namespace efdem::coarse;
@@ -82,8 +83,8 @@ int main(int argc, char** argv) {
     // coordinates X is the members' mean rank state and each member's target its own heights.
     RankObservable ranks(m);
     const bool by_ranks = observable == "ranks";
-    const Eigen::VectorXd target = by_ranks ? ranks.restrict_ensemble(icdf, profiles)
-                                            : Eigen::VectorXd(icdf.colwise().mean().transpose());
+    const Eigen::VectorXd target =
+        by_ranks ? ranks.restrict_ensemble(icdf, profiles) : ensemble_mean(icdf);
     const Relabel relabel = rule == "matched" ? Relabel::at_nodes : Relabel::random;
     Eigen::MatrixXd lifted(realizations, m);
     double switched = 0.0;
@@ -100,7 +101,7 @@ int main(int argc, char** argv) {
     }
     const Eigen::MatrixXd in_coordinate =
         by_ranks ? ranks.restrict_members(lifted, profiles) : lifted;
-    const Eigen::VectorXd miss = in_coordinate.colwise().mean().transpose() - target;
+    const Eigen::VectorXd miss = ensemble_mean(in_coordinate) - target;
     double member_sq = 0.0;
     for (long r = 0; r < realizations; ++r)
         member_sq += (in_coordinate.row(r).transpose() - target).squaredNorm();

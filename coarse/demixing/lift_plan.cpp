@@ -16,10 +16,30 @@ namespace {
 
 using Count = std::int64_t;
 
+/// The bounds of a feasible observed count below each cut j (m + 2 of them) for `n_light`
+/// observed particles in intervals of `population`: L_j = max(0, N_L - (N - S_j)) <= B_j <= U_j =
+/// min(N_L, S_j), S_j = particles below cut j (the others must fit above it, and no more than
+/// S_j fit below).
+struct CountBounds {
+    std::vector<Count> lo, hi;
+};
+
+CountBounds count_bounds(Count n_light, const std::vector<Count>& population) {
+    const std::size_t n_bounds = population.size() + 1;
+    std::vector<Count> below(n_bounds, 0);
+    for (std::size_t j = 1; j < n_bounds; ++j) below[j] = below[j - 1] + population[j - 1];
+    const Count total = below.back();
+    CountBounds b{std::vector<Count>(n_bounds), std::vector<Count>(n_bounds)};
+    for (std::size_t j = 0; j < n_bounds; ++j) {
+        b.lo[j] = std::max<Count>(0, n_light - (total - below[j]));
+        b.hi[j] = std::min<Count>(n_light, below[j]);
+    }
+    return b;
+}
+
 /**
  * Observed counts below each cut: `wanted` (B_0 = 0, ..., B_{m+1} = N_L) made feasible for
- * interval populations `population` (0 <= B_{k+1} - B_k <= P_k). Feasible bounds at boundary j:
- * L_j = max(0, N_L - (N - S_j)) <= B_j <= U_j = min(N_L, S_j), S_j = particles below it. A
+ * interval populations `population` (0 <= B_{k+1} - B_k <= P_k, within count_bounds). A
  * forward pass pushes any excess up, a backward pass pushes it down; both are feasible, and so
  * is the floor of their mean, which splits the excess between the neighbours. A feasible
  * `wanted` is returned unchanged.
@@ -28,21 +48,18 @@ std::vector<Count> feasible_cumulative(const std::vector<Count>& wanted,
                                        const std::vector<Count>& population) {
     const std::size_t n_bounds = wanted.size();  // m + 2
     const Count n_light = wanted.back();
-    std::vector<Count> below(n_bounds, 0);
-    for (std::size_t j = 1; j < n_bounds; ++j) below[j] = below[j - 1] + population[j - 1];
-    const Count total = below.back();
-    auto lower = [&](std::size_t j) { return std::max<Count>(0, n_light - (total - below[j])); };
-    auto upper = [&](std::size_t j) { return std::min<Count>(n_light, below[j]); };
+    const CountBounds bounds = count_bounds(n_light, population);
+    const std::vector<Count>&lower = bounds.lo, &upper = bounds.hi;
 
     std::vector<Count> forward(n_bounds), backward(n_bounds), result(n_bounds);
     forward[0] = 0;
     for (std::size_t j = 1; j < n_bounds; ++j)
-        forward[j] = std::clamp(wanted[j], std::max(forward[j - 1], lower(j)),
-                                std::min(forward[j - 1] + population[j - 1], upper(j)));
+        forward[j] = std::clamp(wanted[j], std::max(forward[j - 1], lower[j]),
+                                std::min(forward[j - 1] + population[j - 1], upper[j]));
     backward[n_bounds - 1] = n_light;
     for (std::size_t j = n_bounds - 1; j-- > 0;)
-        backward[j] = std::clamp(wanted[j], std::max(backward[j + 1] - population[j], lower(j)),
-                                 std::min(backward[j + 1], upper(j)));
+        backward[j] = std::clamp(wanted[j], std::max(backward[j + 1] - population[j], lower[j]),
+                                 std::min(backward[j + 1], upper[j]));
     for (std::size_t j = 0; j < n_bounds; ++j) result[j] = (forward[j] + backward[j]) / 2;
     return result;
 }
@@ -51,7 +68,7 @@ std::vector<Count> feasible_cumulative(const std::vector<Count>& wanted,
  * The feasible counts nearest `wanted`: B minimizing sum_j |B_j - W_j| (the lights placed
  * across a cut other than the target asks), then sum_j (B_j - W_j)^2 (an excess that can go
  * either way is split between the neighbours, not always sent one way), over L_j <= B_j <= U_j,
- * 0 <= B_{j+1} - B_j <= P_j (the bounds of feasible_cumulative). Where a short interval sits in
+ * 0 <= B_{j+1} - B_j <= P_j (count_bounds). Where a short interval sits in
  * a run of full ones (a segregated bed: every particle above a cut light), the halves split
  * sends half the excess down the whole run, each cut off by it; this puts it where one cut
  * absorbs it (least squares alone would still send one particle down every cut: 18 cuts off by
@@ -68,14 +85,10 @@ std::vector<Count> nearest_feasible_cumulative(const std::vector<Count>& wanted,
     };
     const std::size_t n_bounds = wanted.size();
     const Count n_light = wanted.back();
-    std::vector<Count> below(n_bounds, 0);
-    for (std::size_t j = 1; j < n_bounds; ++j) below[j] = below[j - 1] + population[j - 1];
-    const Count total = below.back();
-    std::vector<Count> lo(n_bounds), hi(n_bounds);
+    const CountBounds bounds = count_bounds(n_light, population);
+    const std::vector<Count>&lo = bounds.lo, &hi = bounds.hi;
     bool feasible = true;
     for (std::size_t j = 0; j < n_bounds; ++j) {
-        lo[j] = std::max<Count>(0, n_light - (total - below[j]));
-        hi[j] = std::min<Count>(n_light, below[j]);
         feasible = feasible && wanted[j] >= lo[j] && wanted[j] <= hi[j] &&
                    (j == 0 ||
                     (wanted[j] >= wanted[j - 1] && wanted[j] - wanted[j - 1] <= population[j - 1]));

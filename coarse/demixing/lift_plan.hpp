@@ -30,8 +30,9 @@ enum class CountPlan {
     /// A forward pass pushes any excess up, a backward pass down, the floor of their mean splits
     /// it between the neighbours (the paper's lift; position lifting).
     halves,
-    /// The feasible counts nearest the wanted ones in least squares over the cuts: the excess goes
-    /// where the fewest cuts move least. In a segregated bed, where every interval above a cut is
+    /// The feasible counts nearest the wanted ones: the fewest observed particles placed across
+    /// cuts other than asked, then the least squares (an excess that can go either way is split).
+    /// In a segregated bed, where every interval above a cut is
     /// full, `halves` moves half of a short interval's excess down through every full interval
     /// below it (each node off by it: a lift that mixes the bed); `nearest` puts it into the one
     /// interval with room. The colour lift's default (Relabel::at_nodes).
