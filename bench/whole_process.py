@@ -93,6 +93,12 @@ TALL_WAVES = {
     # middle quarters); same keys, the efdem version is the difference
     "ranks_tol_counts": {**WAVES, "cpi.tolerance": 0.64},
     "ranks_accuracy": {**WAVES, "cpi.accuracy": 1.5},
+    # ranks_tol_counts whose relabelled particles take their new species' mean vertical velocity:
+    # in the bursts after ranks_tol_counts' lifts (t = 100-320) the lower light nodes rose 0.03 d_p
+    # per unit slower than the directs' over the first 5 units, 0.011 slower after (of 0.07; two
+    # directs differ by 0.005): a relabelled particle keeps its old species' drift
+    # (bench/lift_velocity.py)
+    "ranks_velocity": {**WAVES, "cpi.tolerance": 0.64, "cpi.relabel_velocity": "species"},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own). The R = 4 cases of
 # the tall bed run no direct ensembles of their own: each R = 8 direct ensemble of the same bed and

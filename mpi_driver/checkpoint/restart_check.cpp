@@ -48,6 +48,7 @@ constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.lift_resolution", "0.1"},     // positions, large observed: rank windows (issue 37)
     {"cpi.lift_error", "ignored"},      // counted: in the jump's error (issue 37)
     {"cpi.relabel_nodes", "random"},    // matched: node-aware colour lift (issue 34)
+    {"cpi.relabel_velocity", "kept"},   // species: relabelled take the species' drift (issue 34)
 };
 // clang-format on
 

@@ -8,6 +8,7 @@
 
 #include "coarse/dem_adapters/apply_colours.hpp"
 #include "coarse/dem_adapters/realization_observables.hpp"
+#include "coarse/dem_adapters/species_velocity.hpp"
 #include "coarse/demixing/colour_lifting.hpp"
 #include "core/contracts.hpp"
 #include "core/error.hpp"
@@ -18,13 +19,14 @@ namespace efdem::mpi_driver {
 DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
                                const RealizationOutput& output, bool restarting,
                                std::optional<dem::BedObservationSettings> bed,
-                               bool lift_by_positions)
+                               bool lift_by_positions, bool carry_velocity)
     : system_(std::move(system)),
       observed_(observed),
       other_(other),
       output_(output),
       bed_(bed),
-      lift_by_positions_(lift_by_positions) {
+      lift_by_positions_(lift_by_positions),
+      carry_velocity_(carry_velocity) {
     const std::string stem =
         fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
     if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
@@ -91,6 +93,9 @@ void DemRealization::apply_lift(const LiftPayload& lifted) {
         std::copy(v.begin(), v.end(), p.v().begin());
         system_.rearranged(lifted.bytes);
     } else {
+        // Before the labels change: the species' means are of the old labels.
+        if (carry_velocity_)
+            coarse::carry_species_velocity(system_, lifted.bytes, observed_, other_);
         coarse::apply_colours(system_, lifted.bytes, observed_, other_);
     }
     still_samples_ = 0;  // other masses or places: its balance is judged again

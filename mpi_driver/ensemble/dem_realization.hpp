@@ -38,10 +38,12 @@ class DemRealization final : public Realization {
     /// `bed`: also measure the bed quantities at every sample (Observation::bed).
     /// `lift_by_positions` (cpi.lift_by = positions): lifts move particles (PositionLifter's
     /// payloads) instead of switching their labels (ColourLifter's).
+    /// `carry_velocity` (cpi.relabel_velocity = species): a colour lift moves each relabelled
+    /// particle's vertical velocity to its new species' local mean (carry_species_velocity).
     DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
                    const RealizationOutput& output, bool restarting = false,
                    std::optional<dem::BedObservationSettings> bed = std::nullopt,
-                   bool lift_by_positions = false);
+                   bool lift_by_positions = false, bool carry_velocity = false);
 
     long index() const override { return system_.realization(); }
     double time() const override { return system_.time(); }
@@ -103,6 +105,7 @@ class DemRealization final : public Realization {
     RealizationOutput output_;
     std::optional<dem::BedObservationSettings> bed_;
     bool lift_by_positions_ = false;
+    bool carry_velocity_ = false;
     std::optional<dem::VtkSeriesWriter> vtk_;
     std::unique_ptr<dem::ThermoLog> thermo_;
     long still_samples_ = 0;  ///< see still_samples(); part of the checkpoint

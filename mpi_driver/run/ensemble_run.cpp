@@ -101,9 +101,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
             std::lround(s.output.thermo_interval / s.observe.interval),
             resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
         for (auto& sys : systems)
-            local.push_back(std::make_unique<DemRealization>(std::move(sys), s.observe.species,
-                                                             s.observe.other, out, resume, bed,
-                                                             by_positions));
+            local.push_back(std::make_unique<DemRealization>(
+                std::move(sys), s.observe.species, s.observe.other, out, resume, bed, by_positions,
+                s.carry_species_velocity));
     } catch (const std::exception& e) {
         // The run file may exist already (a CSV header on a nearly full disk): it says so.
         RunSummary failed;

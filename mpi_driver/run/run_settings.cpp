@@ -100,6 +100,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // the paper's minimal relabelling.
     s.relabel_at_nodes =
         cpi.get_or_choice("relabel_nodes", "matched", {"matched", "random"}) == "matched";
+    // Each species rises or sinks at its own mean velocity: a relabelled particle that keeps its
+    // velocity carries the old species' drift into the new one until drag and contacts restore
+    // it (bench/results/lift_velocity.md); species moves it to the new species' local mean.
+    s.carry_species_velocity =
+        cpi.get_or_choice("relabel_velocity", "kept", {"kept", "species"}) == "species";
     // positions: a bed of two sizes is lifted by exchanging particles between heights
     // (docs/lifting_by_positions.md); colours switch labels in place (equal sizes only).
     s.lift_by_positions =
@@ -119,6 +124,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                  "= moving chooses which labels a colour lift switches, and cpi.lift_by = "
                  "positions switches none",
                  "any with cpi.lift_by = positions, or cpi.lift_by = colours");
+    if (s.lift_by_positions && s.carry_species_velocity)
+        cpi.fail("relabel_velocity",
+                 "= species moves the velocities of relabelled particles, and cpi.lift_by = "
+                 "positions relabels none (it moves particles with their velocities)",
+                 "kept with cpi.lift_by = positions, or cpi.lift_by = colours");
     if (s.lift_by_positions && s.is_steady())
         cpi.fail("lift_by",
                  "= positions can fail to relax its overlaps, which only an adaptive cpi run "

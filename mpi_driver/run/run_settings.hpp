@@ -113,6 +113,10 @@ struct RunSettings {
     /// ranks on the particles that meet it best (coarse::Relabel::at_nodes); random: every
     /// switch drawn at random (the fewest switches, the paper's lift).
     bool relabel_at_nodes = true;
+    /// cpi.relabel_velocity = species: a relabelled particle's vertical velocity is moved to its
+    /// new species' local mean (coarse::carry_species_velocity); kept (default): velocities are
+    /// kept (the paper's lift).
+    bool carry_species_velocity = false;
     /// cpi.lift_by = positions: lifts exchange particles between heights (PositionLifter), for
     /// beds whose species differ in size; colours (false) switch labels in place.
     bool lift_by_positions = false;

@@ -348,3 +348,41 @@ TEST_CASE(
         CHECK(springs_of_others > 100);  // the pairs the lift did not touch keep theirs
     }
 }
+
+TEST_CASE(
+    "cpi.relabel_velocity = species: a realization's relabelled particles take their new "
+    "species' vertical velocity",
+    "[mpi][lifting]") {
+    // Lights rise at 0.2, heavies sink at 0.2 (every band's means exact): with carry_velocity a
+    // relabelled particle ends at its new species' velocity, without it keeps its own; the
+    // other particles and every horizontal velocity are untouched either way.
+    for (const bool carry : {true, false}) {
+        DemRealization d(random_column(0), 0, 1, RealizationOutput{}, false, std::nullopt, false,
+                         carry);
+        dem::Particles& p = d.system().particles();
+        for (std::size_t i = 0; i < p.size(); ++i) p.v()[i].z = p.species()[i] == 0 ? 0.2 : -0.2;
+        const std::vector<Vec3> before(p.v().begin(), p.v().end());
+        const std::vector<dem::SpeciesId> species_before(p.species().begin(), p.species().end());
+        const LiftPayload input = d.lift_input();  // colours, then the moving flags
+        LiftPayload lifted;
+        lifted.bytes.assign(input.bytes.begin(), input.bytes.begin() + static_cast<long>(p.size()));
+        for (std::size_t i = 0; i < lifted.bytes.size(); i += 7) lifted.bytes[i] ^= 1u;
+        d.apply_lift(lifted);
+        const dem::Particles& q = d.system().particles();
+        long moved = 0;
+        for (std::size_t i = 0; i < q.size(); ++i) {
+            // apply_colours keeps the particles' order: index i is the same particle
+            CHECK(q.v()[i].x == before[i].x);
+            CHECK(q.v()[i].y == before[i].y);
+            if (q.species()[i] == species_before[i]) {
+                CHECK(q.v()[i].z == before[i].z);
+            } else if (carry) {
+                CHECK(q.v()[i].z == Approx(q.species()[i] == 0 ? 0.2 : -0.2).margin(1e-12));
+                ++moved;
+            } else {
+                CHECK(q.v()[i].z == before[i].z);
+            }
+        }
+        if (carry) CHECK(moved > 100);  // every 7th of 1,200 switched
+    }
+}

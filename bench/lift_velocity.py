@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""What a colour lift does to the species' velocities, and what that costs the bursts after it.
+
+1. The slip: in each height band of a direct run's checkpoints, the mean vertical velocity of the
+   light and of the heavy spheres, their difference, and the spread of the vertical velocities
+   (all realizations pooled; bands of 2 d_p with at least 6 of each species). A lift that keeps
+   velocities (cpi.relabel_velocity = kept) gives each particle it turns light the heavy ones'
+   mean, and the reverse.
+2. The bursts after the lifts: for each CPI run of a whole-process case (bench/whole_process.py,
+   its committed reductions), the light ICDF's slope over the first 5 units of each burst's
+   sampling grid and over the rest, minus the direct ensembles' over the same times, for the
+   lower light nodes (p = 0.05-0.30), over bursts in t = 100-320 (the tall bed's transient at
+   U_s = 0.41, where lifts move these nodes most); with two direct ensembles' difference over
+   the same windows as the noise to read it against.
+
+    /usr/bin/python3 bench/lift_velocity.py --checkpoints runs/transient_lift/direct_ckpt_*.h5 \\
+        --case bench/results/whole_process/tall_u0.41_r8 --runs ranks_tol ranks_tol_counts ranks_velocity \\
+        --out bench/results/lift_velocity.md
+
+The checkpoints of bench/results/lift_velocity.md: the demo bed at U_s = 0.41, R = 4, direct, seed
+606, checkpoints every 20 units (run files not in git; this makes them again, 3 min on 2 cores):
+
+    mpirun -n 2 build/mpi_driver/efdem examples/demo_small/scene.cfg gas_drag.superficial_velocity=0.41 \\
+        ensemble.realizations_per_rank=2 mode=direct seed=606 run.duration=100 checkpoint.interval=40 \\
+        checkpoint.keep=10 output.directory=runs/transient_lift output.prefix=direct
+"""
+import argparse
+import json
+import os
+import sys
+
+import h5py
+import numpy as np
+
+LOWER = slice(0, 6)  # nodes p = 0.05 .. 0.30 of the 19-node grid
+SPAN = (100.0, 320.0)
+EARLY = 5.0  # one grid interval of the reductions (bench/whole_process.py GRID)
+
+
+def slip_table(paths):
+    lines = ["| checkpoint | t | band [d_p] | lights | heavies | light mean v_z | heavy mean v_z | slip | spread of v_z |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for path in paths:
+        with h5py.File(path, "r") as f:
+            x, v = f["realizations/x"][:], f["realizations/v"][:]
+            species = f["realizations/species"][:].ravel()
+            t = float(f["realizations/time"][0])
+        z, vz = x[:, 2], v[:, 2]
+        for lo in np.arange(0.0, np.ceil(z.max()), 2.0):
+            band = (z >= lo) & (z < lo + 2.0)
+            light, heavy = band & (species == 0), band & (species == 1)
+            if light.sum() < 6 or heavy.sum() < 6:
+                continue
+            a, b = vz[light].mean(), vz[heavy].mean()
+            lines.append(f"| {os.path.basename(path)} | {t:g} | {lo:g}-{lo + 2:g} | {light.sum()} | {heavy.sum()} | "
+                         f"{a:.3f} | {b:.3f} | {a - b:.3f} | {vz[band].std():.3f} |")
+    return lines
+
+
+def load(folder, name):
+    with open(os.path.join(folder, name + ".json")) as f:
+        d = json.load(f)
+    t = np.asarray(d["t"])
+    icdf = np.asarray(d["icdf"], dtype=float).reshape(len(t), len(d["stops"]), -1)
+    return t, icdf.mean(axis=1)
+
+
+def bursts(t):
+    """Index runs of consecutive grid samples (a jump leaves a gap longer than one interval)."""
+    out, cur = [], [0]
+    for i in range(1, len(t)):
+        if t[i] - t[i - 1] > EARLY + 1e-6:
+            out.append(cur)
+            cur = [i]
+        else:
+            cur.append(i)
+    out.append(cur)
+    return out
+
+
+def deficit_table(folder, runs):
+    directs = [load(folder, n) for n in ("direct_a", "direct_b", "direct_c")]
+    td = directs[0][0]
+    dmean = np.mean([d[1] for d in directs], axis=0)
+
+    def slope(x, tt, a, b):
+        return (x[b] - x[a]) / (tt[b] - tt[a])
+
+    def at(tt):
+        return int(np.argmin(np.abs(td - tt)))
+
+    lines = ["| CPI run | bursts | direct slope, lower nodes [d_p/unit] | CPI - direct, first 5 units | CPI - direct, rest | "
+             "direct_a - direct_b, first 5 / rest (noise) |",
+             "|---|---|---|---|---|---|"]
+    for name in runs:
+        if not os.path.exists(os.path.join(folder, name + ".json")):
+            lines.append(f"| {name} | (no reduction yet) | | | | |")
+            continue
+        t, x = load(folder, name)
+        early, late, noise_e, noise_l, ref = [], [], [], [], []
+        for b in bursts(t)[1:]:  # the first stretch is the warm-up's direct run
+            if len(b) < 3 or t[b[0]] < SPAN[0] or t[b[-1]] > SPAN[1]:
+                continue
+            i0, i1, i2 = b[0], b[1], b[-1]
+            j0, j1, j2 = at(t[i0]), at(t[i1]), at(t[i2])
+            early.append((slope(x, t, i0, i1) - slope(dmean, td, j0, j1))[LOWER].mean())
+            late.append((slope(x, t, i1, i2) - slope(dmean, td, j1, j2))[LOWER].mean())
+            a, bb = directs[0][1], directs[1][1]
+            noise_e.append((slope(a, td, j0, j1) - slope(bb, td, j0, j1))[LOWER].mean())
+            noise_l.append((slope(a, td, j1, j2) - slope(bb, td, j1, j2))[LOWER].mean())
+            ref.append(slope(dmean, td, j0, j2)[LOWER].mean())
+        def pm(a):  # mean +- its standard error over the bursts
+            return f"{np.mean(a):+.3f} +- {np.std(a, ddof=1) / np.sqrt(len(a)):.3f}"
+
+        lines.append(f"| {name} | {len(early)} | {np.mean(ref):.3f} | {pm(early)} | {pm(late)} | "
+                     f"{pm(noise_e)} / {pm(noise_l)} |")
+    return lines
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--checkpoints", nargs="*", default=[])
+    ap.add_argument("--case", help="a case folder of bench/whole_process.py's results")
+    ap.add_argument("--runs", nargs="*", default=[])
+    ap.add_argument("--out")
+    args = ap.parse_args()
+    text = [f"Made by `/usr/bin/python3 bench/lift_velocity.py {' '.join(sys.argv[1:])}`.", ""]
+    if args.checkpoints:
+        text += ["## 1. The species' vertical velocities in a direct run", ""] + slip_table(args.checkpoints) + [""]
+    if args.case:
+        text += [f"## 2. The lower light nodes' slope in the bursts after lifts ({os.path.basename(args.case)}, "
+                 f"bursts in t = {SPAN[0]:g}-{SPAN[1]:g}, nodes p = 0.05-0.30)", ""] + deficit_table(args.case, args.runs) + [""]
+    out = "\n".join(text)
+    print(out)
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(out)
+
+
+if __name__ == "__main__":
+    main()
