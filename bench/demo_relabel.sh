@@ -9,7 +9,8 @@
 #   bash bench/demo_relabel.sh [build dir] [seed...]     (default: build, seeds 2 3 4)
 #
 # RULES (default "matched random") limits the rules; TAG is appended to each CPI run's name, so a
-# later efdem's runs stand beside an earlier one's (TAG=_counts: after the count plan changed).
+# later efdem's runs stand beside an earlier one's (TAG=_counts: after the count plan changed);
+# KEYS adds scene keys to each CPI run (KEYS="cpi.relabel_velocity=species" TAG=_velocity).
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$src/build}
@@ -29,7 +30,8 @@ tag=${TAG:-}
 for seed in "${seeds[@]}"; do
   for relabel in $rules; do
     name=cpi_${relabel}${tag}_s$seed
-    done_run "$name" || efdem mode=cpi seed="$seed" cpi.relabel_nodes=$relabel output.prefix="$name"
+    # shellcheck disable=SC2086 # KEYS: words, one key=value each
+    done_run "$name" || efdem mode=cpi seed="$seed" cpi.relabel_nodes=$relabel ${KEYS:-} output.prefix="$name"
   done
 done
 for seed in "${seeds[@]}"; do
