@@ -32,9 +32,12 @@ import sys
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import whole_process as wp  # noqa: E402
+
 LOWER = slice(0, 6)  # nodes p = 0.05 .. 0.30 of the 19-node grid
 SPAN = (100.0, 320.0)
-EARLY = 5.0  # one grid interval of the reductions (bench/whole_process.py GRID)
+EARLY = wp.GRID  # one grid interval of the reductions
 
 
 def slip_table(paths):
@@ -58,11 +61,10 @@ def slip_table(paths):
 
 
 def load(folder, name):
+    """A run's grid times and ensemble-mean ICDF, from its reduction (whole_process.py)."""
     with open(os.path.join(folder, name + ".json")) as f:
-        d = json.load(f)
-    t = np.asarray(d["t"])
-    icdf = np.asarray(d["icdf"], dtype=float).reshape(len(t), len(d["stops"]), -1)
-    return t, icdf.mean(axis=1)
+        run = wp.from_reduction(json.load(f))
+    return run["t"], run["mean"]
 
 
 def bursts(t):
