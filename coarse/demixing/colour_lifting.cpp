@@ -24,32 +24,56 @@ void switch_random(std::vector<std::size_t>& candidates, Count count,
     }
 }
 
+/// The candidates' order of preference (SwitchOrder) when `to_light` particles turn light (else
+/// heavy): 0 first. Each class is drawn from uniformly.
+std::uint8_t preference(const SwitchOrder& order, std::size_t j, bool to_light) {
+    switch (order.by) {
+        case SwitchOrder::By::any:
+            return 0;
+        case SwitchOrder::By::moving:
+            return order.values[j] ? 0 : 1;
+        case SwitchOrder::By::light_neighbours:
+            return to_light ? static_cast<std::uint8_t>(255 - order.values[j]) : order.values[j];
+    }
+    return 0;
+}
+
 /**
  * Relabels positions [first, last) of one interval's particles (`members`: sorted by height, or
  * in index order) so that exactly `wanted` of them are light, switching the fewest: the excess
  * colour's particles drawn at random (partial Fisher-Yates in the order of `members`, so
- * deterministic for a stream state), the `moving` ones first when flags are given. Returns the
- * labels switched.
+ * deterministic for a stream state), class by class in `order`'s preference. Returns the labels
+ * switched.
  */
 Count relabel_run(std::span<const std::size_t> members, std::size_t first, std::size_t last,
-                  Count wanted, std::span<const std::uint8_t> colours,
-                  std::span<const std::uint8_t> moving, std::vector<std::uint8_t>& out,
-                  RandomStream& rng) {
+                  Count wanted, std::span<const std::uint8_t> colours, const SwitchOrder& order,
+                  std::vector<std::uint8_t>& out, RandomStream& rng) {
     Count light = 0;
     for (std::size_t p = first; p < last; ++p) light += colours[members[p]] == kLight ? 1 : 0;
     const Count excess = light - wanted;
     EFDEM_ASSERT(wanted >= 0 && wanted <= static_cast<Count>(last - first));
     if (excess == 0) return 0;
-    std::vector<std::size_t> first_drawn, rest;
+    // The candidates by class (a counting sort: classes are bytes), index order within each.
+    std::vector<std::pair<std::uint8_t, std::size_t>> candidates;
     for (std::size_t p = first; p < last; ++p) {
         const std::size_t j = members[p];
         if ((colours[j] == kLight) == (excess > 0))
-            (moving.empty() || moving[j] ? first_drawn : rest).push_back(j);
+            candidates.emplace_back(preference(order, j, excess < 0), j);
     }
-    const Count from_first =
-        std::min<Count>(std::abs(excess), static_cast<Count>(first_drawn.size()));
-    switch_random(first_drawn, from_first, out, rng);
-    switch_random(rest, std::abs(excess) - from_first, out, rng);
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    Count left = std::abs(excess);
+    for (std::size_t a = 0; a < candidates.size() && left > 0;) {
+        std::size_t b = a;
+        std::vector<std::size_t> cls;
+        for (; b < candidates.size() && candidates[b].first == candidates[a].first; ++b)
+            cls.push_back(candidates[b].second);
+        const Count here = std::min<Count>(left, static_cast<Count>(cls.size()));
+        switch_random(cls, here, out, rng);
+        left -= here;
+        a = b;
+    }
+    EFDEM_ASSERT(left == 0);
     return std::abs(excess);
 }
 
@@ -83,16 +107,16 @@ Eigen::VectorXd achieved_light_icdf(std::span<const double> heights,
 }
 
 /// Relabel::random: each interval switches |gain| particles of the colour it has too many of,
-/// drawn at random among them in index order (the moving ones first). Returns the labels
+/// drawn at random among them in index order (in `order`'s preference). Returns the labels
 /// switched.
 std::size_t switch_at_random(const LiftPlan& plan, std::span<const std::uint8_t> colours,
-                             std::span<const std::uint8_t> moving, std::vector<std::uint8_t>& out,
+                             const SwitchOrder& order, std::vector<std::uint8_t>& out,
                              RandomStream& rng) {
     const std::vector<std::vector<std::size_t>> members = particles_by_interval(plan);
     Count changed = 0;
     for (std::size_t k = 0; k < members.size(); ++k)
         changed += relabel_run(members[k], 0, members[k].size(), plan.below[k + 1] - plan.below[k],
-                               colours, moving, out, rng);
+                               colours, order, out, rng);
     return static_cast<std::size_t>(changed);
 }
 
@@ -101,9 +125,13 @@ std::size_t switch_at_random(const LiftPlan& plan, std::span<const std::uint8_t>
 /// Returns the labels switched.
 std::size_t switch_at_nodes(const LiftPlan& plan, std::span<const double> heights,
                             std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
-                            std::span<const std::uint8_t> moving, std::vector<std::uint8_t>& out,
+                            const SwitchOrder& switch_order, std::vector<std::uint8_t>& out,
                             RandomStream& rng) {
     const IntervalOrder order = order_intervals(plan, heights);
+    // The pins prefer moving particles (cpi.relabel = moving); other orders leave them alike.
+    const std::span<const std::uint8_t> moving = switch_order.by == SwitchOrder::By::moving
+                                                     ? switch_order.values
+                                                     : std::span<const std::uint8_t>{};
     const std::vector<RankPin> pins = pin_node_ranks(plan, order, heights, colours, grid, moving);
     auto pin = pins.begin();
     Count changed = 0;
@@ -112,16 +140,16 @@ std::size_t switch_at_nodes(const LiftPlan& plan, std::span<const double> height
         Count placed = 0;  // observed particles of interval k below position `start`
         for (; pin != pins.end() && pin->interval == k; ++pin) {
             changed += relabel_run(order[k], start, pin->position, pin->offset - placed, colours,
-                                   moving, out, rng);
+                                   switch_order, out, rng);
             const std::size_t j = order[k][pin->position];
             changed += colours[j] == kLight ? 0 : 1;
             out[j] = kLight;
             placed = pin->offset + 1;
             start = pin->position + 1;
         }
-        changed +=
-            relabel_run(order[k], start, order[k].size(),
-                        plan.below[k + 1] - plan.below[k] - placed, colours, moving, out, rng);
+        changed += relabel_run(order[k], start, order[k].size(),
+                               plan.below[k + 1] - plan.below[k] - placed, colours, switch_order,
+                               out, rng);
     }
     return static_cast<std::size_t>(changed);
 }
@@ -130,8 +158,9 @@ std::size_t switch_at_nodes(const LiftPlan& plan, std::span<const double> height
 
 LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                         std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
-                        RandomStream& rng, std::span<const std::uint8_t> moving, Relabel relabel) {
-    EFDEM_EXPECTS(moving.empty() || moving.size() == colours.size());  // the rest: plan_lift
+                        RandomStream& rng, SwitchOrder order, Relabel relabel) {
+    EFDEM_EXPECTS(order.by == SwitchOrder::By::any ||
+                  order.values.size() == colours.size());  // the rest: plan_lift
     LiftResult result;
     result.colours.assign(colours.begin(), colours.end());
     result.target = target_icdf;
@@ -153,8 +182,8 @@ LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const doub
     result.n_short_intervals = plan.n_short_intervals;
     result.n_changed =
         relabel == Relabel::at_nodes
-            ? switch_at_nodes(plan, heights, colours, grid, moving, result.colours, rng)
-            : switch_at_random(plan, colours, moving, result.colours, rng);
+            ? switch_at_nodes(plan, heights, colours, grid, order, result.colours, rng)
+            : switch_at_random(plan, colours, order, result.colours, rng);
 
     result.achieved_icdf =
         achieved_light_icdf(heights, result.colours, plan.interval, plan.below, grid);

@@ -39,6 +39,22 @@ enum class Relabel {
     random,
 };
 
+/// Which of an interval's candidates switch first (cpi.relabel). The count each interval switches
+/// is the same whatever the order; within one preference class the draw is uniform.
+struct SwitchOrder {
+    enum class By {
+        any,     ///< every candidate alike (`values` unused)
+        moving,  ///< `values` are flags: the moving particles (1) first, the still ones after
+        /// `values` count each particle's light neighbours (light_neighbours.hpp): a heavy one
+        /// with more of them turns light first, a light one with fewer turns heavy first, so a
+        /// lift adds lights to the clusters a direct bed grows and takes away its isolated ones
+        /// (bench/results/lift_clusters.md)
+        light_neighbours,
+    };
+    By by = By::any;
+    std::span<const std::uint8_t> values;  ///< one per particle, unless `by` is any
+};
+
 struct LiftResult {
     LiftStatus status = LiftStatus::rejected;
     /// The new labels (a copy of the input when rejected).
@@ -109,19 +125,20 @@ struct LiftResult {
  * bursts of 2-3e5 time steps per realization (hours). Wall time doubled on a loaded shared core.
  * Reproduce: efdem_unit_tests "[.benchmark]".
  *
- * `moving` (optional, one flag per particle): steps 3 and 4 draw an interval's (or a run's)
- * switches from its moving particles first and from the still ones only for what is left, so
+ * `order` (SwitchOrder): which candidates steps 3 and 4 draw an interval's (or a run's) switches
+ * from first. `moving`: the moving particles first and the still ones only for what is left, so
  * that a bed whose lower part has come to rest is relabelled where it moves (cpi.relabel =
  * moving); at_nodes pins a still particle only if it is already light (or none other is in
- * reach). With random, the same interval counts, so the same n_changed and the same guarantees;
- * only which particles switch differs. Empty: every candidate alike.
+ * reach). `light_neighbours`: heavies with the most light neighbours turn light first, lights
+ * with the fewest turn heavy first (the pins as with `any`). The same interval counts whatever
+ * the order, so the same n_changed and the same guarantees; only which particles switch differs.
  *
  * \pre heights.size() == colours.size(); colours in {kHeavy, kLight};
- *      target_icdf.size() == grid.size(); moving empty or of colours' size.
+ *      target_icdf.size() == grid.size(); order.values of colours' size unless order.by is any.
  */
 LiftResult lift_colours(const Eigen::VectorXd& target_icdf, std::span<const double> heights,
                         std::span<const std::uint8_t> colours, const ProbabilityGrid& grid,
-                        RandomStream& rng, std::span<const std::uint8_t> moving = {},
+                        RandomStream& rng, SwitchOrder order = {},
                         Relabel relabel = Relabel::at_nodes);
 
 }  // namespace efdem::coarse

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "coarse/dem_adapters/apply_colours.hpp"
+#include "coarse/dem_adapters/light_neighbours.hpp"
 #include "coarse/dem_adapters/realization_observables.hpp"
 #include "coarse/dem_adapters/species_velocity.hpp"
 #include "coarse/demixing/colour_lifting.hpp"
@@ -18,15 +19,13 @@ namespace efdem::mpi_driver {
 
 DemRealization::DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
                                const RealizationOutput& output, bool restarting,
-                               std::optional<dem::BedObservationSettings> bed,
-                               bool lift_by_positions, bool carry_velocity)
+                               std::optional<dem::BedObservationSettings> bed, RealizationLift lift)
     : system_(std::move(system)),
       observed_(observed),
       other_(other),
       output_(output),
       bed_(bed),
-      lift_by_positions_(lift_by_positions),
-      carry_velocity_(carry_velocity) {
+      lift_(lift) {
     const std::string stem =
         fmt::format("{}_r{:04d}{}", output_.prefix, index(), output_.continuation);
     if (output_.vtk_every > 0) vtk_.emplace(output_.directory, stem);
@@ -66,24 +65,29 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid,
 
 LiftPayload DemRealization::lift_input() const {
     const dem::Particles& p = system_.particles();
-    if (lift_by_positions_) {
+    if (lift_.by_positions) {
         return {pack_positions(p.x(), p.v()), coarse::heights_and_colours(p, observed_).colours};
     }
     auto hc = coarse::heights_and_colours(p, observed_);
-    // Then one flag per particle: moving (ColourLifter relabels those first, cpi.relabel).
+    // Then one byte per particle that ColourLifter orders the switches by (cpi.relabel).
     std::vector<std::uint8_t> bytes = std::move(hc.colours);
-    bytes.reserve(2 * p.size());
-    for (const auto& v : p.v()) bytes.push_back(norm2(v) > kMovingSpeed * kMovingSpeed ? 1 : 0);
+    if (lift_.switch_by == coarse::SwitchOrder::By::light_neighbours) {
+        const auto counts = coarse::light_neighbour_counts(p, system_.domain(), observed_);
+        bytes.insert(bytes.end(), counts.begin(), counts.end());
+    } else {
+        bytes.reserve(2 * p.size());
+        for (const auto& v : p.v()) bytes.push_back(norm2(v) > kMovingSpeed * kMovingSpeed ? 1 : 0);
+    }
     return {std::move(hc.heights), std::move(bytes)};
 }
 
 std::pair<std::size_t, std::size_t> DemRealization::lift_output_sizes() const {
     const std::size_t n = system_.particles().size();
-    return {lift_by_positions_ ? 6 * n : 0, n};
+    return {lift_.by_positions ? 6 * n : 0, n};
 }
 
 void DemRealization::apply_lift(const LiftPayload& lifted) {
-    if (lift_by_positions_) {
+    if (lift_.by_positions) {
         dem::Particles& p = system_.particles();
         const std::size_t n = p.size();
         EFDEM_EXPECTS(lifted.reals.size() == 6 * n && lifted.bytes.size() == n);
@@ -94,7 +98,7 @@ void DemRealization::apply_lift(const LiftPayload& lifted) {
         system_.rearranged(lifted.bytes);
     } else {
         // Before the labels change: the species' means are of the old labels.
-        if (carry_velocity_)
+        if (lift_.carry_velocity)
             coarse::carry_species_velocity(system_, lifted.bytes, observed_, other_);
         coarse::apply_colours(system_, lifted.bytes, observed_, other_);
     }
@@ -216,13 +220,15 @@ void DemRealization::restore_state(const RealizationState& s) {
 
 LiftOutcome ColourLifter::lift(const Eigen::VectorXd& target, const LiftPayload& input,
                                const coarse::ProbabilityGrid& grid, RandomStream& rng) const {
-    // input.bytes: the colours, then the moving flags (DemRealization::lift_input).
+    // input.bytes: the colours, then the bytes to order by (DemRealization::lift_input).
     const std::span<const std::uint8_t> bytes(input.bytes);
     const std::size_t n = input.reals.size();
     EFDEM_EXPECTS(bytes.size() == 2 * n);
-    coarse::LiftResult r = coarse::lift_colours(
-        target, input.reals, bytes.first(n), grid, rng,
-        prefer_moving_ ? bytes.subspan(n) : std::span<const std::uint8_t>{}, relabel_);
+    coarse::SwitchOrder order;
+    order.by = switch_by_;
+    if (switch_by_ != coarse::SwitchOrder::By::any) order.values = bytes.subspan(n);
+    coarse::LiftResult r =
+        coarse::lift_colours(target, input.reals, bytes.first(n), grid, rng, order, relabel_);
     LiftOutcome out;
     out.changed = static_cast<long>(r.n_changed);
     out.max_deviation = r.max_deviation;

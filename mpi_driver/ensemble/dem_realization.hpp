@@ -30,20 +30,30 @@ struct RealizationOutput {
     std::string continuation;
 };
 
+/// How a realization is lifted: the cpi.lift_by and cpi.relabel* keys it acts on itself.
+struct RealizationLift {
+    /// cpi.lift_by = positions: lifts move particles (PositionLifter's payloads) instead of
+    /// switching their labels (ColourLifter's).
+    bool by_positions = false;
+    /// cpi.relabel_velocity = species: a colour lift moves each relabelled particle's vertical
+    /// velocity to its new species' local mean (carry_species_velocity).
+    bool carry_velocity = false;
+    /// cpi.relabel: what lift_input sends after the colours, the values ColourLifter orders the
+    /// switches by: moving flags (any, moving) or light-neighbour counts (light_neighbours).
+    coarse::SwitchOrder::By switch_by = coarse::SwitchOrder::By::any;
+};
+
 class DemRealization final : public Realization {
   public:
     /// `observed`: the species whose heights make the ICDF (colour 1); `other`: colour 0.
     /// `restarting`: the state will be restored from a checkpoint, so the per-realization
     /// outputs do not record the (discarded) initial state.
     /// `bed`: also measure the bed quantities at every sample (Observation::bed).
-    /// `lift_by_positions` (cpi.lift_by = positions): lifts move particles (PositionLifter's
-    /// payloads) instead of switching their labels (ColourLifter's).
-    /// `carry_velocity` (cpi.relabel_velocity = species): a colour lift moves each relabelled
-    /// particle's vertical velocity to its new species' local mean (carry_species_velocity).
+    /// `lift`: how it is lifted (RealizationLift).
     DemRealization(dem::System system, dem::SpeciesId observed, dem::SpeciesId other,
                    const RealizationOutput& output, bool restarting = false,
                    std::optional<dem::BedObservationSettings> bed = std::nullopt,
-                   bool lift_by_positions = false, bool carry_velocity = false);
+                   RealizationLift lift = {});
 
     long index() const override { return system_.realization(); }
     double time() const override { return system_.time(); }
@@ -58,8 +68,9 @@ class DemRealization final : public Realization {
     /// 0.1-0.2 s of one core, well inside Open MPI's 1 s between its SIGTERM and SIGKILL.
     static constexpr long kStopCheckSteps = 100;
     Observation observe(const coarse::ProbabilityGrid& grid, ReferenceNeeds needs) const override;
-    /// Colours: heights (reals), colours then moving flags (bytes). Positions: x, y, z of every
-    /// particle then its velocity (reals), colours (bytes).
+    /// Colours: heights (reals), colours then one byte per particle (bytes): its moving flag, or
+    /// with RealizationLift::switch_by = light_neighbours its light-neighbour count. Positions: x,
+    /// y, z of every particle then its velocity (reals), colours (bytes).
     LiftPayload lift_input() const override;
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
     /// Colours: the new labels. Positions: new positions and velocities (reals), one moved flag
@@ -104,27 +115,27 @@ class DemRealization final : public Realization {
     dem::SpeciesId observed_, other_;
     RealizationOutput output_;
     std::optional<dem::BedObservationSettings> bed_;
-    bool lift_by_positions_ = false;
-    bool carry_velocity_ = false;
+    RealizationLift lift_;
     std::optional<dem::VtkSeriesWriter> vtk_;
     std::unique_ptr<dem::ThermoLog> thermo_;
     long still_samples_ = 0;  ///< see still_samples(); part of the checkpoint
 };
 
 /// Minimal-change recolouring (physics.md §9) of one realization: payload in = heights (reals)
-/// and colours then moving flags (bytes, DemRealization::lift_input), payload out = colours.
-/// `prefer_moving` (cpi.relabel = moving): each interval relabels its moving particles first;
-/// `relabel` (cpi.relabel_nodes): which particles switch (coarse::Relabel).
+/// and colours then one byte per particle (DemRealization::lift_input), payload out = colours.
+/// `switch_by` (cpi.relabel): which of an interval's particles switch first, read from those
+/// bytes (coarse::SwitchOrder); `relabel` (cpi.relabel_nodes): which particles switch
+/// (coarse::Relabel).
 class ColourLifter final : public Lifter {
   public:
-    explicit ColourLifter(bool prefer_moving = false,
+    explicit ColourLifter(coarse::SwitchOrder::By switch_by = coarse::SwitchOrder::By::any,
                           coarse::Relabel relabel = coarse::Relabel::at_nodes)
-        : prefer_moving_(prefer_moving), relabel_(relabel) {}
+        : switch_by_(switch_by), relabel_(relabel) {}
     LiftOutcome lift(const Eigen::VectorXd& target, const LiftPayload& input,
                      const coarse::ProbabilityGrid& grid, RandomStream& rng) const override;
 
   private:
-    bool prefer_moving_;
+    coarse::SwitchOrder::By switch_by_;
     coarse::Relabel relabel_;
 };
 

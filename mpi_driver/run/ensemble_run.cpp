@@ -102,8 +102,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
             resume ? fmt::format("_cont{:08d}", restart->header.stepper.samples_taken) : ""};
         for (auto& sys : systems)
             local.push_back(std::make_unique<DemRealization>(
-                std::move(sys), s.observe.species, s.observe.other, out, resume, bed, by_positions,
-                s.carry_species_velocity));
+                std::move(sys), s.observe.species, s.observe.other, out, resume, bed,
+                RealizationLift{by_positions, s.carry_species_velocity,
+                                s.is_cpi() ? s.relabel_by : coarse::SwitchOrder::By::any}));
     } catch (const std::exception& e) {
         // The run file may exist already (a CSV header on a nearly full disk): it says so.
         RunSummary failed;
@@ -145,9 +146,9 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     const double t0 =
         resume && mpi.is_root() ? restart->header.driver.t_origin : local.front()->time();
     Progress progress(t0, t0 + s.duration, 2.0);
-    const ColourLifter colour_lifter(s.relabel_moving && s.is_cpi(), s.relabel_at_nodes
-                                                                         ? coarse::Relabel::at_nodes
-                                                                         : coarse::Relabel::random);
+    const ColourLifter colour_lifter(
+        s.is_cpi() ? s.relabel_by : coarse::SwitchOrder::By::any,
+        s.relabel_at_nodes ? coarse::Relabel::at_nodes : coarse::Relabel::random);
     dem::OverlapRelaxationSettings relaxation;
     relaxation.height_band = s.lift_height_band;
     const PositionLifter position_lifter(species, s.observe.species, s.observe.other, box,

@@ -93,7 +93,12 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     s.hold_at_rest = at_rest == "hold";
     // Where a bed has partly come to rest, a relabelling there kicks it back into motion
     // (bench/lift_restart.py): moving relabels the moving particles of each height interval first.
-    s.relabel_moving = cpi.get_or_choice("relabel", "any", {"any", "moving"}) == "moving";
+    // In a segregating bed the lights gather with lights (bench/results/lift_clusters.md):
+    // clustered adds lights where lights are and takes away the isolated ones.
+    const std::string relabel = cpi.get_or_choice("relabel", "any", {"any", "moving", "clustered"});
+    s.relabel_by = relabel == "moving"      ? coarse::SwitchOrder::By::moving
+                   : relabel == "clustered" ? coarse::SwitchOrder::By::light_neighbours
+                                            : coarse::SwitchOrder::By::any;
     // A node of the ICDF is the mean of two particles' heights: which particles of an interval
     // end as its lowest and highest light ones decides how far the lift misses it (the lift's
     // error is charged to the jump, docs/error_control.md §6). matched picks them; random is
@@ -119,10 +124,11 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
         s.lift_resolution =
             cpi.get_or<double>("lift_resolution", 0.1, Bounds::open_closed(0.0, 1.0));
     }
-    if (s.lift_by_positions && s.relabel_moving)
+    if (s.lift_by_positions && s.relabel_by != coarse::SwitchOrder::By::any)
         cpi.fail("relabel",
-                 "= moving chooses which labels a colour lift switches, and cpi.lift_by = "
-                 "positions switches none",
+                 "= " + relabel +
+                     " chooses which labels a colour lift switches, and cpi.lift_by = "
+                     "positions switches none",
                  "any with cpi.lift_by = positions, or cpi.lift_by = colours");
     if (s.lift_by_positions && s.carry_species_velocity)
         cpi.fail("relabel_velocity",

@@ -56,6 +56,7 @@
 #include <filesystem>
 #include <string>
 
+#include "coarse/demixing/colour_lifting.hpp"
 #include "coarse/equation_free/projective/cpi_settings.hpp"
 #include "coarse/equation_free/steady/steady_run_settings.hpp"
 #include "core/param_table.hpp"
@@ -106,9 +107,11 @@ struct RunSettings {
     /// cpi.at_rest = hold (default where the observable restricts members): a lift leaves the
     /// realizations at rest where they are; lift: every realization is lifted.
     bool hold_at_rest = false;
-    /// cpi.relabel = moving: the colour lift relabels each height interval's moving particles
-    /// first (ColourLifter); any (default): every candidate alike.
-    bool relabel_moving = false;
+    /// cpi.relabel: which of each height interval's particles the colour lift relabels first
+    /// (ColourLifter). any (default): every candidate alike; moving: the moving ones;
+    /// clustered: heavies among lights turn light, lights among heavies turn heavy
+    /// (coarse::SwitchOrder::By::light_neighbours).
+    coarse::SwitchOrder::By relabel_by = coarse::SwitchOrder::By::any;
     /// cpi.relabel_nodes = matched (default): the colour lift pins each ICDF node's defining
     /// ranks on the particles that meet it best (coarse::Relabel::at_nodes); random: every
     /// switch drawn at random (the fewest switches, the paper's lift).

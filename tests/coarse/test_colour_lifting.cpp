@@ -240,9 +240,10 @@ TEST_CASE("at_nodes with moving flags: still particles switch no more than at ra
         for (std::size_t j = 0; j < bed.z.size(); ++j)
             moving[j] = bed.z[j] > 25.0 || rng.uniform() < 0.2 ? 1 : 0;
         efdem::RandomStream a(41, trial, "lifting"), b(41, trial, "lifting");
-        const LiftResult nodes = lift_colours(target, bed.z, bed.colour, kGrid, a, moving);
+        const SwitchOrder order{SwitchOrder::By::moving, moving};
+        const LiftResult nodes = lift_colours(target, bed.z, bed.colour, kGrid, a, order);
         const LiftResult random =
-            lift_colours(target, bed.z, bed.colour, kGrid, b, moving, Relabel::random);
+            lift_colours(target, bed.z, bed.colour, kGrid, b, order, Relabel::random);
         INFO("trial " << trial);
         REQUIRE(nodes.status == LiftStatus::ok);
         CHECK(interval_light_counts(bed, nodes.colours, nodes.target) ==
@@ -257,6 +258,59 @@ TEST_CASE("at_nodes with moving flags: still particles switch no more than at ra
     }
     CHECK(still_nodes <= 1.05 * static_cast<double>(still_random));
     CHECK(off_nodes < 0.5 * off_random);
+}
+
+TEST_CASE("light_neighbours order: heavies among lights turn light, lone lights turn heavy",
+          "[unit][coarse]") {
+    // Each particle carries a light-neighbour count (0..12, random). With the random relabelling
+    // (Relabel::random, no pins) every interval must switch, of the colour it has too many of,
+    // the particles its order prefers: a heavy turned light has at least as many light
+    // neighbours as any heavy of its interval left heavy; a light turned heavy at most as many as
+    // any light kept. The counts per interval, and so n_changed, are those of the unordered lift.
+    efdem::RandomStream rng(50, 0, "test-lifting");
+    for (int trial = 0; trial < 10; ++trial) {
+        const Bed bed = random_bed(rng, 2000, 0.5);
+        const Labels s = demixed_labels(rng, bed, 0.5);
+        const Eigen::VectorXd target = quantiles(light_heights(bed, s), kGrid);
+        Labels neighbours(bed.z.size());
+        for (auto& c : neighbours) c = static_cast<std::uint8_t>(rng.below(13));
+        efdem::RandomStream a(51, trial, "lifting"), b(51, trial, "lifting");
+        const LiftResult ordered = lift_colours(
+            target, bed.z, bed.colour, kGrid, a,
+            SwitchOrder{SwitchOrder::By::light_neighbours, neighbours}, Relabel::random);
+        const LiftResult plain =
+            lift_colours(target, bed.z, bed.colour, kGrid, b, {}, Relabel::random);
+        INFO("trial " << trial);
+        REQUIRE(ordered.status == LiftStatus::ok);
+        CHECK(ordered.n_changed == plain.n_changed);
+        CHECK(ordered.n_changed > 200);  // a demixing target: hundreds of switches to order
+        CHECK(interval_light_counts(bed, ordered.colours, ordered.target) ==
+              interval_light_counts(bed, plain.colours, plain.target));
+        // Per interval: the fewest neighbours among heavies turned light, the most among heavies
+        // kept; the reverse for lights.
+        const auto m = static_cast<std::size_t>(ordered.target.size()) + 1;
+        std::vector<int> turned_light_min(m, 99), kept_heavy_max(m, -1);
+        std::vector<int> turned_heavy_max(m, -1), kept_light_min(m, 99);
+        const Eigen::VectorXd& cuts = ordered.target;
+        for (std::size_t j = 0; j < bed.z.size(); ++j) {
+            const auto k = static_cast<std::size_t>(
+                std::upper_bound(cuts.data(), cuts.data() + cuts.size(), bed.z[j]) - cuts.data());
+            const int c = neighbours[j];
+            if (bed.colour[j] != kLight && ordered.colours[j] == kLight)
+                turned_light_min[k] = std::min(turned_light_min[k], c);
+            if (bed.colour[j] != kLight && ordered.colours[j] != kLight)
+                kept_heavy_max[k] = std::max(kept_heavy_max[k], c);
+            if (bed.colour[j] == kLight && ordered.colours[j] != kLight)
+                turned_heavy_max[k] = std::max(turned_heavy_max[k], c);
+            if (bed.colour[j] == kLight && ordered.colours[j] == kLight)
+                kept_light_min[k] = std::min(kept_light_min[k], c);
+        }
+        for (std::size_t k = 0; k < m; ++k) {
+            INFO("interval " << k);
+            CHECK(turned_light_min[k] >= kept_heavy_max[k]);
+            CHECK(turned_heavy_max[k] <= kept_light_min[k]);
+        }
+    }
 }
 
 TEST_CASE("a target equal to the current ICDF changes no label", "[unit][coarse]") {

@@ -7,7 +7,7 @@
 # 1e-4; ordinary contacts in the fluidized bed reach a few 1e-4); asserted
 # <= 0.01, a tenth of the watchdog's limit, which a lift left unrelaxed (0.7-0.9) exceeds by far.
 # Also refused with exit 2 and the key named: colour lifting of unequal sizes, positions with a
-# fixed DT (a failed relaxation could not be redone), with cpi.relabel = moving and with
+# fixed DT (a failed relaxation could not be redone), with cpi.relabel = moving or clustered and with
 # cpi.relabel_velocity = species (both act on relabelled particles, which positions has none of).
 #   lift_by_positions.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 source "$(dirname "$0")/lib.sh" "$@"
@@ -77,5 +77,7 @@ grep -q "cpi.lift_by = positions" "$work/colours_two_sizes.log" || { echo "FAIL:
 refused fixed_dt "cpi.lift_by" cpi.lift_by=positions cpi.projection=fixed cpi.dt=2
 refused relabel_moving "cpi.relabel" cpi.lift_by=positions cpi.projection=adaptive cpi.tolerance=1 \
   cpi.relabel=moving
+refused relabel_clustered "cpi.relabel" cpi.lift_by=positions cpi.projection=adaptive \
+  cpi.tolerance=1 cpi.relabel=clustered
 refused relabel_velocity "cpi.relabel_velocity" cpi.lift_by=positions cpi.projection=adaptive \
   cpi.tolerance=1 cpi.relabel_velocity=species
