@@ -1,6 +1,7 @@
 #include "coarse/demixing/colour_lifting.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "coarse/demixing/node_pins.hpp"
@@ -34,8 +35,41 @@ std::uint8_t preference(const SwitchOrder& order, std::size_t j, bool to_light) 
             return order.values[j] ? 0 : 1;
         case SwitchOrder::By::light_neighbours:
             return to_light ? static_cast<std::uint8_t>(255 - order.values[j]) : order.values[j];
+        case SwitchOrder::By::like_lights:
+            return 0;  // drawn by weight (switch_like_lights) or uniformly
     }
     return 0;
+}
+
+/**
+ * SwitchOrder::By::like_lights, heavies turning light: `count` of the `candidates` (heavies)
+ * drawn without replacement with weights w(c) = P_L(c) / P_H(c), c a particle's light-neighbour
+ * count, P_L the distribution of c over `lights` (with half a light spread over the counts, so
+ * a count no light has keeps a small weight) and P_H over the candidates: the drawn heavies' counts
+ * are distributed as the lights' (exactly so for a draw with replacement). Efraimidis-Spirakis:
+ * each candidate's key log(u) / w, the `count` largest switch; deterministic for a stream state.
+ */
+void switch_like_lights(std::span<const std::size_t> candidates,
+                        std::span<const std::size_t> lights, Count count,
+                        std::span<const std::uint8_t> values, std::vector<std::uint8_t>& colours,
+                        RandomStream& rng) {
+    std::array<double, 256> p_light{}, p_heavy{};
+    int top = 0;
+    for (const std::size_t j : candidates) top = std::max<int>(top, values[j]);
+    for (const std::size_t j : lights) top = std::max<int>(top, values[j]);
+    // Half a light spread over the counts seen: a count no light has keeps a small weight.
+    for (int c = 0; c <= top; ++c) p_light[static_cast<std::size_t>(c)] = 0.5 / (top + 1);
+    for (const std::size_t j : lights) p_light[values[j]] += 1.0;
+    for (const std::size_t j : candidates) p_heavy[values[j]] += 1.0;
+    std::vector<std::pair<double, std::size_t>> keyed;
+    keyed.reserve(candidates.size());
+    for (const std::size_t j : candidates) {
+        const double w = p_light[values[j]] / p_heavy[values[j]];  // up to a common factor
+        keyed.emplace_back(std::log(std::max(rng.uniform(), 1e-300)) / w, j);
+    }
+    std::partial_sort(keyed.begin(), keyed.begin() + count, keyed.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (Count k = 0; k < count; ++k) colours[keyed[static_cast<std::size_t>(k)].second] ^= 1u;
 }
 
 /**
@@ -53,6 +87,13 @@ Count relabel_run(std::span<const std::size_t> members, std::size_t first, std::
     const Count excess = light - wanted;
     EFDEM_ASSERT(wanted >= 0 && wanted <= static_cast<Count>(last - first));
     if (excess == 0) return 0;
+    if (order.by == SwitchOrder::By::like_lights && excess < 0) {
+        std::vector<std::size_t> heavies, lights;
+        for (std::size_t p = first; p < last; ++p)
+            (colours[members[p]] == kLight ? lights : heavies).push_back(members[p]);
+        switch_like_lights(heavies, lights, -excess, order.values, out, rng);
+        return -excess;
+    }
     // The candidates by class (a counting sort: classes are bytes), index order within each.
     std::vector<std::pair<std::uint8_t, std::size_t>> candidates;
     for (std::size_t p = first; p < last; ++p) {

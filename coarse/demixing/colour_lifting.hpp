@@ -50,6 +50,12 @@ struct SwitchOrder {
         /// lift adds lights to the clusters a direct bed grows and takes away its isolated ones
         /// (bench/results/lift_clusters.md)
         light_neighbours,
+        /// `values` count light neighbours as for light_neighbours: the heavies turned light are
+        /// drawn with weights that give them the distribution of light-neighbour counts the
+        /// lights of their run of particles have (the new lights stand among lights as the
+        /// interval's lights do, neither alone nor in denser clusters); the lights turned heavy
+        /// at random (a uniform sample of the lights keeps their distribution)
+        like_lights,
     };
     By by = By::any;
     std::span<const std::uint8_t> values;  ///< one per particle, unless `by` is any
@@ -130,7 +136,9 @@ struct LiftResult {
  * that a bed whose lower part has come to rest is relabelled where it moves (cpi.relabel =
  * moving); at_nodes pins a still particle only if it is already light (or none other is in
  * reach). `light_neighbours`: heavies with the most light neighbours turn light first, lights
- * with the fewest turn heavy first (the pins as with `any`). The same interval counts whatever
+ * with the fewest turn heavy first (the pins as with `any`). `like_lights`: heavies drawn to turn
+ * light with the weights that match their light-neighbour counts to the lights' (Efraimidis-
+ * Spirakis keys), lights at random. The same interval counts whatever
  * the order, so the same n_changed and the same guarantees; only which particles switch differs.
  *
  * \pre heights.size() == colours.size(); colours in {kHeavy, kLight};

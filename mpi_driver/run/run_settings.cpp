@@ -94,11 +94,15 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // Where a bed has partly come to rest, a relabelling there kicks it back into motion
     // (bench/lift_restart.py): moving relabels the moving particles of each height interval first.
     // In a segregating bed the lights gather with lights (bench/results/lift_clusters.md):
-    // clustered adds lights where lights are and takes away the isolated ones.
-    const std::string relabel = cpi.get_or_choice("relabel", "any", {"any", "moving", "clustered"});
-    s.relabel_by = relabel == "moving"      ? coarse::SwitchOrder::By::moving
-                   : relabel == "clustered" ? coarse::SwitchOrder::By::light_neighbours
-                                            : coarse::SwitchOrder::By::any;
+    // clustered adds lights where lights are and takes away the isolated ones (it overshoots:
+    // the lifted beds then rise faster than the direct ones); like_lights draws the new lights
+    // with the neighbourhoods the interval's lights have.
+    const std::string relabel =
+        cpi.get_or_choice("relabel", "any", {"any", "moving", "clustered", "like_lights"});
+    s.relabel_by = relabel == "moving"        ? coarse::SwitchOrder::By::moving
+                   : relabel == "clustered"   ? coarse::SwitchOrder::By::light_neighbours
+                   : relabel == "like_lights" ? coarse::SwitchOrder::By::like_lights
+                                              : coarse::SwitchOrder::By::any;
     // A node of the ICDF is the mean of two particles' heights: which particles of an interval
     // end as its lowest and highest light ones decides how far the lift misses it (the lift's
     // error is charged to the jump, docs/error_control.md §6). matched picks them; random is

@@ -313,6 +313,56 @@ TEST_CASE("light_neighbours order: heavies among lights turn light, lone lights 
     }
 }
 
+TEST_CASE(
+    "like_lights order: the new lights' light-neighbour counts are distributed as the lights'",
+    "[unit][coarse]") {
+    // Lights carry counts uniform on 6..12 (mean 9), heavies on 0..12 (mean 6). The target: the
+    // light ICDF 0.5 d_p higher, the size of a CPI jump's move (each interval of ~100 particles
+    // switches ~10). A random draw of heavies gives new lights of mean 6; like_lights weights a
+    // heavy of count c by P_light(c) / P_heavy(c), ~0 below 6 and equal above: its draws are
+    // uniform on 6..12, mean 9, less what drawing without replacement takes where an interval
+    // has few such heavies to spare (measured: 8.92 against the lights' 9.00, random 6.23; 0.7
+    // is the margin). The lights turned heavy: a uniform sample of the lights, mean 9 within 0.7
+    // as well. Relabel::random: with at_nodes the nodes' pins (2 per node, here a third of the
+    // switches) are chosen by height, not count.
+    efdem::RandomStream rng(52, 0, "test-lifting");
+    double drawn = 0.0, random = 0.0, lights = 0.0, removed = 0.0;
+    long n_drawn = 0, n_random = 0, n_lights = 0, n_removed = 0;
+    for (int trial = 0; trial < 10; ++trial) {
+        const Bed bed = random_bed(rng, 2000, 0.5);
+        const Eigen::VectorXd target =
+            (quantiles(light_heights(bed, bed.colour), kGrid).array() + 0.5).matrix();
+        Labels counts(bed.z.size());
+        for (std::size_t j = 0; j < bed.z.size(); ++j)
+            counts[j] = static_cast<std::uint8_t>(bed.colour[j] == kLight ? 6 + rng.below(7)
+                                                                          : rng.below(13));
+        efdem::RandomStream a(53, trial, "lifting"), b(53, trial, "lifting");
+        const LiftResult like =
+            lift_colours(target, bed.z, bed.colour, kGrid, a,
+                         SwitchOrder{SwitchOrder::By::like_lights, counts}, Relabel::random);
+        const LiftResult plain =
+            lift_colours(target, bed.z, bed.colour, kGrid, b, {}, Relabel::random);
+        REQUIRE(like.status == LiftStatus::ok);
+        CHECK(interval_light_counts(bed, like.colours, like.target) ==
+              interval_light_counts(bed, plain.colours, plain.target));
+        for (std::size_t j = 0; j < bed.z.size(); ++j) {
+            if (bed.colour[j] == kLight) lights += counts[j], ++n_lights;
+            if (bed.colour[j] != kLight && like.colours[j] == kLight) drawn += counts[j], ++n_drawn;
+            if (bed.colour[j] == kLight && like.colours[j] != kLight)
+                removed += counts[j], ++n_removed;
+            if (bed.colour[j] != kLight && plain.colours[j] == kLight)
+                random += counts[j], ++n_random;
+        }
+    }
+    REQUIRE(n_drawn > 400);  // 40+ switches per lift: the means below are to ~0.15
+    INFO("new lights' mean count: like_lights "
+         << drawn / n_drawn << ", random " << random / n_random << "; lights " << lights / n_lights
+         << ", removed " << removed / n_removed);
+    CHECK(random / n_random == Approx(6.0).margin(0.4));
+    CHECK(drawn / n_drawn == Approx(lights / n_lights).margin(0.7));
+    CHECK(removed / n_removed == Approx(lights / n_lights).margin(0.7));
+}
+
 TEST_CASE("a target equal to the current ICDF changes no label", "[unit][coarse]") {
     efdem::RandomStream rng(32, 0, "test-lifting");
     for (std::size_t n : {10u, 31u, 100u, 1000u, 10000u, 100000u}) {
