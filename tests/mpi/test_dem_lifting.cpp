@@ -431,6 +431,11 @@ TEST_CASE(
     const auto counts = coarse::light_neighbour_counts(column.particles(), column.domain(), 0);
     CHECK(std::equal(counts.begin(), counts.end(),
                      in_clustered.bytes.begin() + static_cast<long>(n)));
+    // like_lights sends the same counts.
+    const DemRealization like(make_column(), 0, 1, RealizationOutput{}, false, std::nullopt,
+                              RealizationLift{false, false, coarse::SwitchOrder::By::like_lights});
+    const LiftPayload in_like = like.lift_input();
+    CHECK(std::equal(counts.begin(), counts.end(), in_like.bytes.begin() + static_cast<long>(n)));
     RandomStream a(7, 0, "lift"), b(7, 0, "lift");
     const LiftOutcome out_any = ColourLifter().lift(target, in_any, grid, a);
     const LiftOutcome out_clustered =
