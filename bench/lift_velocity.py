@@ -37,7 +37,6 @@ import whole_process as wp  # noqa: E402
 
 LOWER = slice(0, 6)  # nodes p = 0.05 .. 0.30 of the 19-node grid
 SPAN = (100.0, 320.0)
-EARLY = wp.GRID  # one grid interval of the reductions
 
 
 def slip_table(paths):
@@ -61,26 +60,25 @@ def slip_table(paths):
 
 
 def load(folder, name):
-    """A run's grid times and ensemble-mean ICDF, from its reduction (whole_process.py)."""
+    """A run's grid times, ensemble-mean ICDF and burst index runs, from its reduction
+    (whole_process.py)."""
     with open(os.path.join(folder, name + ".json")) as f:
         run = wp.from_reduction(json.load(f))
-    return run["t"], run["mean"]
+    return run["t"], run["mean"], bursts(run["t_all"], run["t"])
 
 
-def bursts(t):
-    """Index runs of consecutive grid samples (a jump leaves a gap longer than one interval)."""
-    out, cur = [], [0]
-    for i in range(1, len(t)):
-        if t[i] - t[i - 1] > EARLY + 1e-6:
-            out.append(cur)
-            cur = [i]
-        else:
-            cur.append(i)
-    out.append(cur)
-    return out
+def bursts(t_all, t):
+    """The grid samples T in runs of one burst each: a jump leaves a gap in the full sample times
+    T_ALL longer than their spacing (a jump of a few units may not leave one on the grid)."""
+    spacing = float(np.median(np.diff(t_all)))
+    starts = t_all[np.r_[0, np.nonzero(np.diff(t_all) > 1.5 * spacing)[0] + 1]]
+    which = np.searchsorted(starts, t + 1e-9, side="right") - 1
+    return [list(np.nonzero(which == k)[0]) for k in range(len(starts)) if np.any(which == k)]
 
 
-def deficit_table(folder, runs):
+def deficit_table(folder, runs, runs_folder=None):
+    """FOLDER: the case with the direct ensembles; RUNS_FOLDER (default FOLDER): the CPI runs'."""
+    runs_folder = runs_folder or folder
     directs = [load(folder, n) for n in ("direct_a", "direct_b", "direct_c")]
     td = directs[0][0]
     dmean = np.mean([d[1] for d in directs], axis=0)
@@ -95,12 +93,12 @@ def deficit_table(folder, runs):
              "direct_a - direct_b, first 5 / rest (noise) |",
              "|---|---|---|---|---|---|"]
     for name in runs:
-        if not os.path.exists(os.path.join(folder, name + ".json")):
+        if not os.path.exists(os.path.join(runs_folder, name + ".json")):
             lines.append(f"| {name} | (no reduction yet) | | | | |")
             continue
-        t, x = load(folder, name)
+        t, x, runs_of = load(runs_folder, name)
         early, late, noise_e, noise_l, ref = [], [], [], [], []
-        for b in bursts(t)[1:]:  # the first stretch is the warm-up's direct run
+        for b in runs_of[1:]:  # the first stretch is the warm-up's direct run
             if len(b) < 3 or t[b[0]] < SPAN[0] or t[b[-1]] > SPAN[1]:
                 continue
             i0, i1, i2 = b[0], b[1], b[-1]

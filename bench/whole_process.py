@@ -103,6 +103,10 @@ TALL_WAVES = {
     # lift, -0.013 after): ranks_tol_counts with 8 units of healing, so that the slope is fitted
     # after most of it (the burst 8 + 20)
     "ranks_heal8": {**WAVES, "cpi.tolerance": 0.64, "cpi.healing": 8},
+    # the lights of a direct bed gather with lights (bench/results/lift_clusters.md) and a random
+    # relabelling puts new lights among heavies, alone: ranks_tol_counts with the lift adding
+    # lights where lights are and taking away the lone ones
+    "ranks_clustered": {**WAVES, "cpi.tolerance": 0.64, "cpi.relabel": "clustered"},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own). The R = 4 cases of
 # the tall bed run no direct ensembles of their own: each R = 8 direct ensemble of the same bed and
@@ -145,18 +149,22 @@ def halves(run, realizations):
 
 
 def make(args, case):
-    results = os.path.join(args.results, case)
-    work = os.path.join(args.out, case)
-    scene = os.path.join(HERE, "scenes", CASES[case][0])
-    for name, (mode, overrides) in runs_of(case).items():
-        if args.only and name not in args.only:
+    make_runs(args.efdem, os.path.join(HERE, "scenes", CASES[case][0]), runs_of(case),
+              os.path.join(args.results, case), os.path.join(args.out, case), args.only, case)
+
+
+def make_runs(efdem, scene, runs, results, work, only=None, label=""):
+    """Each run of RUNS (name -> (mode, overrides)) not in ONLY's exclusion whose reduction is not
+    in RESULTS yet: made (or continued) in WORK, archived and reduced into RESULTS."""
+    for name, (mode, overrides) in runs.items():
+        if only and name not in only:
             continue
         if os.path.exists(os.path.join(results, name + ".json")):
-            print(f"  {case}/{name}: done before (its reduction is there), skipped", flush=True)
+            print(f"  {label}/{name}: done before (its reduction is there), skipped", flush=True)
             continue
         archive = os.path.join(results, name + ".h5")
-        if sr.ensure(os.path.abspath(args.efdem), 2, scene, work, name, mode, overrides, archive,
-                     label=f"{case}/{name}"):
+        if sr.ensure(os.path.abspath(efdem), 2, scene, work, name, mode, overrides, archive,
+                     label=f"{label}/{name}"):
             write_reduction(archive, os.path.join(results, name + ".json"))
 
 
