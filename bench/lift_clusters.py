@@ -19,8 +19,11 @@ lights with the fewest turn heavy), and the new lights' light-neighbour fraction
     /usr/bin/python3 bench/lift_clusters.py CHECKPOINT... --out bench/results/lift_clusters.md
 
 The checkpoints of bench/results/lift_clusters.md (run files not in git): the demo bed at U_s =
-0.41 (the commands in bench/lift_velocity.py), the tall bed at 0.41 from the direct warm-up of
-bench/null_lift.py (its run folder runs/null_lift/members_dt3/, checkpoints at t = 66 and on).
+0.41 (runs/transient_lift/, the command in bench/lift_velocity.py), and the tall bed at 0.41 from
+the runs of bench/null_lift.py, copied to runs/lift_clusters/ before a run replaces them:
+tall_direct_warmup.h5 = mean_dt3_like's first checkpoint (t = 44, inside its direct warm-up),
+tall_mean_dt3_step7.h5 and tall_mean_dt3_clustered_step7.h5 = mean_dt3's and mean_dt3_clustered's
+checkpoint 7 (t = 275, after seven lifts without a jump, random and clustered relabelling).
 """
 import argparse
 import re
