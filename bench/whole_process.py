@@ -107,6 +107,9 @@ TALL_WAVES = {
     # relabelling puts new lights among heavies, alone: ranks_tol_counts with the lift adding
     # lights where lights are and taking away the lone ones
     "ranks_clustered": {**WAVES, "cpi.tolerance": 0.64, "cpi.relabel": "clustered"},
+    # clustered overshot (2.13 floors, the lower nodes 2 d_p ahead at t = 300: the lifted beds
+    # more clustered than the direct ones); the new lights with the lights' own neighbourhoods
+    "ranks_like": {**WAVES, "cpi.tolerance": 0.64, "cpi.relabel": "like_lights"},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own). The R = 4 cases of
 # the tall bed run no direct ensembles of their own: each R = 8 direct ensemble of the same bed and
