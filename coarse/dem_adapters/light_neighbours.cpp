@@ -38,10 +38,11 @@ std::vector<std::uint8_t> light_neighbour_counts(const dem::Particles& particles
     };
     // The observed particles by cell (counting sort).
     std::vector<std::size_t> start(static_cast<std::size_t>(nx) * ny * nz + 1, 0);
+    std::vector<std::array<int, 3>> where(n);
     std::vector<std::size_t> cell(n);
     for (std::size_t a = 0; a < n; ++a) {
-        const auto c = cell_of(x[a]);
-        cell[a] = flat(c[0], c[1], c[2]);
+        where[a] = cell_of(x[a]);
+        cell[a] = flat(where[a][0], where[a][1], where[a][2]);
         if (species[a] == observed) ++start[cell[a] + 1];
     }
     for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
@@ -51,10 +52,11 @@ std::vector<std::uint8_t> light_neighbour_counts(const dem::Particles& particles
         for (std::size_t a = 0; a < n; ++a)
             if (species[a] == observed) members[fill[cell[a]]++] = a;
     }
+    std::vector<std::size_t> near;
     for (std::size_t a = 0; a < n; ++a) {
-        const auto c = cell_of(x[a]);
+        const auto& c = where[a];
         // The distinct neighbour cells (a box of fewer than 3 cells wraps onto itself).
-        std::vector<std::size_t> near;
+        near.clear();
         for (int dk = -1; dk <= 1; ++dk) {
             const int k = c[2] + dk;
             if (k < 0 || k >= nz) continue;
