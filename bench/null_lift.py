@@ -18,7 +18,8 @@ reduction committed), skipped when there.
     /usr/bin/python3 bench/null_lift.py --efdem build/mpi_driver/efdem      # make what is missing
     /usr/bin/python3 bench/null_lift.py --analyse-only
 
-Cost (AMD EPYC, 2 cores): about 15 min a run.
+Cost (AMD EPYC, 2 cores): 27-33 min a run beside another study (2026-12-06); the warm-up to t = 100
+is a third of it.
 """
 import argparse
 import json
