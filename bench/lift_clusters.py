@@ -10,11 +10,13 @@ the top 30 %). Against the same with the labels shuffled within 0.5-d_p height s
 shuffles): the composition profile kept to 0.5 d_p, the arrangement at random. A ratio above 1:
 lights gather with lights.
 
-Then a lift of each checkpoint's realizations done here, in Python, as the colour lift does it
+Then lifts of each checkpoint's realizations done here, in Python, as the colour lift does it
 (each 0.5-d_p slice of the lowest 30 % of the lights' range gains or loses as many lights as
 a shift of the light ranks by SHIFT d_p asks; the fewest switches, drawn at random (cpi.relabel =
 any) or by light neighbours (clustered: heavies with the most light neighbours turn light,
-lights with the fewest turn heavy), and the new lights' light-neighbour fraction.
+lights with the fewest turn heavy), and the new lights' light-neighbour fraction; and a one-way
+lift (SHIFT = 1.5: the lower lights up, as a CPI jump moves them, so their slices lose lights):
+what each removal leaves of the remaining lights' light-neighbour fraction.
 
     /usr/bin/python3 bench/lift_clusters.py CHECKPOINT... --out bench/results/lift_clusters.md
 
@@ -123,12 +125,17 @@ def main():
     ap.add_argument("--out")
     args = ap.parse_args()
     rng = np.random.default_rng(1)
+    rng_oneway = np.random.default_rng(3)  # its own stream: sections 1-3 as without section 4
     lines = [f"Made by `/usr/bin/python3 bench/lift_clusters.py {' '.join(sys.argv[1:])}`.", "",
              "## 1. The lights' neighbours: the light fraction, direct against shuffled in 0.5-d_p slices", "",
              "| checkpoint | t | realizations | lights | light fraction of neighbours | shuffled | ratio |",
              "|---|---|---|---|---|---|---|"]
     lifted = ["", f"## 2. A lift of the lowest 30 % of the lights by {args.shift:g} d_p: the new lights' light fraction of neighbours", "",
               "| checkpoint | t | new lights per realization | random (any) | clustered | the lights already there |",
+              "|---|---|---|---|---|---|"]
+    oneway = ["", "## 4. A one-way lift, as a jump's: the lower lights up by 1.5 d_p (their slices lose lights); "
+              "the light fraction of the neighbours of the lowest 30 % of the lights that stay light", "",
+              "| checkpoint | t | lights removed per realization | before | random (any) | clustered (lone lights first) |",
               "|---|---|---|---|---|---|"]
     velocity = ["", "## 3. The lowest 30 % of the lights: vertical velocity [sqrt(g d_p)] less the mean of those in "
                 "its 1-d_p slice, by the light fraction of its neighbours (mean +- standard error (lights))", "",
@@ -139,6 +146,7 @@ def main():
         rows = {name: ([], []) for name, _, _ in RANGES}
         new = {"any": [], "clustered": [], "native": [], "count": []}
         speed = []
+        stay = {"any": [], "clustered": [], "removed": []}
         for t, x, light, vz in reals:
             p = pairs(x, lx)
             for name, lo, hi in RANGES:
@@ -151,6 +159,10 @@ def main():
             who, _ = rank_range(x, light, 0.0, 0.3)
             new["native"].append(light_fraction(p, light.astype(float), who))
             new["count"].append(int(turned.sum()))
+            for how in ("any", "clustered"):
+                lab, _ = lift(x, light, p, 1.5, how, rng_oneway)
+                stay[how].append(light_fraction(p, lab.astype(float), who & lab))
+            stay["removed"].append(int((light & ~lab).sum()))
             # each lower light's v_z less the mean of the lower lights in its 1-d_p slice
             frac = light_neighbours(p, light.astype(float)) / np.maximum(neighbour_counts(p, len(light)), 1)
             slab = np.floor(x[:, 2]).astype(int)
@@ -167,9 +179,11 @@ def main():
         velocity.append(f"| {name_} | {reals[0][0]:.0f} | " + " | ".join(
             f"{c.mean():+.3f} +- {c.std(ddof=1) / np.sqrt(len(c)):.3f} ({len(c)})" for c in cells) +
             f" | {np.corrcoef(a[:, 0], a[:, 1])[0, 1]:.2f} |")
+        oneway.append(f"| {name_} | {reals[0][0]:.0f} | {np.mean(stay['removed']):.0f} | {np.mean(new['native']):.3f} | "
+                      f"{np.mean(stay['any']):.3f} | {np.mean(stay['clustered']):.3f} |")
         lifted.append(f"| {name_} | {reals[0][0]:.0f} | {np.mean(new['count']):.0f} | {np.mean(new['any']):.3f} | "
                       f"{np.mean(new['clustered']):.3f} | {np.mean(new['native']):.3f} |")
-    text = "\n".join(lines + lifted + velocity) + "\n"
+    text = "\n".join(lines + lifted + velocity + oneway) + "\n"
     print(text)
     if args.out:
         with open(args.out, "w") as f:
