@@ -110,6 +110,10 @@ TALL_WAVES = {
     # clustered overshot (2.13 floors, the lower nodes 2 d_p ahead at t = 300: the lifted beds
     # more clustered than the direct ones); the new lights with the lights' own neighbourhoods
     "ranks_like": {**WAVES, "cpi.tolerance": 0.64, "cpi.relabel": "like_lights"},
+    # ranks_like's first bursts after a lift were as slow as the random relabelling's: a jump's
+    # lifts mostly remove lights from the lower bed, and like_lights removes them at random;
+    # keep_clusters removes the lone lights first (bench/results/lift_clusters.md section 4)
+    "ranks_keep": {**WAVES, "cpi.tolerance": 0.64, "cpi.relabel": "keep_clusters"},
 }
 # case: scene, U_s, duration, R, the CPI runs (name: keys beyond the case's own). The R = 4 cases of
 # the tall bed run no direct ensembles of their own: each R = 8 direct ensemble of the same bed and

@@ -36,7 +36,9 @@ std::uint8_t preference(const SwitchOrder& order, std::size_t j, bool to_light) 
         case SwitchOrder::By::light_neighbours:
             return to_light ? static_cast<std::uint8_t>(255 - order.values[j]) : order.values[j];
         case SwitchOrder::By::like_lights:
-            return 0;  // drawn by weight (switch_like_lights) or uniformly
+            return 0;                         // drawn by weight (switch_like_lights) or uniformly
+        case SwitchOrder::By::keep_clusters:  // turning light: by weight (switch_like_lights)
+            return to_light ? 0 : order.values[j];
     }
     return 0;
 }
@@ -87,7 +89,8 @@ Count relabel_run(std::span<const std::size_t> members, std::size_t first, std::
     const Count excess = light - wanted;
     EFDEM_ASSERT(wanted >= 0 && wanted <= static_cast<Count>(last - first));
     if (excess == 0) return 0;
-    if (order.by == SwitchOrder::By::like_lights && excess < 0) {
+    if ((order.by == SwitchOrder::By::like_lights || order.by == SwitchOrder::By::keep_clusters) &&
+        excess < 0) {
         std::vector<std::size_t> heavies, lights;
         for (std::size_t p = first; p < last; ++p)
             (colours[members[p]] == kLight ? lights : heavies).push_back(members[p]);

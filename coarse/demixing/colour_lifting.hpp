@@ -56,6 +56,11 @@ struct SwitchOrder {
         /// interval's lights do, neither alone nor in denser clusters); the lights turned heavy
         /// at random (a uniform sample of the lights keeps their distribution)
         like_lights,
+        /// like_lights' draw of the heavies turned light, light_neighbours' order of the lights
+        /// turned heavy (the fewest light neighbours first): a lift that moves lights up (a
+        /// CPI jump's, its lower intervals losing lights) removes the lone ones and leaves the
+        /// clusters whole, and adds lights as the interval's lights stand
+        keep_clusters,
     };
     By by = By::any;
     std::span<const std::uint8_t> values;  ///< one per particle, unless `by` is any

@@ -96,13 +96,16 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
     // In a segregating bed the lights gather with lights (bench/results/lift_clusters.md):
     // clustered adds lights where lights are and takes away the isolated ones (it overshoots:
     // the lifted beds then rise faster than the direct ones); like_lights draws the new lights
-    // with the neighbourhoods the interval's lights have.
-    const std::string relabel =
-        cpi.get_or_choice("relabel", "any", {"any", "moving", "clustered", "like_lights"});
-    s.relabel_by = relabel == "moving"        ? coarse::SwitchOrder::By::moving
-                   : relabel == "clustered"   ? coarse::SwitchOrder::By::light_neighbours
-                   : relabel == "like_lights" ? coarse::SwitchOrder::By::like_lights
-                                              : coarse::SwitchOrder::By::any;
+    // with the neighbourhoods the interval's lights have; keep_clusters adds them so and removes
+    // the lone lights first (a jump's lifts mostly remove lights from the lower bed, and a random
+    // removal thins its clusters: bench/results/lift_clusters.md section 4).
+    const std::string relabel = cpi.get_or_choice(
+        "relabel", "any", {"any", "moving", "clustered", "like_lights", "keep_clusters"});
+    s.relabel_by = relabel == "moving"          ? coarse::SwitchOrder::By::moving
+                   : relabel == "clustered"     ? coarse::SwitchOrder::By::light_neighbours
+                   : relabel == "like_lights"   ? coarse::SwitchOrder::By::like_lights
+                   : relabel == "keep_clusters" ? coarse::SwitchOrder::By::keep_clusters
+                                                : coarse::SwitchOrder::By::any;
     // A node of the ICDF is the mean of two particles' heights: which particles of an interval
     // end as its lowest and highest light ones decides how far the lift misses it (the lift's
     // error is charged to the jump, docs/error_control.md §6). matched picks them; random is

@@ -363,6 +363,55 @@ TEST_CASE(
     CHECK(removed / n_removed == Approx(lights / n_lights).margin(0.7));
 }
 
+TEST_CASE("keep_clusters order: new lights as like_lights, the lone lights removed first",
+          "[unit][coarse]") {
+    // The beds and counts of the like_lights case (lights 6..12, heavies 0..12). Against
+    // like_lights with the same stream: the same counts; the lights turned heavy are, in each
+    // run of particles, those with the fewest light neighbours (no light kept has fewer than one
+    // removed from its interval), and the new lights' mean count stays the lights' within 0.7.
+    efdem::RandomStream rng(52, 0, "test-lifting");
+    double drawn = 0.0, lights = 0.0;
+    long n_drawn = 0, n_lights = 0;
+    for (int trial = 0; trial < 10; ++trial) {
+        const Bed bed = random_bed(rng, 2000, 0.5);
+        const Eigen::VectorXd target =
+            (quantiles(light_heights(bed, bed.colour), kGrid).array() + 0.5).matrix();
+        Labels counts(bed.z.size());
+        for (std::size_t j = 0; j < bed.z.size(); ++j)
+            counts[j] = static_cast<std::uint8_t>(bed.colour[j] == kLight ? 6 + rng.below(7)
+                                                                          : rng.below(13));
+        efdem::RandomStream a(53, trial, "lifting"), b(53, trial, "lifting");
+        const LiftResult keep =
+            lift_colours(target, bed.z, bed.colour, kGrid, a,
+                         SwitchOrder{SwitchOrder::By::keep_clusters, counts}, Relabel::random);
+        const LiftResult like =
+            lift_colours(target, bed.z, bed.colour, kGrid, b,
+                         SwitchOrder{SwitchOrder::By::like_lights, counts}, Relabel::random);
+        REQUIRE(keep.status == LiftStatus::ok);
+        CHECK(interval_light_counts(bed, keep.colours, keep.target) ==
+              interval_light_counts(bed, like.colours, like.target));
+        const auto m = static_cast<std::size_t>(keep.target.size()) + 1;
+        std::vector<int> removed_max(m, -1), kept_min(m, 99);
+        const Eigen::VectorXd& cuts = keep.target;
+        for (std::size_t j = 0; j < bed.z.size(); ++j) {
+            const auto k = static_cast<std::size_t>(
+                std::upper_bound(cuts.data(), cuts.data() + cuts.size(), bed.z[j]) - cuts.data());
+            if (bed.colour[j] == kLight) {
+                lights += counts[j], ++n_lights;
+                if (keep.colours[j] == kLight)
+                    kept_min[k] = std::min<int>(kept_min[k], counts[j]);
+                else
+                    removed_max[k] = std::max<int>(removed_max[k], counts[j]);
+            } else if (keep.colours[j] == kLight) {
+                drawn += counts[j], ++n_drawn;
+            }
+        }
+        for (std::size_t k = 0; k < m; ++k) CHECK(removed_max[k] <= kept_min[k]);
+    }
+    REQUIRE(n_drawn > 400);
+    CHECK(drawn / n_drawn == Approx(lights / n_lights).margin(0.7));
+}
+
 TEST_CASE("a target equal to the current ICDF changes no label", "[unit][coarse]") {
     efdem::RandomStream rng(32, 0, "test-lifting");
     for (std::size_t n : {10u, 31u, 100u, 1000u, 10000u, 100000u}) {
