@@ -89,15 +89,14 @@ Count relabel_run(std::span<const std::size_t> members, std::size_t first, std::
     const Count excess = light - wanted;
     EFDEM_ASSERT(wanted >= 0 && wanted <= static_cast<Count>(last - first));
     if (excess == 0) return 0;
-    if ((order.by == SwitchOrder::By::like_lights || order.by == SwitchOrder::By::keep_clusters) &&
-        excess < 0) {
+    if (SwitchOrder::draws_like_lights(order.by) && excess < 0) {
         std::vector<std::size_t> heavies, lights;
         for (std::size_t p = first; p < last; ++p)
             (colours[members[p]] == kLight ? lights : heavies).push_back(members[p]);
         switch_like_lights(heavies, lights, -excess, order.values, out, rng);
         return -excess;
     }
-    // The candidates by class (a counting sort: classes are bytes), index order within each.
+    // The candidates by class (a stable sort on the class byte), index order within each.
     std::vector<std::pair<std::uint8_t, std::size_t>> candidates;
     for (std::size_t p = first; p < last; ++p) {
         const std::size_t j = members[p];

@@ -64,6 +64,15 @@ struct SwitchOrder {
     };
     By by = By::any;
     std::span<const std::uint8_t> values;  ///< one per particle, unless `by` is any
+
+    /// Whether `by` reads light-neighbour counts (else moving flags, or nothing).
+    static constexpr bool reads_light_neighbours(By by) {
+        return by == By::light_neighbours || by == By::like_lights || by == By::keep_clusters;
+    }
+    /// Whether `by` draws the heavies it turns light by weight (switch_like_lights).
+    static constexpr bool draws_like_lights(By by) {
+        return by == By::like_lights || by == By::keep_clusters;
+    }
 };
 
 struct LiftResult {

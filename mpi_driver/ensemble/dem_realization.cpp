@@ -71,9 +71,7 @@ LiftPayload DemRealization::lift_input() const {
     auto hc = coarse::heights_and_colours(p, observed_);
     // Then one byte per particle that ColourLifter orders the switches by (cpi.relabel).
     std::vector<std::uint8_t> bytes = std::move(hc.colours);
-    if (lift_.switch_by == coarse::SwitchOrder::By::light_neighbours ||
-        lift_.switch_by == coarse::SwitchOrder::By::like_lights ||
-        lift_.switch_by == coarse::SwitchOrder::By::keep_clusters) {
+    if (coarse::SwitchOrder::reads_light_neighbours(lift_.switch_by)) {
         const auto counts = coarse::light_neighbour_counts(p, system_.domain(), observed_);
         bytes.insert(bytes.end(), counts.begin(), counts.end());
     } else {

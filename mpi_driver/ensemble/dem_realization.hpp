@@ -39,8 +39,8 @@ struct RealizationLift {
     /// velocity to its new species' local mean (carry_species_velocity).
     bool carry_velocity = false;
     /// cpi.relabel: what lift_input sends after the colours, the values ColourLifter orders the
-    /// switches by: moving flags (any, moving) or light-neighbour counts (light_neighbours,
-    /// like_lights).
+    /// switches by: light-neighbour counts where the order reads them
+    /// (SwitchOrder::reads_light_neighbours), else moving flags.
     coarse::SwitchOrder::By switch_by = coarse::SwitchOrder::By::any;
 };
 
@@ -69,10 +69,9 @@ class DemRealization final : public Realization {
     /// 0.1-0.2 s of one core, well inside Open MPI's 1 s between its SIGTERM and SIGKILL.
     static constexpr long kStopCheckSteps = 100;
     Observation observe(const coarse::ProbabilityGrid& grid, ReferenceNeeds needs) const override;
-    /// Colours: heights (reals), colours then one byte per particle (bytes): its moving flag, or
-    /// with RealizationLift::switch_by = light_neighbours or like_lights its light-neighbour
-    /// count. Positions: x,
-    /// y, z of every particle then its velocity (reals), colours (bytes).
+    /// Colours: heights (reals), colours then one byte per particle (bytes): its light-neighbour
+    /// count where RealizationLift::switch_by reads them, else its moving flag. Positions: x, y,
+    /// z of every particle then its velocity (reals), colours (bytes).
     LiftPayload lift_input() const override;
     std::pair<std::size_t, std::size_t> lift_output_sizes() const override;
     /// Colours: the new labels. Positions: new positions and velocities (reals), one moved flag

@@ -111,7 +111,8 @@ struct RunSettings {
     /// (ColourLifter). any (default): every candidate alike; moving: the moving ones;
     /// clustered: heavies among lights turn light, lights among heavies turn heavy
     /// (coarse::SwitchOrder::By::light_neighbours); like_lights: new lights drawn with the
-    /// lights' neighbourhoods (coarse::SwitchOrder::By::like_lights).
+    /// lights' neighbourhoods (coarse::SwitchOrder::By::like_lights); keep_clusters: those new
+    /// lights, the lone lights removed first (coarse::SwitchOrder::By::keep_clusters).
     coarse::SwitchOrder::By relabel_by = coarse::SwitchOrder::By::any;
     /// cpi.relabel_nodes = matched (default): the colour lift pins each ICDF node's defining
     /// ranks on the particles that meet it best (coarse::Relabel::at_nodes); random: every

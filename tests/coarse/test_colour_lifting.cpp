@@ -60,14 +60,37 @@ Labels demixed_labels(efdem::RandomStream& rng, const Bed& bed, double noise) {
 }
 
 /// Light particles per interval I_0..I_m of the cuts (interval = number of cuts <= z).
+/// The interval of height z among the cuts: 0 below the first, cuts.size() above the last.
+std::size_t interval_of(const Eigen::VectorXd& cuts, double z) {
+    return static_cast<std::size_t>(std::upper_bound(cuts.data(), cuts.data() + cuts.size(), z) -
+                                    cuts.data());
+}
+
 std::vector<long> interval_light_counts(const Bed& bed, const Labels& colour,
                                         const Eigen::VectorXd& cuts) {
     std::vector<long> count(static_cast<std::size_t>(cuts.size()) + 1, 0);
     for (std::size_t j = 0; j < bed.z.size(); ++j)
-        if (colour[j] == kLight)
-            ++count[static_cast<std::size_t>(
-                std::upper_bound(cuts.data(), cuts.data() + cuts.size(), bed.z[j]) - cuts.data())];
+        if (colour[j] == kLight) ++count[interval_of(cuts, bed.z[j])];
     return count;
+}
+
+/// The beds of the like_lights and keep_clusters cases: random (half light), the target its light
+/// ICDF 0.5 d_p higher (a CPI jump's move: each interval of ~100 particles switches ~10), and
+/// light-neighbour counts uniform on 6..12 (mean 9) for the lights, 0..12 (mean 6) for the heavies.
+struct CountedBed {
+    Bed bed;
+    Eigen::VectorXd target;
+    Labels counts;
+};
+
+CountedBed counted_bed(efdem::RandomStream& rng) {
+    CountedBed c{random_bed(rng, 2000, 0.5), {}, {}};
+    c.target = (quantiles(light_heights(c.bed, c.bed.colour), kGrid).array() + 0.5).matrix();
+    c.counts.resize(c.bed.z.size());
+    for (std::size_t j = 0; j < c.bed.z.size(); ++j)
+        c.counts[j] =
+            static_cast<std::uint8_t>(c.bed.colour[j] == kLight ? 6 + rng.below(7) : rng.below(13));
+    return c;
 }
 
 long differing(const Labels& a, const Labels& b) {
@@ -293,8 +316,7 @@ TEST_CASE("light_neighbours order: heavies among lights turn light, lone lights 
         std::vector<int> turned_heavy_max(m, -1), kept_light_min(m, 99);
         const Eigen::VectorXd& cuts = ordered.target;
         for (std::size_t j = 0; j < bed.z.size(); ++j) {
-            const auto k = static_cast<std::size_t>(
-                std::upper_bound(cuts.data(), cuts.data() + cuts.size(), bed.z[j]) - cuts.data());
+            const std::size_t k = interval_of(cuts, bed.z[j]);
             const int c = neighbours[j];
             if (bed.colour[j] != kLight && ordered.colours[j] == kLight)
                 turned_light_min[k] = std::min(turned_light_min[k], c);
@@ -316,9 +338,8 @@ TEST_CASE("light_neighbours order: heavies among lights turn light, lone lights 
 TEST_CASE(
     "like_lights order: the new lights' light-neighbour counts are distributed as the lights'",
     "[unit][coarse]") {
-    // Lights carry counts uniform on 6..12 (mean 9), heavies on 0..12 (mean 6). The target: the
-    // light ICDF 0.5 d_p higher, the size of a CPI jump's move (each interval of ~100 particles
-    // switches ~10). A random draw of heavies gives new lights of mean 6; like_lights weights a
+    // The beds of counted_bed (lights' counts mean 9, heavies' 6, the target 0.5 d_p higher). A
+    // random draw of heavies gives new lights of mean 6; like_lights weights a
     // heavy of count c by P_light(c) / P_heavy(c), ~0 below 6 and equal above: its draws are
     // uniform on 6..12, mean 9, less what drawing without replacement takes where an interval
     // has few such heavies to spare (measured: 8.92 against the lights' 9.00, random 6.23; 0.7
@@ -329,13 +350,7 @@ TEST_CASE(
     double drawn = 0.0, random = 0.0, lights = 0.0, removed = 0.0;
     long n_drawn = 0, n_random = 0, n_lights = 0, n_removed = 0;
     for (int trial = 0; trial < 10; ++trial) {
-        const Bed bed = random_bed(rng, 2000, 0.5);
-        const Eigen::VectorXd target =
-            (quantiles(light_heights(bed, bed.colour), kGrid).array() + 0.5).matrix();
-        Labels counts(bed.z.size());
-        for (std::size_t j = 0; j < bed.z.size(); ++j)
-            counts[j] = static_cast<std::uint8_t>(bed.colour[j] == kLight ? 6 + rng.below(7)
-                                                                          : rng.below(13));
+        const auto [bed, target, counts] = counted_bed(rng);
         efdem::RandomStream a(53, trial, "lifting"), b(53, trial, "lifting");
         const LiftResult like =
             lift_colours(target, bed.z, bed.colour, kGrid, a,
@@ -365,21 +380,15 @@ TEST_CASE(
 
 TEST_CASE("keep_clusters order: new lights as like_lights, the lone lights removed first",
           "[unit][coarse]") {
-    // The beds and counts of the like_lights case (lights 6..12, heavies 0..12). Against
-    // like_lights with the same stream: the same counts; the lights turned heavy are, in each
-    // run of particles, those with the fewest light neighbours (no light kept has fewer than one
-    // removed from its interval), and the new lights' mean count stays the lights' within 0.7.
+    // The beds of counted_bed, as in the like_lights case. Against like_lights with the same
+    // stream: the same counts; the lights turned heavy are, in each run of particles, those with
+    // the fewest light neighbours (no light kept has fewer than one removed from its interval),
+    // and the new lights' mean count stays the lights' within 0.7.
     efdem::RandomStream rng(52, 0, "test-lifting");
     double drawn = 0.0, lights = 0.0;
     long n_drawn = 0, n_lights = 0;
     for (int trial = 0; trial < 10; ++trial) {
-        const Bed bed = random_bed(rng, 2000, 0.5);
-        const Eigen::VectorXd target =
-            (quantiles(light_heights(bed, bed.colour), kGrid).array() + 0.5).matrix();
-        Labels counts(bed.z.size());
-        for (std::size_t j = 0; j < bed.z.size(); ++j)
-            counts[j] = static_cast<std::uint8_t>(bed.colour[j] == kLight ? 6 + rng.below(7)
-                                                                          : rng.below(13));
+        const auto [bed, target, counts] = counted_bed(rng);
         efdem::RandomStream a(53, trial, "lifting"), b(53, trial, "lifting");
         const LiftResult keep =
             lift_colours(target, bed.z, bed.colour, kGrid, a,
@@ -394,8 +403,7 @@ TEST_CASE("keep_clusters order: new lights as like_lights, the lone lights remov
         std::vector<int> removed_max(m, -1), kept_min(m, 99);
         const Eigen::VectorXd& cuts = keep.target;
         for (std::size_t j = 0; j < bed.z.size(); ++j) {
-            const auto k = static_cast<std::size_t>(
-                std::upper_bound(cuts.data(), cuts.data() + cuts.size(), bed.z[j]) - cuts.data());
+            const std::size_t k = interval_of(cuts, bed.z[j]);
             if (bed.colour[j] == kLight) {
                 lights += counts[j], ++n_lights;
                 if (keep.colours[j] == kLight)
