@@ -22,7 +22,6 @@ Cost (AMD EPYC, 2 cores): 27-33 min a run beside another study (2026-12-06); the
 is a third of it.
 """
 import argparse
-import json
 import os
 import sys
 
@@ -53,26 +52,24 @@ LAG_TIMES = (100.0, 150.0, 200.0, 250.0, 295.0)
 
 
 def lag_table():
-    directs = [wp.from_reduction(json.load(open(os.path.join(DIRECTS, n + ".json"))))
-               for n in ("direct_a", "direct_b", "direct_c")]
-    td, dm = directs[0]["t"], np.mean([d["mean"] for d in directs], axis=0)
-    lines = ["| run | " + " | ".join(f"t = {t:g}" for t in LAG_TIMES) + " |", "|---" * (len(LAG_TIMES) + 1) + "|"]
+    directs = [lv.load(DIRECTS, n)[:2] for n in ("direct_a", "direct_b", "direct_c")]
+    td, dm = directs[0][0], np.mean([mean for _, mean in directs], axis=0)
+
+    def nearest(times, t):
+        return int(np.argmin(np.abs(times - t)))
 
     def cell(x, ref):
         return f"{(x - ref)[lv.LOWER].mean():+.2f} / {(x - ref).mean():+.2f}"
+    lines = ["| run | " + " | ".join(f"t = {t:g}" for t in LAG_TIMES) + " |", "|---" * (len(LAG_TIMES) + 1) + "|"]
     for name in RUNS:
-        path = os.path.join(RESULTS, name + ".json")
-        if not os.path.exists(path):
+        if not os.path.exists(os.path.join(RESULTS, name + ".json")):
             continue
-        run = wp.from_reduction(json.load(open(path)))
-        row = []
-        for t in LAG_TIMES:
-            i = int(np.argmin(np.abs(run["t"] - t)))
-            row.append(cell(run["mean"][i], dm[int(np.argmin(np.abs(td - run["t"][i])))]))
+        t_run, mean, _ = lv.load(RESULTS, name)
+        row = [cell(mean[i], dm[nearest(td, t_run[i])]) for i in (nearest(t_run, t) for t in LAG_TIMES)]
         lines.append(f"| {name} | " + " | ".join(row) + " |")
-    a, b = directs[0]["mean"], directs[1]["mean"]
+    a, b = directs[0][1], directs[1][1]
     lines.append("| direct_a - direct_b | " + " | ".join(
-        cell(a[int(np.argmin(np.abs(td - t)))], b[int(np.argmin(np.abs(td - t)))]) for t in LAG_TIMES) + " |")
+        cell(a[nearest(td, t)], b[nearest(td, t)]) for t in LAG_TIMES) + " |")
     return lines
 
 
