@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     }
     // The coarse state X and each member's target: the ICDF's mean lifted as it is; in rank
     // coordinates X is the members' mean rank state and each member's target its own heights.
-    RankObservable ranks(m);
+    RankObservable ranks(grid);
     const bool by_ranks = observable == "ranks";
     const Eigen::VectorXd target =
         by_ranks ? ranks.restrict_ensemble(icdf, profiles) : ensemble_mean(icdf);

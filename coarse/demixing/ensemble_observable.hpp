@@ -78,6 +78,11 @@ class EnsembleObservable {
         (void)range;
         return {};
     }
+    /// The share of all particles that are of the observed species (the same in every
+    /// realization: a lift changes labels, not counts), told at every sample before
+    /// restrict_ensemble(); NaN when the micro model does not say. An observable whose repair
+    /// needs it (RankObservable: no interval can hold more lights than particles) keeps it.
+    virtual void set_observed_fraction(double fraction) { (void)fraction; }
     /// State carried from sample to sample (a warm start), for checkpoints; empty if none.
     virtual std::vector<double> saved_state() const { return {}; }
     virtual void restore_state(const std::vector<double>& state) { (void)state; }

@@ -12,7 +12,7 @@ std::unique_ptr<EnsembleObservable> make_icdf(const ProbabilityGrid& grid) {
     return std::make_unique<IcdfObservable>(grid.size());
 }
 std::unique_ptr<EnsembleObservable> make_ranks(const ProbabilityGrid& grid) {
-    return std::make_unique<RankObservable>(grid.size());
+    return std::make_unique<RankObservable>(grid);
 }
 std::unique_ptr<EnsembleObservable> make_compact(const ProbabilityGrid& grid) {
     return std::make_unique<CompactObservable>(grid);

@@ -15,14 +15,27 @@
 /// Lifting: member r's target is Q_r(F_ref(x_i)): the rank x stands for, placed in that member's
 /// own bed, which a recolouring does not move. Restricting a member right after its lift returns
 /// x (to the map's rounding): lifting and restriction use the same two maps.
+///
+/// Repair: besides order and range, no interval between nodes may ask for more lights than the
+/// bed has particles there. With phi the observed fraction (N_L / N) and u_i = F_ref(x_i), the
+/// (p_i - p_{i-1}) N_L lights between nodes i-1 and i need (u_i - u_{i-1}) N >= that, i.e.
+/// y_i = u_i - phi p_i non-decreasing, with y_0 >= 0 and y_{m-1} <= 1 - phi (room below the first
+/// node and above the last). A projection extrapolating the pure-light top of a demixing bed
+/// breaks it (the lights there cannot rise further); the lift would then move lights to
+/// neighbouring intervals and miss X. The repair is the Euclidean projection of y onto that set
+/// (isotonic regression and clipping, monotone_repair.hpp), which contains the true state, so it
+/// brings X nearer to it, never further (docs/error_control.md "A lift that misses its target").
+
+#include <limits>
 
 #include "coarse/demixing/ensemble_observable.hpp"
+#include "coarse/demixing/probability_grid.hpp"
 
 namespace efdem::coarse {
 
 class RankObservable final : public EnsembleObservable {
   public:
-    explicit RankObservable(Eigen::Index m) : m_(m) {}
+    explicit RankObservable(const ProbabilityGrid& grid) : m_(grid.size()), p_(grid.values()) {}
     std::string_view name() const override { return "ranks"; }
     std::string_view label() const override { return "light ranks in the whole bed"; }
     Eigen::Index dimension() const override { return m_; }
@@ -39,15 +52,26 @@ class RankObservable final : public EnsembleObservable {
     Eigen::VectorXd lift_target(const Eigen::VectorXd& x,
                                 const Eigen::VectorXd& profile) const override;
     /// Non-decreasing and inside the reference bed's heights [Q_ref(0), Q_ref(1)] (the range the
-    /// lift maps onto each member's own [lowest, highest] particle); `range` is not needed.
+    /// lift maps onto each member's own [lowest, highest] particle), then, where the observed
+    /// fraction is known, no interval with more lights than particles (see the file comment;
+    /// nodes the second step does not move keep their value bit for bit); `range` is not needed.
     RepairHook repair_hook(FeasibleRange range) const override;
-    /// The reference profile (kWholeBedNodes heights), or empty before the first sample.
+    /// \pre `fraction` in (0, 1], or NaN (unknown: the light-count repair is skipped).
+    void set_observed_fraction(double fraction) override;
+    /// The reference profile (kWholeBedNodes heights) then the observed fraction (NaN if not
+    /// known), or empty before the first sample. restore_state() also takes the reference alone
+    /// (checkpoints written before the fraction was kept: it is told again at the next sample).
     std::vector<double> saved_state() const override;
     void restore_state(const std::vector<double>& state) override;
 
   private:
+    /// The light-count step of the repair, on a monotone X inside the reference bed.
+    RepairReport repair_light_counts(Eigen::VectorXd& x) const;
+
     Eigen::Index m_;
+    Eigen::VectorXd p_;          ///< the p-grid's nodes
     Eigen::VectorXd reference_;  ///< empty until the first restriction
+    double observed_fraction_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace efdem::coarse

@@ -49,7 +49,12 @@ Observation DemRealization::observe(const coarse::ProbabilityGrid& grid,
         o.z_max = std::max(o.z_max, x.z);
         o.mean_height += x.z;
     }
-    if (!p.x().empty()) o.mean_height /= static_cast<double>(p.x().size());
+    if (!p.x().empty()) {
+        o.mean_height /= static_cast<double>(p.x().size());
+        o.observed_fraction =
+            static_cast<double>(std::count(p.species().begin(), p.species().end(), observed_)) /
+            static_cast<double>(p.x().size());
+    }
     if (bed_) o.bed = dem::observe_bed(system_, *bed_).pack();
     if (output_.thermo_every > 0) {
         const dem::ThermoStats st = system_.thermo_stats();

@@ -1,5 +1,6 @@
 #include "mpi_driver/ensemble/ensemble_sampler.hpp"
 
+#include <cmath>
 #include <limits>
 
 #include <mpi.h>
@@ -11,7 +12,7 @@ namespace efdem::mpi_driver {
 
 namespace {
 /// Per realization and sample: centre of mass, lowest and highest centre, mean height, at rest.
-constexpr Eigen::Index kScalars = 9;
+constexpr Eigen::Index kScalars = 10;
 
 /// The rows of `all` listed in `rows` (all rows when every realization is in the ensemble).
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& all, const std::vector<Eigen::Index>& rows) {
@@ -84,8 +85,9 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
         references.add(o);
         Eigen::VectorXd row(kScalars);
         const ThermoNumbers& th = o.thermo;
-        row << o.com, o.z_min, o.z_max, o.mean_height, r->at_rest() ? 1.0 : 0.0, th.ke_per_particle,
-            th.contacts_per_particle, th.max_overlap, th.neighbor_builds;
+        row << o.com, o.z_min, o.z_max, o.mean_height, r->at_rest() ? 1.0 : 0.0,
+            o.observed_fraction, th.ke_per_particle, th.contacts_per_particle, th.max_overlap,
+            th.neighbor_builds;
         scalars.push_back(std::move(row));
         if (bed_width > 0) {
             EFDEM_ASSERT(static_cast<Eigen::Index>(o.bed.size()) == bed_width);
@@ -129,6 +131,14 @@ const SampleRecord* EnsembleSampler::take(const Realizations& local,
     }
     rec.top_mean = needs.top_half ? coarse::ensemble_mean(all_top) : Eigen::VectorXd();
     height_range_ = {all_scalars.col(1).minCoeff(), all_scalars.col(2).maxCoeff()};
+    // The largest share among the realizations (they are equal: a lift keeps the counts): the
+    // one whose intervals fill with lights first.
+    double fraction = std::numeric_limits<double>::quiet_NaN();
+    for (Eigen::Index r = 0; r < all_scalars.rows(); ++r)
+        if (std::isfinite(all_scalars(r, 5)) &&
+            (std::isnan(fraction) || all_scalars(r, 5) > fraction))
+            fraction = all_scalars(r, 5);
+    observable_->set_observed_fraction(fraction);
     const Eigen::MatrixXd own_reference = reference_of(*observable_);
     const Eigen::VectorXd x = observable_->restrict_ensemble(used_icdf, own_reference);
     last_x_ = x;

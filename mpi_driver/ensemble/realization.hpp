@@ -66,6 +66,9 @@ struct Observation {
     double mean_height = 0;
     double z_min = 0;  ///< lowest particle centre
     double z_max = 0;  ///< highest particle centre
+    /// The share of the particles that are of the observed species (NaN: the model has no
+    /// species; coarse::EnsembleObservable::set_observed_fraction).
+    double observed_fraction = std::numeric_limits<double>::quiet_NaN();
     /// The packed dem::BedObservation (observe.bed = true; empty otherwise).
     std::vector<double> bed;
     /// LAMMPS-style thermo numbers (output.thermo_interval > 0; NaN otherwise).

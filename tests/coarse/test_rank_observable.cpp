@@ -4,9 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
+#include "coarse/demixing/colour_lifting.hpp"
 #include "coarse/demixing/probability_grid.hpp"
 #include "coarse/demixing/quantiles.hpp"
 #include "coarse/demixing/rank_observable.hpp"
@@ -115,7 +118,7 @@ TEST_CASE("rank coordinates cancel a shift and an expansion of a member's whole 
         icdf.push_back(m.icdf);
         profile.push_back(m.profile);
     }
-    RankObservable obs(19);
+    RankObservable obs{ProbabilityGrid(19)};
     const Eigen::VectorXd x = obs.restrict_ensemble(rows(icdf), rows(profile));
     REQUIRE(x.allFinite());
     // X is the members' mean, in d_p of the reference bed (here the first sample's mean bed):
@@ -149,11 +152,11 @@ TEST_CASE("a rank lift restricts back to the target it was given, in each member
     // Beds of different extents: member r stands r d_p higher.
     const auto [icdf, profile] = members(
         rng, 4, 1000, [](int r) { return 0.5 + r; }, [](int) { return 15.0; });
-    RankObservable obs(19);
+    RankObservable obs{ProbabilityGrid(19)};
     const Eigen::VectorXd x = obs.restrict_ensemble(rows(icdf), rows(profile));
     // A projected X: the light species 0.7 d_p higher (as a jump would move it), kept inside the
     // reference bed (a repaired X is).
-    const double top = obs.saved_state().back();
+    const double top = obs.saved_state()[kWholeBedNodes - 1];
     const Eigen::VectorXd target = (x.array() + 0.7).min(top - 0.1).matrix();
     std::vector<Eigen::VectorXd> lifted;
     for (std::size_t r = 0; r < 4; ++r) lifted.push_back(obs.lift_target(target, profile[r]));
@@ -173,15 +176,17 @@ TEST_CASE("the rank observable's reference is its state; dropped members give Na
     efdem::RandomStream rng(17, 0, "test");
     const auto [icdf, profile] = members(
         rng, 3, 800, [](int) { return 0.5; }, [](int r) { return 12.0 + r; });
-    RankObservable a(19);
+    RankObservable a{ProbabilityGrid(19)};
     CHECK(a.saved_state().empty());
     const Eigen::VectorXd x0 = a.restrict_ensemble(rows(icdf), rows(profile));
-    REQUIRE(static_cast<Eigen::Index>(a.saved_state().size()) == kWholeBedNodes);
+    // The reference profile, then the observed fraction (NaN: nobody told it).
+    REQUIRE(static_cast<Eigen::Index>(a.saved_state().size()) == kWholeBedNodes + 1);
+    CHECK(std::isnan(a.saved_state().back()));
     // A later sample of changed beds restricts through the SAME reference: a second observable
     // given the first one's state restricts it identically, one without it does not.
     std::vector<Eigen::VectorXd> later = profile;
     for (auto& p : later) p = (p.array() * 1.2).matrix();  // every bed expanded by 20 %
-    RankObservable b(19), fresh(19);
+    RankObservable b{ProbabilityGrid(19)}, fresh{ProbabilityGrid(19)};
     b.restore_state(a.saved_state());
     const Eigen::VectorXd xa = a.restrict_ensemble(rows(icdf), rows(later));
     CHECK(b.restrict_ensemble(rows(icdf), rows(later)) == xa);
@@ -195,4 +200,62 @@ TEST_CASE("the rank observable's reference is its state; dropped members give Na
     CHECK_FALSE(own.row(1).allFinite());
     CHECK(own.row(0).allFinite());
     CHECK(own.row(2).allFinite());
+}
+
+TEST_CASE("the rank repair keeps each interval's lights within its particles, so the lift meets X",
+          "[unit][coarse][lifting]") {
+    // A demixing bed: 1,000 heights, the top 400 all light, 100 more lights spread below
+    // (observed fraction 0.5). The p-grid's upper nodes sit on the pure-light stretch, where the
+    // lights already fill every place: u_i - 0.5 p_i is flat there.
+    const ProbabilityGrid grid(19);
+    efdem::RandomStream rng(23, 0, "test");
+    const std::vector<double> z = sorted_heights(rng, 1000, 0.5, 15.0);
+    std::vector<std::uint8_t> colour(1000, kHeavy);
+    for (std::size_t j = 600; j < 1000; ++j) colour[j] = kLight;
+    for (std::size_t j = 0; j < 600; j += 6) colour[j] = kLight;
+    const Eigen::VectorXd profile = profile_of_heights(z);
+    RankObservable obs{grid};
+    obs.set_observed_fraction(0.5);
+    const Eigen::VectorXd x =
+        obs.restrict_ensemble(observed_icdf(z, colour, grid).transpose(), profile.transpose());
+    const RepairHook repair = obs.repair_hook({});
+    // The sampled state is liftable: left bit for bit (its ranks, read through the profile's
+    // linear map, break the limit by up to 0.0033 of the bed between nodes: the map's resolution,
+    // below the repair's threshold).
+    Eigen::VectorXd same = x;
+    CHECK_FALSE(repair(same).changed());
+    CHECK(same == x);
+    // A jump that raises the lower lights by up to 1.9 d_p and the top ones by 0.1 (as a
+    // projection of a demixing bed does) squeezes the pure-light stretch: more lights than
+    // places between the upper nodes.
+    const Eigen::VectorXd projected = (x.array() + 2.0 * (1.0 - grid.values().array())).matrix();
+    Eigen::VectorXd plain = projected;  // order and range only: the fraction unknown
+    RankObservable unknown{grid};
+    unknown.restrict_ensemble(observed_icdf(z, colour, grid).transpose(), profile.transpose());
+    CHECK_FALSE(unknown.repair_hook({})(plain).changed());
+    Eigen::VectorXd repaired = projected;
+    const RepairReport report = repair(repaired);
+    CHECK(report.changed());
+    INFO(report.message);
+    CHECK(report.message.find("more light particles") != std::string::npos);
+    // In ranks the repaired X leaves room: y = u - 0.5 p non-decreasing within [0, 0.5]
+    // (1e-12: the maps' rounding).
+    const Eigen::VectorXd y = ranks_in(repaired, profile) - 0.5 * grid.values();
+    for (Eigen::Index i = 1; i < y.size(); ++i) CHECK(y[i] >= y[i - 1] - 1e-12);
+    CHECK(y[0] >= -1e-12);
+    CHECK(y[y.size() - 1] <= 0.5 + 1e-12);
+    // A projection onto a convex set that holds every possible state moves X nearer to each of
+    // them: here the sampled one (in ranks, where the set is convex).
+    const Eigen::VectorXd y_true = ranks_in(x, profile) - 0.5 * grid.values();
+    const Eigen::VectorXd y_proj = ranks_in(projected, profile) - 0.5 * grid.values();
+    CHECK((y - y_true).norm() <= (y_proj - y_true).norm());
+    // The lift: the repaired X is met to within the particles' spacing (15 d_p / 1,000 = 0.015;
+    // the at_nodes lift pins each node within the gap around its cut, 0.1 allows ~6 gaps); the
+    // unrepaired one is missed by far more, the lights pushed out of the squeezed intervals.
+    efdem::RandomStream a(29, 0, "lift"), b(29, 0, "lift");
+    const LiftResult met = lift_colours(obs.lift_target(repaired, profile), z, colour, grid, a);
+    const LiftResult missed = lift_colours(obs.lift_target(projected, profile), z, colour, grid, b);
+    INFO("max deviation: repaired " << met.max_deviation << ", projected " << missed.max_deviation);
+    CHECK(met.max_deviation < 0.1);
+    CHECK(missed.max_deviation > 5 * met.max_deviation);
 }

@@ -158,7 +158,7 @@ TEST_CASE(
     StepperSettings ss;
     ss.sample_interval = 0.01;
     ss.steps_per_sample = 1;  // the free flight of one 1e-4 step moves nothing that matters
-    coarse::RankObservable observable(19);
+    coarse::RankObservable observable{coarse::ProbabilityGrid(19)};
     const ColourLifter lifter;
     EnsembleStepper stepper(columns.layout, std::move(columns.local), ss, observable, lifter,
                             nullptr, nullptr);
@@ -168,7 +168,9 @@ TEST_CASE(
         coarse::BurstSamples burst;
         stepper.run(0.01, burst);
         const std::vector<double> state = observable.saved_state();
-        REQUIRE(static_cast<Eigen::Index>(state.size()) == coarse::kWholeBedNodes);
+        // The reference profile, then the observed fraction (half of each column is light).
+        REQUIRE(static_cast<Eigen::Index>(state.size()) == coarse::kWholeBedNodes + 1);
+        CHECK(state.back() == 0.5);  // 2 x kLight particles, kLight of them light: told exactly
         const Eigen::VectorXd reference =
             Eigen::Map<const Eigen::VectorXd>(state.data(), coarse::kWholeBedNodes);
         const Eigen::VectorXd target = coarse::heights_at(u, reference);
