@@ -59,13 +59,13 @@ Labels demixed_labels(efdem::RandomStream& rng, const Bed& bed, double noise) {
     return s;
 }
 
-/// Light particles per interval I_0..I_m of the cuts (interval = number of cuts <= z).
 /// The interval of height z among the cuts: 0 below the first, cuts.size() above the last.
 std::size_t interval_of(const Eigen::VectorXd& cuts, double z) {
     return static_cast<std::size_t>(std::upper_bound(cuts.data(), cuts.data() + cuts.size(), z) -
                                     cuts.data());
 }
 
+/// Light particles per interval I_0..I_m of the cuts (interval = number of cuts <= z).
 std::vector<long> interval_light_counts(const Bed& bed, const Labels& colour,
                                         const Eigen::VectorXd& cuts) {
     std::vector<long> count(static_cast<std::size_t>(cuts.size()) + 1, 0);
