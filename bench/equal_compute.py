@@ -11,7 +11,9 @@ S x R realizations at one budget of core-hours.
 
 Reads the run files a study of bench/slope_study.py made (direct_a/b/c.h5: three direct ensembles
 with their own seeds, and its CPI runs; the run files are not in git, the study's command in its
-analysis.md regenerates them). A study given as DIRECTS+CPI takes the direct runs from the
+analysis.md regenerates them), or the reductions bench/whole_process.py keeps in git (NAME.json:
+each realization's ICDF on a 5-unit grid; preferred where a run has both, so that every run of a
+study is costed alike, by its particle-steps). A study given as DIRECTS+CPI takes the direct runs from the
 folder DIRECTS and the CPI runs from both (bench/whole_process.py keeps its R = 4 CPI runs of the
 tall bed beside the R = 8 directs whose halves are their floor). Writes docs/equal_compute.md and
 docs/equal_compute.png.
@@ -37,9 +39,11 @@ Both over the whole span and over its last quarter (where the end state is).
 """
 import argparse
 import glob
+import json
 import math
 import os
 import platform
+import re
 import sys
 
 import h5py
@@ -74,6 +78,8 @@ def cpu():
 
 
 def load(path):
+    if path.endswith(".json"):
+        return load_reduction(path)
     with h5py.File(path, "r") as f:
         a = f.attrs
         return {"t": f["samples/time"][:], "mean": run_files.get(f, "samples/mean_icdf")[:], "icdf": f["samples/icdf"][:],
@@ -81,6 +87,32 @@ def load(path):
                 "dem_time": float(a["dem_time"]), "wall": float(a["wall_seconds"]),
                 "overhead": float(a["lift_seconds"]) + float(a["restrict_seconds"]),
                 "mode": sr.text(a["mode"]), "status": sr.text(a.get("end_status", ""))}
+
+
+def load_reduction(path):
+    """A run as bench/whole_process.py keeps it in git (NAME.json: each realization's ICDF on a
+    5-unit grid, DEM time, particle-steps, wall time; the run files themselves are not kept). The
+    lift's and restriction's share of the wall time is not in it: 0 here (1-3 % in the runs that
+    have it). Compute is counted in particle-steps (`particle_steps`: a rejected jump's burst and a
+    realization paused at rest count as they cost), converted to realization-units by the study."""
+    with open(path) as f:
+        d = json.load(f)
+    icdf = np.array(d["icdf"], dtype=float)
+    ranks = re.search(r"-np (\d+)", d.get("study_command", ""))
+    name = os.path.basename(path)[:-5]
+    return {"t": np.array(d["t"], dtype=float), "mean": np.nanmean(icdf, axis=1), "icdf": icdf,
+            "realizations": icdf.shape[1], "ranks": int(ranks.group(1)) if ranks else 2,
+            "dem_time": float(d["dem_time"]), "wall": float(d["wall_seconds"]), "overhead": 0.0,
+            "particle_steps": float(d.get("particle_steps") or "nan"),
+            "mode": "direct" if name in DIRECTS else "cpi", "status": d.get("end_status", "")}
+
+
+def run_paths(folder):
+    """The runs of FOLDER: their reductions (NAME.json, bench/whole_process.py) where there are any,
+    else their run files (NAME.h5): one cost accounting for every run of a study."""
+    h5 = {os.path.basename(p)[:-3]: p for p in glob.glob(os.path.join(folder, "*.h5"))}
+    js = {os.path.basename(p)[:-5]: p for p in glob.glob(os.path.join(folder, "*.json")) if not p.endswith("analysis.json")}
+    return {**h5, **js}
 
 
 def members_at(t_ref, members, t):
@@ -99,9 +131,10 @@ def analyse_study(spec):
     name = os.path.basename(os.path.normpath(folder))
     if cpi_folders:
         name = os.path.basename(os.path.dirname(os.path.normpath(folder))) + "_" + name
-    directs = [load(os.path.join(folder, d + ".h5")) for d in DIRECTS if os.path.exists(os.path.join(folder, d + ".h5"))]
+    paths = run_paths(folder)
+    directs = [load(paths[d]) for d in DIRECTS if d in paths]
     if len(directs) < 3:
-        print(f"{name}: {len(directs)} direct run file(s), 3 needed; skipped")
+        print(f"{name}: {len(directs)} direct run file(s) or reduction(s), 3 needed; skipped")
         return None
     t = directs[0]["t"]
     if any(len(d["t"]) != len(t) or np.max(np.abs(d["t"] - t)) > 1e-9 for d in directs):
@@ -111,12 +144,16 @@ def analyse_study(spec):
     span = float(t[-1] - t[0])
     last = t >= t[0] + 0.75 * span
     cost = min(d["wall"] * d["ranks"] / (d["realizations"] * d["dem_time"]) for d in directs)
+    # Particle-steps of one realization-unit: the directs' largest (a direct realization paused at
+    # rest costs less; none is at U_s = 0.41), for runs whose reduction counts particle-steps.
+    unit = max((d.get("particle_steps", math.nan) / (d["realizations"] * d["dem_time"]) for d in directs),
+               default=math.nan)
     sizes = [s for s in (1, 2, 4, 8, 16) if s <= n - 2]
     direct = {s: {"compute": s * span, "e": am.subset_errors(pool, s),
                   "e_last": am.subset_errors(pool[last], s)} for s in sizes}
     cpi = {}
-    for path in sorted(p for f in [folder, *cpi_folders] for p in glob.glob(os.path.join(f, "*.h5"))):
-        run_name = os.path.basename(path)[:-3]
+    for path in sorted(p for f in [folder, *cpi_folders] for p in run_paths(f).values()):
+        run_name = os.path.splitext(os.path.basename(path))[0]
         if run_name in DIRECTS:
             continue
         if os.path.dirname(path) != os.path.normpath(folder):  # runs of a second folder: named by it
@@ -130,6 +167,8 @@ def analyse_study(spec):
         sel = r["t"] >= t[0] + 0.75 * span
         var_last = float(np.mean(ref[sel].var(axis=1, ddof=1)))
         compute = r["realizations"] * r["dem_time"] * (1.0 + r["overhead"] / r["wall"])
+        if math.isfinite(r.get("particle_steps", math.nan)) and math.isfinite(unit):
+            compute = r["particle_steps"] / unit  # what it cost, rejected bursts included
         # A run that ended early (at its end state) is held against direct over its own span.
         span_r = min(span, float(r["t"][-1] - t[0]))
         e = am.error_against_truth(r["mean"], ref)
@@ -201,8 +240,9 @@ def main():
         ["--out", os.path.relpath(args.out, os.path.join(HERE, ".."))] if args.folders else []) +
         [os.path.relpath(f, os.path.join(HERE, "..")) for f in args.folders])
     text_ = (f"# Error at equal compute: direct ensembles and CPI\n\nMade by `{command}` "
-             "from the studies' run files (regenerate those with the command in each "
-             "study's analysis.md). Method: the script's docstring.\n\n" + "\n".join(table(s) for s in studies))
+             "from the studies' runs: their reductions (NAME.json, in git) where a study keeps them, "
+             "else their run files (regenerate those with the command in each study's analysis.md). "
+             "Compute of a run with a reduction: its particle-steps. Method: the script's docstring.\n\n" + "\n".join(table(s) for s in studies))
     with open(args.out + ".md", "w") as f:
         f.write(text_)
     plot(studies, args.out + ".png")
