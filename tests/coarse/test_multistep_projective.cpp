@@ -708,6 +708,36 @@ TEST_CASE(
     CHECK(std::abs(jump.stability.amplification) <= 1.0);
 }
 
+TEST_CASE("a jump shortened for stability at the end of a run still lets the run reach its end",
+          "[unit][coarse][multistep]") {
+    // One fast mode (k = 0.1, no noise, a tolerance that never binds; the stability case above):
+    // DT is set by the end rule, then halved until the projective cycle is stable. With
+    // Adams-Bashforth 2 (a smaller stability region) a halved last jump left less than one
+    // burst after the burst that follows it, and the run stopped short of its end (a tall-bed
+    // run at U_s = 0.41 ended at 586.5 of 600). That burst now runs on to the end: every end
+    // time reached, to round-off.
+    const Eigen::VectorXd k = Eigen::VectorXd::Constant(19, 0.1);
+    int halved = 0;
+    for (int steps : {1, 2})
+        for (double end = 20.0; end <= 120.0; end += 2.5) {
+            // Sampled every 1/64 (exact in binary): the halved DTs of these ends stay on it.
+            test::OuEnsembleStepper toy(k, 0.0, 2, 1.0 / 64.0, Eigen::VectorXd::Constant(19, 3.0),
+                                        3);
+            MultistepSettings s =
+                adaptive_settings(4.0, 4.0, {.tolerance = 1e3, .dt_min = 0.5, .dt_max = 200.0});
+            s.steps = steps;
+            MultistepProjectiveIntegrator integrator(s);
+            integrator.set_end_time(end);
+            for (int i = 0; i < 40 && end - toy.time() >= 8.0 - 1e-9; ++i) {
+                const ProjectiveStepRecord rec = integrator.step(toy);
+                if (to_string(rec.controller.limited_by) == "stability") ++halved;
+            }
+            INFO("steps " << steps << ", end " << end);
+            CHECK(toy.time() == Approx(end).margin(1e-9));
+        }
+    CHECK(halved > 0);  // the case arose
+}
+
 TEST_CASE("a first burst that would leave less than one burst runs on to the end of the run",
           "[unit][coarse][multistep]") {
     // The paper's bed at U_s = 0.41 over 100 time units: the warm-up waited 62 units for the

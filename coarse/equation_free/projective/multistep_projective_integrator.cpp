@@ -281,9 +281,8 @@ double MultistepProjectiveIntegrator::prior_curvature() const {
     return slope_divided_difference(nodes).norm;
 }
 
-double MultistepProjectiveIntegrator::direct_burst_length(const CoarseStepper& stepper) const {
-    const double burst = burst_length(), left = end_time() - stepper.time();
-    return left < 2.0 * burst - time_tolerance(end_time()) ? left : burst;
+double MultistepProjectiveIntegrator::burst_length_from(const CoarseStepper& stepper) const {
+    return burst_length_to_end(stepper.time(), end_time(), burst_length());
 }
 
 MultistepProjectiveIntegrator::JumpBasis MultistepProjectiveIntegrator::jump_basis() const {
@@ -350,7 +349,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     Measured m;
     if (history_.empty()) {  // the first slope: one burst, no jump
-        if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
+        if (!measure_burst(stepper, rec, m, burst_length_from(stepper))) return rec;
         // No lift before it: with healing >= window its start is a second window, whose slope
         // gives the first jump a curvature (for the error model only).
         const double w = settings_.burst.window;
@@ -395,7 +394,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     rec.dt = rec.dt_requested;
     if (rec.dt == 0.0) {  // one burst of direct simulation from where we are
         if (c.limited_by == DtLimit::below_dt_min) ++totals_.direct;
-        if (!measure_burst(stepper, rec, m, direct_burst_length(stepper))) return rec;
+        if (!measure_burst(stepper, rec, m, burst_length_from(stepper))) return rec;
         accept_burst(m, c);
         rec.status = StepStatus::burst_only;
         rec.x_projected = rec.x_end;
@@ -448,7 +447,9 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     ProjectiveStepRecord after;  // the burst that judges the jump
     after.t_start = stepper.time();
-    const bool measured = measure_burst(stepper, after, m);
+    // A jump the end rule did not place (shortened for stability or after a rejection) can
+    // leave between one and two bursts: this burst then runs to the end of the run.
+    const bool measured = measure_burst(stepper, after, m, burst_length_from(stepper));
     // Whatever the verdict on the jump, the burst says whether lifts leave a transient: the
     // healing of the bursts to come.
     judge_healing(after.burst, after.t_start, c);

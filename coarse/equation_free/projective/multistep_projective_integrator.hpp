@@ -168,9 +168,10 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
                        double length = 0.0) const;
-    /// The length of a burst of direct simulation starting now: one burst, or the rest of the
-    /// run when one burst would leave less than one more (the run then ends at its end time).
-    double direct_burst_length(const CoarseStepper& stepper) const;
+    /// The length of a burst starting now (a direct one or the one after a jump): one burst, or
+    /// the rest of the run when one burst would leave less than one more, so that the run ends
+    /// at its end time rather than short of it.
+    double burst_length_from(const CoarseStepper& stepper) const;
     /// Takes the burst's slope and end state; cpi.window_auto: sizes the next bursts' window
     /// from its evidence (into `c`).
     void accept_burst(const Measured& m, ControllerRecord& c);

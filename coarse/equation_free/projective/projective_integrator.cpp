@@ -40,6 +40,12 @@ double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, doub
     return std::numeric_limits<double>::infinity();
 }
 
+double burst_length_to_end(double now, double t_end, double burst) {
+    if (!std::isfinite(t_end)) return burst;
+    const double left = t_end - now;
+    return left < 2.0 * burst - time_tolerance(t_end) ? left : burst;
+}
+
 void CoarseStepper::lift_apart([[maybe_unused]] const Eigen::VectorXd& target,
                                [[maybe_unused]] const Eigen::MatrixXd& member_steps,
                                [[maybe_unused]] double new_time) {
