@@ -210,7 +210,21 @@ def load_archive(path):
         d = {k: sr.text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
         d["t"], d["icdf"] = f["samples/time"][:], f["samples/icdf"][:]
         d["rest"] = f["samples/at_rest"][:] if "samples/at_rest" in f else None
+        d["lifts"] = lift_records(f)
     return d
+
+
+def lift_records(f):
+    """Every kept jump of a CPI run file F (open): [t of the burst after it, DT, labels its lift
+    switched per lifted realization]; [] for a direct run."""
+    if "cpi/status" not in f or "cpi/lift_changed" not in f:
+        return []
+    c = f["cpi"]
+    status = [sr.text(s) for s in c["status"][:]]
+    changed = c["lift_changed"][:].astype(float)
+    lifted = np.maximum((changed > 0).sum(axis=1), 1)
+    return [[round(float(c["t_start"][k]), 6), round(float(c["dt"][k]), 6), round(float(changed[k].sum() / lifted[k]), 2)]
+            for k in range(len(status)) if status[k] == "projected"]
 
 
 def reduce_run(full):
@@ -223,6 +237,7 @@ def reduce_run(full):
         return [float(x) if np.isfinite(x) else None for x in xs]
 
     out.update(t_all=[round(float(x), 6) for x in t], stops=finite(stops(full)), quiet=finite(demixing_stops(full)),
+               lifts=full.get("lifts", []),
                t=[round(float(x), 6) for x in t[on_grid]],
                icdf=np.round(full["icdf"][on_grid].astype(float), 3).tolist())
     return out
