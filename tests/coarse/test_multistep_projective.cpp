@@ -735,7 +735,10 @@ TEST_CASE("a jump shortened for stability at the end of a run still lets the run
             INFO("steps " << steps << ", end " << end);
             CHECK(toy.time() == Approx(end).margin(1e-9));
         }
-    CHECK(halved > 0);  // the case arose
+    CHECK(halved > 0);                                                        // the case arose
+    CHECK(burst_length_to_end(12.0, 15.0, 2.0) == Approx(3.0).margin(1e-9));  // less than two
+    CHECK(burst_length_to_end(11.0, 15.0, 2.0) == 2.0);                       // two bursts left
+    CHECK(burst_length_to_end(0.0, std::numeric_limits<double>::infinity(), 2.0) == 2.0);
 }
 
 TEST_CASE("a first burst that would leave less than one burst runs on to the end of the run",

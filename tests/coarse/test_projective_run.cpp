@@ -164,26 +164,6 @@ TEST_CASE("the coarse run loop ends at t_origin + duration exactly, with the war
     CHECK(run.end_time() == 100.0);
 }
 
-TEST_CASE("a burst that would leave less than one more runs on to the end of the run",
-          "[unit][coarse][run]") {
-    // Warm-up to 2, a burst to 4 and a whole jump of 8 to 12 (13 - 8 >= one burst, so the end
-    // rule leaves it whole): 3 time units left, one burst (2) would leave 1. The last burst runs
-    // the 3 to t = 15 (a tall-bed run at U_s = 0.41 ended at 586.5 of 600 this way, its last
-    // jump halved for stability). Multiples of 0.1: exact to 1e-9.
-    auto toy = slow_toy();
-    ProjectiveRun run(fixed_settings(2.0), toy, variable("x"));
-    const ProjectiveRunOutcome out = run.run(15.0);
-    CHECK(out.end_status == "completed");
-    CHECK(out.coarse_steps == 2);
-    CHECK(out.jumps == 1);
-    CHECK(toy.time() == Approx(15.0).margin(1e-9));
-    CHECK(out.simulated_time == Approx(15.0).margin(1e-9));
-    CHECK(planned_micro_time(2.0, 15.0, 2.0, 8.0) == Approx(5.0).margin(1e-9));
-    CHECK(burst_length_to_end(12.0, 15.0, 2.0) == Approx(3.0).margin(1e-9));
-    CHECK(burst_length_to_end(11.0, 15.0, 2.0) == 2.0);  // two bursts left: one
-    CHECK(burst_length_to_end(0.0, std::numeric_limits<double>::infinity(), 2.0) == 2.0);
-}
-
 TEST_CASE("a run shorter than warm-up plus one burst stops with no coarse step, and says so",
           "[unit][coarse][run]") {
     auto toy = slow_toy();

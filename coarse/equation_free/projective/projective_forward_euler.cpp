@@ -1,6 +1,5 @@
 #include "coarse/equation_free/projective/projective_forward_euler.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -22,15 +21,13 @@ ProjectiveForwardEuler::ProjectiveForwardEuler(const ProjectiveEulerSettings& se
 ProjectiveStepRecord ProjectiveForwardEuler::step(CoarseStepper& stepper) {
     ProjectiveStepRecord rec;
     rec.t_start = stepper.time();
+    rec.healing = settings_.burst.healing;
     rec.dt_requested = settings_.dt;
-    const double burst = settings_.burst.healing + settings_.burst.window;
-    rec.burst_length = burst_length_to_end(stepper.time(), end_time(), burst);
-    // A burst run on to the end of the run heals longer; its window stays the last `window`.
-    rec.healing = settings_.burst.healing + std::max(0.0, rec.burst_length - burst);
+    rec.burst_length = settings_.burst.healing + settings_.burst.window;
     stepper.run(rec.burst_length, rec.burst);
     if (!check_burst(rec, stepper.time(), false)) return rec;
 
-    const double t_window = rec.t_start + rec.healing;
+    const double t_window = rec.t_start + settings_.burst.healing;
     const SlopeEstimate slope = least_squares_slope(rec.burst.t, rec.burst.x, t_window);
     if (!slope.ok) {
         rec.status = StepStatus::invalid_burst;

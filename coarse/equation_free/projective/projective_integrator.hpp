@@ -158,10 +158,12 @@ struct ProjectiveStepRecord {
 /// otherwise +infinity (also for an infinite t_end). Times compared to time_tolerance(t_end).
 double end_of_run_jump_limit(double t_after_burst, double t_end, double dt, double burst);
 
-/// The other half of that rule: the length of a burst that starts at `now` (a direct one or the
-/// one after a jump) when a burst lasts `burst`: `burst`, or the time left when one burst would
-/// leave less than one more, so that a jump shortened below the end rule's DT (for stability,
-/// after a rejection) does not leave the run ending short of t_end. `burst` for an infinite t_end.
+/// The multistep integrator's other half of that rule (its jumps are always followed by a burst):
+/// the length of a burst that starts at `now` (a direct one or the one after a jump) when a burst
+/// lasts `burst`: `burst`, or the time left when one burst would leave less than one more, so
+/// that a jump shortened below the end rule's DT (for stability) does not leave the run ending
+/// short of t_end. `burst` for an infinite t_end. (The fixed forward Euler ends with a jump to
+/// t_end instead, which end_of_run_jump_limit allows.)
 double burst_length_to_end(double now, double t_end, double burst);
 
 /// An integrator's own state between two steps, for a checkpoint: only the multistep

@@ -76,9 +76,10 @@ ProjectiveRunOutcome ProjectiveRun::run(double duration,
         state_.integrator = integrator_->save_state();
         state_.drift = drift_.save();
         for (auto* o : observers_) o->between_steps(*this);
-        // The integrators shorten their jumps to end at t_end, and a burst that would leave less
-        // than one more runs to t_end (burst_length_to_end); only a run shorter than warm-up
-        // plus one burst (or one whose period bursts were extended) can be left with less.
+        // The integrators shorten their jumps to end at t_end (the adaptive one also runs a burst
+        // that would leave less than one more on to t_end, burst_length_to_end); only a run
+        // shorter than warm-up plus one burst (or one whose period bursts were extended) can be
+        // left with less.
         if (t_end_ - stepper_.time() < burst - tol) {
             log::info(
                 "stopping at t = {:.6g}: the {:.4g} time units left are less than one "
@@ -261,9 +262,8 @@ double planned_micro_time(double t_now, double t_end, double burst, double dt) {
     const double tol = time_tolerance(t_end);
     double micro = 0.0;
     for (double t = t_now; t_end - t >= burst - tol;) {
-        const double b = burst_length_to_end(t, t_end, burst);
-        t += b;
-        micro += b;
+        t += burst;
+        micro += burst;
         t += std::min(dt, end_of_run_jump_limit(t, t_end, dt, burst));
     }
     return micro;

@@ -181,8 +181,7 @@ class ProjectiveRun {
 };
 
 /// Micro time a run needs from t_now to t_end with bursts of `burst` (> 0) and jumps of `dt`,
-/// shortened at the end by the integrators' rule (end_of_run_jump_limit, and a last burst run on
-/// to t_end by burst_length_to_end).
+/// shortened at the end by the integrators' rule (end_of_run_jump_limit).
 double planned_micro_time(double t_now, double t_end, double burst, double dt);
 
 }  // namespace efdem::coarse
