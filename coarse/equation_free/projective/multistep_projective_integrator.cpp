@@ -447,7 +447,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     ProjectiveStepRecord after;  // the burst that judges the jump
     after.t_start = stepper.time();
-    // A jump the end rule did not place (shortened for stability or after a rejection) can
+    // A jump shortened after the end rule placed it (by the stability check) can
     // leave between one and two bursts: this burst then runs to the end of the run.
     const bool measured = measure_burst(stepper, after, m, burst_length_from(stepper));
     // Whatever the verdict on the jump, the burst says whether lifts leave a transient: the
