@@ -76,18 +76,38 @@ def bursts(t_all, t):
     return [list(np.nonzero(which == k)[0]) for k in range(len(starts)) if np.any(which == k)]
 
 
+def direct_ensembles(folder):
+    """The case's three direct ensembles (load's tuples), their grid times and the mean of their
+    ensemble means."""
+    directs = [load(folder, n) for n in ("direct_a", "direct_b", "direct_c")]
+    return directs, directs[0][0], np.mean([d[1] for d in directs], axis=0)
+
+
+def slope(x, tt, a, b):
+    """The secant slope of X (samples at times TT) between samples A and B."""
+    return (x[b] - x[a]) / (tt[b] - tt[a])
+
+
+def nearest(td, tt):
+    """The index of the grid time of TD nearest TT."""
+    return int(np.argmin(np.abs(td - tt)))
+
+
+def early_deficit(t, x, b, td, dmean):
+    """The lower nodes' slope over the first grid interval of burst B (sample indices into T, X)
+    minus the directs' mean slope DMEAN (at TD) over the same times."""
+    i0, i1 = b[0], b[1]
+    j0, j1 = nearest(td, t[i0]), nearest(td, t[i1])
+    return (slope(x, t, i0, i1) - slope(dmean, td, j0, j1))[LOWER].mean()
+
+
 def deficit_table(folder, runs, runs_folder=None):
     """FOLDER: the case with the direct ensembles; RUNS_FOLDER (default FOLDER): the CPI runs'."""
     runs_folder = runs_folder or folder
-    directs = [load(folder, n) for n in ("direct_a", "direct_b", "direct_c")]
-    td = directs[0][0]
-    dmean = np.mean([d[1] for d in directs], axis=0)
-
-    def slope(x, tt, a, b):
-        return (x[b] - x[a]) / (tt[b] - tt[a])
+    directs, td, dmean = direct_ensembles(folder)
 
     def at(tt):
-        return int(np.argmin(np.abs(td - tt)))
+        return nearest(td, tt)
 
     lines = ["| CPI run | bursts | direct slope, lower nodes [d_p/unit] | CPI - direct, first 5 units | CPI - direct, rest | "
              "direct_a - direct_b, first 5 / rest (noise) |",
@@ -103,7 +123,7 @@ def deficit_table(folder, runs, runs_folder=None):
                 continue
             i0, i1, i2 = b[0], b[1], b[-1]
             j0, j1, j2 = at(t[i0]), at(t[i1]), at(t[i2])
-            early.append((slope(x, t, i0, i1) - slope(dmean, td, j0, j1))[LOWER].mean())
+            early.append(early_deficit(t, x, b, td, dmean))
             late.append((slope(x, t, i1, i2) - slope(dmean, td, j1, j2))[LOWER].mean())
             a, bb = directs[0][1], directs[1][1]
             noise_e.append((slope(a, td, j0, j1) - slope(bb, td, j0, j1))[LOWER].mean())
@@ -121,9 +141,7 @@ def lift_cost_table(folder, runs):
     """Per kept jump in the span: the lower nodes' slope over the first 5 units of the burst after
     its lift, minus the directs' mean over the same times, against the labels the lift switched per
     realization; a least-squares line through all of them (deficit = a + c x labels / 1000)."""
-    directs = [load(folder, n) for n in ("direct_a", "direct_b", "direct_c")]
-    td = directs[0][0]
-    dmean = np.mean([d[1] for d in directs], axis=0)
+    _, td, dmean = direct_ensembles(folder)
     rows, pts = [], []
     for name in runs:
         reduction = os.path.join(folder, name + ".json")
@@ -145,9 +163,7 @@ def lift_cost_table(folder, runs):
             match = [r for r in records if r[0] - 1e-6 <= t[b[0]] <= r[0] + 5.0 + 1e-6]
             if not match:
                 continue
-            i0, i1 = b[0], b[1]
-            j0, j1 = int(np.argmin(np.abs(td - t[i0]))), int(np.argmin(np.abs(td - t[i1])))
-            d = ((x[i1] - x[i0]) / (t[i1] - t[i0]) - (dmean[j1] - dmean[j0]) / (td[j1] - td[j0]))[LOWER].mean()
+            d = early_deficit(t, x, b, td, dmean)
             _, dt, labels = match[0]
             pts.append((labels, d))
             rows.append(f"| {name} | {t[b[0]]:g} | {dt:g} | {labels:.0f} | {d:+.3f} |")
@@ -156,7 +172,7 @@ def lift_cost_table(folder, runs):
     if len(pts) >= 3:
         a = np.array(pts)
         A = np.c_[np.ones(len(a)), a[:, 0] / 1000.0]
-        coef, res, *_ = np.linalg.lstsq(A, a[:, 1], rcond=None)
+        coef, *_ = np.linalg.lstsq(A, a[:, 1], rcond=None)
         dof = len(a) - 2
         s2 = float(np.sum((a[:, 1] - A @ coef) ** 2)) / max(dof, 1)
         se = np.sqrt(np.diag(s2 * np.linalg.inv(A.T @ A)))

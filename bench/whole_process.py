@@ -398,7 +398,7 @@ def analyse_case(args, case):
                "direct_end_median": d_mean, "direct_end_median_se": d_se,
                "direct_stopped": int(np.isfinite(direct_stops).sum()), "direct_realizations": len(direct_stops),
                "direct_all_at_rest_at": last_stop, "direct_stopped_demixing": direct_quiet, "cpi": {},
-               "n_directs": len(directs), "runs": sorted(runs)}
+               "runs": sorted(runs)}
     lines = [f"## {case}: {scene.split('_')[0]} bed, U_s = {us}, R = {realizations}, {duration:g} time units\n",
              (f"**Compared over t = 0-{span:g} only** (directs still short: {', '.join(shorter)}).\n"
               if span < duration - 1e-6 else ""),
@@ -544,7 +544,7 @@ def analyse(args):
     for case in CASES:
         section = os.path.join(args.results, case, "analysis.md")
         s, lines = analyse_case(args, case)
-        if s and s["n_directs"] < len(DIRECT) and frozen(section):
+        if s and sum(n.startswith("direct") for n in s["runs"]) < len(DIRECT) and frozen(section):
             # A section made from archives that are gone (FROZEN) stands until the case's directs
             # are all made again; what is made so far is named under it.
             keep_frozen(section, s["runs"])
