@@ -87,6 +87,11 @@ TALL_SLOW = {
     # budget, mean DT 38 for 2.35x; docs/accuracy_vs_cost.md "The tall bed"): the slope pooled over
     # the last 4 bursts (cpi.slope = pooled, issue 33), toward the 5x a mean DT of 80 would give
     "members_pooled": {**MOVING, "cpi.tolerance": 0.32, "cpi.slope": "pooled"},
+    # the two levers the demo bed measured at U_s = 0.19 (docs/accuracy_vs_cost.md, issue 33 and
+    # "R = 8 over 600 units"): healing 2 + window 18 (the same burst, the slope's error 0.74x: no
+    # post-lift transient found there) and rank coordinates (longer jumps, fewer rejections)
+    "ranks_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
+                    "cpi.window": 18},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}
