@@ -352,6 +352,18 @@ def rms(a, b, t, window):
     return math.sqrt(float(np.mean((a[sel] - b[sel]) ** 2))) if sel.any() else float("nan")
 
 
+def spread_floor(directs, window):
+    """sqrt(2 var_r / R), var_r the realizations' variance at a node, mean over the directs, the
+    nodes and their samples in WINDOW."""
+    out = []
+    for d in directs:
+        sel = (d["t"] >= window[0]) & (d["t"] < window[1])
+        x = d["icdf"][sel]
+        if x.shape[0] and x.shape[1] > 1:
+            out.append(2.0 * float(np.mean(x.var(axis=1, ddof=1))) / x.shape[1])
+    return math.sqrt(float(np.mean(out))) if out else float("nan")
+
+
 def analyse_case(args, case):
     scene, us, duration, realizations, cpi = CASES[case]
     folder = os.path.join(args.results, case)
@@ -386,6 +398,10 @@ def analyse_case(args, case):
     pairs = [(i, j) for i in range(len(directs)) for j in range(i + 1, len(directs))]
     floor = {w: float(np.mean([rms(means[i], means[j], t, w) for i, j in pairs])) if pairs else float("nan")
              for w in quarters + [whole]}
+    # The floor a model gives from the realizations' spread: two independent ensembles of R differ
+    # by sqrt(2) standard errors of the mean, sqrt(2 var_r / R). A check beside the pairs' floor, and
+    # the only one while a case has a single direct ensemble (rule: the stated floor is the pairs').
+    spread = {w: spread_floor(directs, w) for w in quarters + [whole]}
 
     def state_at(run, when):
         """Each realization's median light height at the last sample at or before `when`."""
@@ -400,6 +416,7 @@ def analyse_case(args, case):
     direct_quiet = [s for d in directs for s in d["quiet"]]
     last_stop = max(direct_stops) if all(np.isfinite(direct_stops)) else float("nan")
     summary = {"case": case, "span": span, "floor": floor[whole], "floor_quarters": [floor[w] for w in quarters],
+               "spread_floor": spread[whole],
                "direct_end_median": d_mean, "direct_end_median_se": d_se,
                "direct_stopped": int(np.isfinite(direct_stops).sum()), "direct_realizations": len(direct_stops),
                "direct_all_at_rest_at": last_stop, "direct_stopped_demixing": direct_quiet, "cpi": {},
@@ -411,7 +428,8 @@ def analyse_case(args, case):
              + (f": the halves of {DIRECTS_FROM[case]}'s" if case in DIRECTS_FROM else "") + "); noise "
              f"floor (RMS between two direct ensembles' mean ICDF, mean over {len(pairs)} pair(s)): "
              f"{floor[whole]:.3f} d_p over the span, by quarter " + " / ".join(f"{floor[w]:.3f}" for w in quarters)
-             + ".\n",
+             + f" (from the realizations' spread, sqrt(2 var_r / R): {spread[whole]:.3f} d_p, by quarter "
+             + " / ".join(f"{spread[w]:.3f}" for w in quarters) + ").\n",
              f"Direct realizations at rest for good by the end of their runs: {summary['direct_stopped']} of "
              f"{len(direct_stops)} (stop times "
              + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_stops) + "). "
@@ -419,7 +437,7 @@ def analyse_case(args, case):
              f"Direct realizations that stopped demixing (light ICDF moving < {QUIET:g} d_p per {WINDOW:g} units "
              f"to the end of the run, at rest or not): {int(np.isfinite(direct_quiet).sum())} of {len(direct_quiet)} "
              "(since " + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_quiet) + ").\n",
-             f"| CPI run | ended | e / floor by quarter | e / floor | median at t = {span:g} [d_p] | off the "
+             f"| CPI run | ended | e / floor by quarter | e / floor (/ spread floor) | median at t = {span:g} [d_p] | off the "
              "directs' [s.e.] | realizations at rest (stop times) | stopped demixing (since) | DEM-time speed-up "
              "over the span | to the end state: direct / CPI DEM time | wall-time speed-up | DEM time per realization | "
              "stops expected if they came with DEM time (P of none) | particle-steps: the directs' mean / the run's |",
@@ -454,7 +472,8 @@ def analyse_case(args, case):
                 * float(run["simulated_time"]) / float(run["wall_seconds"])) if whole_run else float("nan")
         ended = (f"end state at {float(run['t_all'][-1]):g}" if run["end_state"]
                  else f"{float(run['simulated_time']):g} (duration)")
-        summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole], "e_over_floor_quarters":
+        summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole],
+                                "e_over_spread_floor": e[whole] / spread[whole], "e_over_floor_quarters":
                                 [e[w] / floor[w] for w in quarters], "median": c_mean, "median_se": c_se,
                                 "off_se": off, "stops": [float(x) for x in cpi_stops],
                                 "stopped_demixing": [float(x) for x in cpi_quiet],
@@ -463,7 +482,7 @@ def analyse_case(args, case):
                                 "dem_time_each": dem_each, "stops_expected_by_dem_time": expected,
                                 "p_no_stop_by_dem_time": p_none, "particle_steps_ratio": steps_ratio}
         lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / floor[w]:.2f}" for w in quarters)
-                     + f" | {e[whole] / floor[whole]:.2f} | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
+                     + f" | {e[whole] / floor[whole]:.2f} ({e[whole] / spread[whole]:.2f}) | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
                      f"{int(np.isfinite(cpi_stops).sum())} of {len(cpi_stops)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
                      + f") | {int(np.isfinite(cpi_quiet).sum())} of {len(cpi_quiet)} ("
