@@ -14,14 +14,18 @@ plus a small fast part a. The frozen offsets make most of the noise floor, but a
 them; the walk is what a slope measures as motion.
 
 The model of a CPI run. Its frozen offsets and the walk in its bursts are those of a direct
-ensemble of the same R (an independent one). Each jump of DT from a slope fitted over a window W
-(least squares over N samples) adds to its ensemble mean the variance
+ensemble of the same R (an independent one). A jump of DT from a slope fitted over a window W
+(least squares over N samples) moves the ensemble mean by DT times the slope, whose error is the
+walk's increments over the window: variance 1.2 q / (W R) (the least-squares slope of a walk of
+diffusivity q over W; of white noise of variance a / 2 per sample, 12 (a / 2) / (N W^2)). That
+error is correlated with the walk already in the state it extrapolates from (covariance q / R:
+the weights of a least-squares slope sum, against the times, to one), and the jump stands in for
+DT of walk a direct ensemble makes (q DT / R). So against a direct ensemble each jump adds
 
-    DT^2 (1.2 q / W + 6 a / (N W^2)) / R
+    (1.2 q DT^2 / W + 2 q DT - q DT + 6 a DT^2 / (N W^2)) / R
 
-(the least-squares slope of a walk of diffusivity q over W has variance 1.2 q / W; of white noise
-of variance a / 2 per sample, 12 (a / 2) / (N W^2)), and nothing contracts it (V linear: no decay
-measured over the span). So at time t, against an independent direct ensemble,
+and nothing contracts it (V linear: no decay measured over the span). So at time t, against an
+independent direct ensemble,
 
     E[e^2(t)] = 2 var_r(t) / R + A(t),    A(t) = the sum over the jumps landed by t,
 
@@ -126,8 +130,9 @@ def jumps(run):
 
 
 def jump_variance(dt, a, q, window, step, r):
+    """The variance one jump of DT adds to the ensemble mean beyond a direct ensemble's (above)."""
     n = window / step + 1.0
-    return dt * dt * (1.2 * q / window + 6.0 * a / (n * window * window)) / r
+    return (1.2 * q * dt * dt / window + q * dt + 6.0 * a * dt * dt / (n * window * window)) / r
 
 
 def var_r(directs, t):
