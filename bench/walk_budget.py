@@ -147,7 +147,7 @@ def var_r(directs, t):
 def compare(directs, run, a, q):
     """(predicted, measured) e / spread floor of the CPI run RUN over the directs' grid samples."""
     r = run["icdf"].shape[1]
-    window = key(run["command"], "cpi.window", 10.0)
+    window = key(run.get("command", run.get("study_command", "")), "cpi.window", 10.0)
     step = float(np.min(np.diff(np.asarray(run["t_all"], dtype=float))))
     span = min(float(d["t"][-1]) for d in directs)
     grid = directs[0]["t"][(directs[0]["t"] <= span + 1e-6)]

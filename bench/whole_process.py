@@ -495,6 +495,7 @@ def analyse_case(args, case):
                      + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-")
                      + f" | {dem_each:g} | {expected:.1f} ({p_none:.2g}) | {steps_ratio:.2f} |")
     lines.append("")
+    lines.append(noise_model_line(directs, {n: runs[n] for n in cpi if n in runs}))
     # While some directs are short, the state at the end of the run against those that got there.
     full = [d for d in directs if float(d["t_all"][-1]) >= duration - 1e-6]
     if span < duration - 1e-6 and full:
@@ -511,6 +512,22 @@ def analyse_case(args, case):
                      f"realizations, median light height {f_mean:.2f} +- {f_se:.2f} d_p): " + "; ".join(out) + ".\n")
     plot(folder, case, t, directs, {n: runs[n] for n in cpi if n in runs})
     return summary, lines
+
+
+def noise_model_line(directs, cpis):
+    """The noise model of bench/walk_budget.py on this case: the directs' fitted noise and each
+    CPI run's predicted e / spread floor (noise only) beside its measured one."""
+    import walk_budget as wb  # it imports this module: here, not at the top
+    a, q, c, var, _ = wb.fit_noise(directs)
+    parts = []
+    for name, run in cpis.items():
+        predicted, measured, _, jumps = wb.compare(directs, run, a, q)
+        parts.append(f"{name} {predicted:.2f} ({measured:.2f}, {jumps} jumps)")
+    return (f"Noise model (bench/walk_budget.py; docs/error_control.md §7): offsets' variance {var:.3f} d_p^2, "
+            f"walk q = {q:.2e} d_p^2 per unit, own rates c = {c:.1e}, fast part a = {a:.4f}; e / spread floor "
+            "predicted from noise alone (measured, jumps): " + ("; ".join(parts) if parts else "no CPI run yet")
+            + ". Truncation and the lift's miss come on top; at U_s = 0.41 the offsets relax within tens of "
+            "units and the model overstates.\n")
 
 
 def plot(folder, case, t, directs, cpis):
