@@ -187,7 +187,15 @@ def main():
     ap.add_argument("--healing", type=float, default=2.0, help="the uniform schedules' healing")
     ap.add_argument("--window", type=float, default=18.0, help="the uniform schedules' window")
     args = ap.parse_args()
+    for path in args.directs + args.cpi:
+        if not os.path.isfile(path) or not path.endswith((".h5", ".json")):
+            sys.exit(f"walk_budget: {path}: not a run archive (.h5) or reduction (.json) file")
     directs = [read(p) for p in args.directs]
+    for path, d in zip(args.directs, directs):
+        if d["icdf"].shape[1] < 2 or float(d["t"][-1]) < SETTLED + LAGS[-1]:
+            sys.exit(f"walk_budget: {path}: {d['icdf'].shape[1]} realization(s) over {float(d['t'][-1]):g} units; "
+                     f"the noise fit needs >= 2 realizations and >= {SETTLED + LAGS[-1]:g} units "
+                     f"(offsets settle by t = {SETTLED:g}, lags up to {LAGS[-1]:g})")
     a, q, c, var, v = fit_noise(directs)
     r = directs[0]["icdf"].shape[1]
     span = min(float(d["t"][-1]) for d in directs)

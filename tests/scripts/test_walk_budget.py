@@ -4,7 +4,9 @@ realization's ICDF node is x_r(t) = f t + o_r + rho_r t + w_r(t), a frozen offse
 a rate of its own rho_r (variance c) and a walk w_r (variance q per unit)."""
 import math
 import os
+import subprocess
 import sys
+import tempfile
 import unittest
 
 import numpy as np
@@ -101,6 +103,17 @@ class Noise(unittest.TestCase):
     def test_jumps_are_read_from_the_gaps(self):
         t = np.concatenate([np.arange(0.5, 30.01, 0.5), np.arange(70.5, 90.01, 0.5)])
         self.assertEqual(wb.jumps({"t_all": t}), [(70.0, 40.0)])
+
+
+class Input(unittest.TestCase):
+    def test_bad_files_are_named(self):
+        script = os.path.join(os.path.dirname(__file__), "..", "..", "bench", "walk_budget.py")
+        with tempfile.TemporaryDirectory() as tmp:
+            missing = os.path.join(tmp, "direct_a.h5")
+            out = subprocess.run([sys.executable, script, "--directs", missing], capture_output=True, text=True)
+            self.assertNotEqual(out.returncode, 0)
+            self.assertIn(missing, out.stderr)
+            self.assertNotIn("Traceback", out.stderr)
 
 
 class Prediction(unittest.TestCase):
