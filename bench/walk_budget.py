@@ -186,6 +186,8 @@ def main():
     ap.add_argument("--cpi", nargs="*", default=[])
     ap.add_argument("--healing", type=float, default=2.0, help="the uniform schedules' healing")
     ap.add_argument("--window", type=float, default=18.0, help="the uniform schedules' window")
+    ap.add_argument("--plot", help="PNG: predicted e / floor against S, the CPI runs as measured")
+    ap.add_argument("--title", default="", help="the plot's title")
     args = ap.parse_args()
     for path in args.directs + args.cpi:
         if not os.path.isfile(path) or not path.endswith((".h5", ".json")):
@@ -204,17 +206,52 @@ def main():
     print("V(tau) [d_p^2]: " + ", ".join(f"{lag:g}: {x:.4f}" for lag, x in zip(LAGS, v))
           + f"  (2 var = {2 * var:.4f}); fit a = {a:.4f}, q = {q:.2e} d_p^2 per unit, c = {c:.2e} d_p^2 per unit^2")
     if args.cpi:
-        print("\n| CPI run | window | jumps | e / spread floor predicted (noise only) | measured |")
-        print("|---|---|---|---|---|")
+        print("\n| CPI run | window | jumps | DEM-time speed-up | e / spread floor predicted (noise only) | measured |")
+        print("|---|---|---|---|---|---|")
+    points = []
     for path in args.cpi:
-        pred, meas, window, n = compare(directs, read(path), a, q)
-        print(f"| {os.path.basename(path)} | {window:g} | {n} | {pred:.2f} | {meas:.2f} |")
+        run = read(path)
+        pred, meas, window, n = compare(directs, run, a, q)
+        points.append((os.path.basename(path), speedup_of(run), pred, meas))
+        print(f"| {os.path.basename(path)} | {window:g} | {n} | {points[-1][1]:.2f} | {pred:.2f} | {meas:.2f} |")
     print(f"\nUniform schedules (healing {args.healing:g} + window {args.window:g}, R = {r}, over {span:g} units): "
           "e / floor at the end and RMS over the span; at equal compute, CPI's error over a direct ensemble's of R / S")
     for s in (2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 12.0):
         end, whole, equal = uniform(directs, a, q, span, r, args.healing, args.window, step, s)
         print(f"  S = {s:g} (DT = {(s - 1) * (args.healing + args.window):g}): {end:.2f} at the end, {whole:.2f} over the "
               f"span; at equal compute {equal:.2f}")
+    if args.plot:
+        plot(args, directs, a, q, span, r, step, points)
+
+
+def speedup_of(run):
+    """Simulated time over DEM time: the samples' span over the time they were sampled in."""
+    t = np.asarray(run["t_all"], dtype=float)
+    step = float(np.min(np.diff(t)))
+    return float(t[-1]) / (len(t) * step)
+
+
+def plot(args, directs, a, q, span, r, step, points):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    speedups = np.linspace(1.25, 12.0, 44)
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for healing, window, style in ((args.healing, args.window, "-"), (10.0, 10.0, "--")):
+        curve = [uniform(directs, a, q, span, r, healing, window, step, s) for s in speedups]
+        ax.plot(speedups, [c[1] for c in curve], "k" + style,
+                label=f"noise alone, bursts {healing:g} + {window:g}: e / floor (RMS over the span)")
+        if style == "-":
+            ax.plot(speedups, [c[2] for c in curve], color="0.45", ls="-.", label="noise alone: CPI's error / direct's at equal compute")
+    for k, (name, s, pred, meas) in enumerate(points):
+        ax.plot([s], [meas], "o", color=f"C{k % 8}", label=f"{name}: measured")
+        ax.plot([s], [pred], "o", mfc="none", color=f"C{k % 8}", label=f"{name}: predicted for its jumps")
+    ax.axhline(1.0, color="0.6", lw=0.8)
+    ax.set_xlabel("DEM-time speed-up S")
+    ax.set_ylabel("error / noise floor (from the spread)")
+    ax.set_title(args.title or f"{len(directs)} direct ensemble(s) of R = {r}, {span:g} units", fontsize=10)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    fig.savefig(args.plot, dpi=120, bbox_inches="tight")
 
 
 if __name__ == "__main__":
