@@ -94,7 +94,7 @@ TALL_SLOW = {
                     "cpi.window": 18},
     # the same with the whole trajectory's accuracy instead of a per-jump tolerance (issue 34 item
     # 1): a = 1.5 allows sqrt(1 + a^2 / 2) = 1.46 floors, where bench/walk_budget.py's noise model
-    # of this bed expects 5x at about 1.3 (docs/error_control.md §7)
+    # of this bed (R = 4, 400 units) expects 1.37 floors at 4.4x (docs/error_control.md §7)
     "ranks_accuracy_h2w18": {**{k: v for k, v in MOVING.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5,
                              "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18},
 }
@@ -521,8 +521,12 @@ def noise_model_line(directs, cpis):
     a, q, c, var, _ = wb.fit_noise(directs)
     parts = []
     for name, run in cpis.items():
-        predicted, measured, _, jumps = wb.compare(directs, run, a, q)
-        parts.append(f"{name} {predicted:.2f} ({measured:.2f}, {jumps} jumps)")
+        predicted, measured, _, jumps = wb.compare(directs, run, q)
+        # the model is for one burst's least-squares slope over a fixed window
+        other = [k for k in ("cpi.slope=pooled", "cpi.integrator=adams_bashforth2", "cpi.window_auto=true",
+                             "cpi.healing_auto=true") if k in run.get("study_command", "")]
+        parts.append(f"{name} {predicted:.2f} ({measured:.2f}, {jumps} jumps"
+                     + (f"; not the model's slope: {', '.join(other)}" if other else "") + ")")
     return (f"Noise model (bench/walk_budget.py; docs/error_control.md §7): offsets' variance {var:.3f} d_p^2, "
             f"walk q = {q:.2e} d_p^2 per unit, own rates c = {c:.1e}, fast part a = {a:.4f}; e / spread floor "
             "predicted from noise alone (measured, jumps): " + ("; ".join(parts) if parts else "no CPI run yet")

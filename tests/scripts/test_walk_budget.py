@@ -63,31 +63,32 @@ def cpi(rng, r, span, v0, q, healing, window, dt):
 
 class Noise(unittest.TestCase):
     def test_fit_separates_walk_rates_and_offsets(self):
-        # 6 ensembles x 8 realizations x 4 nodes over 400 units. The fitted q and c from V(tau)
-        # at lags 5-120 over these 192 walks: q within 10 % (each lag's V averages ~190 x 560
-        # overlapping increments; their scatter, estimated by re-drawing, is ~3-4 % for q), c
-        # within 35 % (c tau^2 is a fifth of V at the largest lag and the quadratic term takes
-        # the scatter of the long lags); the offsets' variance v0 + q t + c t^2 within 15 %
-        # (192 draws of the offsets: relative sd of a variance sqrt(2/192) = 10 %, as 1.5 sd).
+        # 6 ensembles x 8 realizations x 4 nodes over 400 units, fitted at lags 5-120. Over 30
+        # seeds the relative errors scatter with sd 4 % (q), 20 % (c: c tau^2 is 40 % of V at the
+        # largest lag, and the quadratic term takes the scatter of the long lags), 11 % (the
+        # offsets' variance v0 + q t + c t^2: 192 draws of the offsets, sqrt(2/192) = 10 %) and
+        # the fast part a, absent here, up to 0.2 q x 5: the bounds are about 3.5 sd (q 15 %,
+        # c 70 %, variance 38 %, a < 0.3 q x 5). A fit of a line alone would put c's share into q
+        # (about +40 %) and fail; c = 0 fails by 100 %.
         rng = np.random.default_rng(7)
         v0, q, c = 0.15, 3e-4, 2e-6
         runs = [direct(rng, 8, 400.0, v0, q, c) for _ in range(6)]
         a, q_fit, c_fit, var, _ = wb.fit_noise(runs)
-        self.assertLess(abs(q_fit / q - 1.0), 0.10)
-        self.assertLess(abs(c_fit / c - 1.0), 0.35)
+        self.assertLess(abs(q_fit / q - 1.0), 0.15)
+        self.assertLess(abs(c_fit / c - 1.0), 0.70)
         mean_t = 0.5 * (wb.SETTLED + 400.0)
         expected = v0 + q * mean_t + c * np.mean(np.arange(wb.SETTLED, 400.0, STEP) ** 2)
-        self.assertLess(abs(var / expected - 1.0), 0.15)
-        self.assertLess(a, 0.1 * q * 5.0)  # no fast part in these walks
+        self.assertLess(abs(var / expected - 1.0), 0.38)
+        self.assertLess(a, 0.3 * q * 5.0)  # no fast part in these walks
 
     def test_jump_variance_is_what_a_jump_adds_beyond_a_direct_run(self):
         # 20,000 walks (q = 3e-4) through a window of W = 18 (37 samples) from 0: the jump's state
         # B(W) + DT slope against a direct run's B(W) + B'(DT) (the walk going on for DT = 80).
         # Their variances' difference (about 510 q: 430 q the slope's, 80 q its covariance with
         # B(W) and the walk the jump replaces) against the formula. The Monte Carlo's relative sd
-        # is about sqrt(2 / 20000) x 605 / 510 = 1.7 %; the continuum 1.2 q / W differs from the
-        # 37 samples' exact value by under 3 % (1/N): 6 % holds both. Without the covariance
-        # term (80 q) the formula would be 16 % low.
+        # is about 1 % (measured over 40 seeds); the continuum 1.2 q / W is 2.6 % above the 37
+        # samples' exact 1.169 q / W: 6 % holds both (the largest error over 40 seeds was 5 %).
+        # Without the covariance term (80 q) the formula would be 16 % low.
         rng = np.random.default_rng(3)
         q, window, dt, r, draws = 3e-4, 18.0, 80.0, 1, 20000
         n = int(round(window / STEP)) + 1
@@ -98,7 +99,7 @@ class Noise(unittest.TestCase):
         jumped = walks[:, -1] + dt * slopes
         walked = walks[:, -1] + rng.normal(0.0, math.sqrt(q * dt), size=draws)
         excess = float(np.var(jumped) - np.var(walked))
-        self.assertLess(abs(excess / wb.jump_variance(dt, 0.0, q, window, STEP, r) - 1.0), 0.06)
+        self.assertLess(abs(excess / wb.jump_variance(dt, q, window, r) - 1.0), 0.06)
 
     def test_jumps_are_read_from_the_gaps(self):
         t = np.concatenate([np.arange(0.5, 30.01, 0.5), np.arange(70.5, 90.01, 0.5)])
@@ -120,19 +121,20 @@ class Prediction(unittest.TestCase):
     def test_predicted_error_is_the_mean_measured_one(self):
         # 300 replicas: 4 direct ensembles and one CPI run (R = 8, bursts 2 + 18, 3 jumps of 80
         # over 330 units) each, the walk of the tall bed at U_s = 0.19 (q = 3e-4) with small frozen
-        # offsets (v0 = 0.02), so that the jumps' part (about 1.5 floors^2) is resolved. The mean
-        # of the measured (e / floor)^2 against the mean predicted: each replica's measured value scatters (3 jumps, 4 directs), so the bound is 4
-        # standard errors of the mean difference (about 0.29) plus 5 % for the continuum slope
-        # variance and the floor taken from the directs' spread. The prediction is 2.78 against a
-        # measured 2.80 here; a q off by 1.5x or 1/1.5x moves it by 0.9 and 0.6, outside the bound
-        # (about 0.48; checked when written). Leaving out a jump's covariance term (0.3 here) is
-        # within it: the test above is the one that catches that.
+        # offsets (v0 = 0.02), so that the jumps' part (about 1.8 floors^2) is resolved. The mean
+        # of the measured (e / floor)^2 against the mean predicted: each replica's measured value
+        # scatters (3 jumps, 4 directs), so the bound is 4 standard errors of the mean difference
+        # (about 0.34) plus 5 % (0.14) for the continuum slope variance and the floor taken from the
+        # directs' spread. The prediction is 2.78 against a measured 2.80 here; a q off by 1.5x or
+        # 1/1.5x moves it by 0.9 and 0.6, outside the bound (about 0.48; checked when written, and
+        # over 6 seeds the difference stayed within 0.03). Leaving out a jump's covariance term
+        # (0.3 here) is within it: the test above is the one that catches that.
         rng = np.random.default_rng(11)
         v0, q = 0.02, 3e-4
         pred, meas = [], []
         for _ in range(300):
             directs = [direct(rng, 8, 330.0, v0, q) for _ in range(4)]
-            p, m, window, n_jumps = wb.compare(directs, cpi(rng, 8, 330.0, v0, q, 2.0, 18.0, 80.0), 0.0, q)
+            p, m, window, n_jumps = wb.compare(directs, cpi(rng, 8, 330.0, v0, q, 2.0, 18.0, 80.0), q)
             self.assertEqual((window, n_jumps), (18.0, 3))
             pred.append(p * p)
             meas.append(m * m)
