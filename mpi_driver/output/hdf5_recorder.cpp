@@ -445,6 +445,7 @@ void Hdf5Recorder::coarse_step(const coarse::ProjectiveStepRecord& rec, const Li
             {"budget", c.budget},
             {"ensemble_standard_error", c.ensemble_standard_error},
             {"budget_spent", c.budget_spent},
+            {"budget_walk", c.budget_walk},
             {"contraction_rate", c.contraction_rate},
             {"predicted_truncation", c.predicted_truncation},
             {"dt_tolerance", c.dt_tolerance},

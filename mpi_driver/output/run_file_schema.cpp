@@ -427,6 +427,12 @@ const std::vector<DatasetDoc>& run_file_schema() {
          "cpi.accuracy: the error the kept jumps have added so far, contracted where a decay is "
          "measured",
          {"t_start"}},
+        {"/cpi/controller/budget_walk",
+         "d_p",
+         "walk charged",
+         "cpi.accuracy: a kept jump's charge for the ensemble's walk beyond its slope's variance, "
+         "sqrt(DT q / R), q / R from the last burst's slope standard error (NaN: no charge)",
+         {"t_start"}},
         {"/cpi/controller/contraction_rate",
          "1/sqrt(d_p/g)",
          "contraction rate credited",

@@ -144,7 +144,7 @@ for spec in "adaptive $now 4" "adaptive $data/checkpoint_format_3_adaptive.h5 3"
   # lift's: cpi.at_rest) came after every stored checkpoint.
   ignore=(--ignore cpi/controller/window_noise_ratio cpi/controller/window_noise_correlation
           cpi/controller/window_next cpi/controller/member_step cpi/controller/budget
-          cpi/controller/ensemble_standard_error cpi/controller/budget_spent
+          cpi/controller/ensemble_standard_error cpi/controller/budget_spent cpi/controller/budget_walk
           cpi/controller/contraction_rate cpi/lift_at_rest cpi/lift_error samples/at_rest)
   [ "$version" = 4 ] || ignore+=(cpi/controller/error_statistical_jump cpi/controller/error_statistical_burst
                                 cpi/controller/error_statistical_pool cpi/controller/slope cpi/controller/pooled_bursts

@@ -256,7 +256,7 @@ void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
     double tol = 0.0;
     if (horizon > t_end_)
         tol = budget_->jump_tolerance(basis.model(t_end_, prior_curvature()), horizon,
-                                      burst_length(), settings_.control.dt_max);
+                                      burst_length(), settings_.control.dt_max, budget_walk());
     // Spent (or no noise at all): a tolerance no jump of cpi.dt_min meets, so bursts run
     // directly.
     const double floor = 1e-12 * std::max(budget_->budget(), 1e-300);
@@ -265,6 +265,11 @@ void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
     c.ensemble_standard_error = budget_->state().sigma;
     c.budget_spent = budget_->spent(t_end_);
     c.contraction_rate = budget_->rate();
+}
+
+double MultistepProjectiveIntegrator::budget_walk() const {
+    // The last accepted burst's own slope (not a pool's: its se is the walk over one window).
+    return history_.empty() ? 0.0 : walk_rate(history_.back(), window());
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -505,7 +510,9 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         if (budget_ && budget_->ready()) {
             // The lift's error is charged as a bias, like the truncation part: it need not
             // average out over the jumps (a relaxation that moves heights one way).
-            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation + c.lift);
+            c.budget_walk = std::sqrt(rec.dt * budget_walk());
+            budget_->commit(t_end_ + rec.dt, c.statistical, c.truncation + c.lift,
+                            c.budget_walk * c.budget_walk);
             c.budget_spent = budget_->spent(t_end_ + rec.dt);
         }
         accept_burst(m, c);

@@ -207,6 +207,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// cpi.accuracy: the next jump's tolerance from the trajectory's budget (into the
     /// controller), and the budget's record (into `c`); nothing without cpi.accuracy.
     void set_jump_tolerance(const JumpBasis& basis, ControllerRecord& c);
+    /// cpi.accuracy: the ensemble mean's walk per unit time from the last accepted burst's slope
+    /// (walk_rate()), charged per unit of DT beyond each jump's slope variance.
+    double budget_walk() const;
     /// The record's statistical parts of a jump of `dt`: charged, the jump's own, and what one
     /// burst's slope and the whole pool would have given (ControllerRecord).
     void record_statistical(ControllerRecord& c, const JumpBasis& basis, double dt) const;

@@ -91,6 +91,9 @@ struct ControllerRecord {
     /// error sigma it was set from, the error accumulated by the jumps kept so far (after this
     /// one, when kept) and the contraction rate credited to it (trajectory_budget.hpp).
     double budget = nan, ensemble_standard_error = nan, budget_spent = nan, contraction_rate = nan;
+    /// cpi.accuracy, a kept jump: the error sqrt(DT q / R) it was charged beyond its slope's
+    /// variance for the ensemble's walk (trajectory_budget.hpp, walk_rate()).
+    double budget_walk = nan;
     double truncation = nan;            ///< from the slope after the jump (a posteriori)
     double predicted_truncation = nan;  ///< from the slopes before it (what DT was chosen on)
     Eigen::VectorXd statistical_nodes;  ///< per component

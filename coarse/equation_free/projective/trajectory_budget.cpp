@@ -9,6 +9,11 @@
 
 namespace efdem::coarse {
 
+double walk_rate(const SlopeNode& burst, double window) {
+    if (window <= 0.0 || burst.se.size() == 0) return 0.0;
+    return window * burst.se.squaredNorm() / static_cast<double>(burst.se.size()) / 1.2;
+}
+
 TrajectoryBudget::TrajectoryBudget(double accuracy) : accuracy_(accuracy) {
     EFDEM_EXPECTS(std::isfinite(accuracy) && accuracy > 0.0);
 }
@@ -61,9 +66,10 @@ void TrajectoryBudget::credit(double measured, double cap) {
 }
 
 double TrajectoryBudget::jump_tolerance(const JumpErrorModel& model, double end_time, double burst,
-                                        double dt_max) const {
+                                        double dt_max, double walk) const {
     EFDEM_EXPECTS(ready() && burst > 0.0 && std::isfinite(dt_max) && dt_max > 0.0 &&
-                  std::isfinite(end_time) && end_time > model.t0);
+                  std::isfinite(end_time) && end_time > model.t0 && std::isfinite(walk) &&
+                  walk >= 0.0);
     const double h = end_time - model.t0;
     const double since = std::isnan(state_.t_last) ? 0.0 : std::max(0.0, model.t0 - state_.t_last);
     const double d = std::exp(-state_.rate * since);  // what has decayed by now, not later
@@ -72,7 +78,8 @@ double TrajectoryBudget::jump_tolerance(const JumpErrorModel& model, double end_
     const auto at_end = [&](double dt) {
         const JumpError e = jump_error(model, dt);
         const double n = h / (dt + burst);
-        return t_now + n * e.truncation + std::sqrt(v_now + n * e.statistical * e.statistical);
+        return t_now + n * e.truncation +
+               std::sqrt(v_now + n * (e.statistical * e.statistical + dt * walk));
     };
     const double cap = std::min(dt_max, h);
     if (at_end(0.0) > b) return 0.0;  // spent: no jump fits
@@ -88,14 +95,14 @@ double TrajectoryBudget::jump_tolerance(const JumpErrorModel& model, double end_
     return jump_error(model, lo).total();
 }
 
-void TrajectoryBudget::commit(double t_landed, double statistical, double truncation) {
-    EFDEM_EXPECTS(statistical >= 0.0 && truncation >= 0.0);
+void TrajectoryBudget::commit(double t_landed, double statistical, double truncation, double walk) {
+    EFDEM_EXPECTS(statistical >= 0.0 && truncation >= 0.0 && walk >= 0.0);
     if (!std::isnan(state_.t_last)) {
         const double decay = std::exp(-state_.rate * std::max(0.0, t_landed - state_.t_last));
         state_.variance *= decay * decay;
         state_.truncation *= decay;
     }
-    state_.variance += statistical * statistical;
+    state_.variance += statistical * statistical + walk;
     state_.truncation += truncation;
     state_.t_last = t_landed;
 }

@@ -16,7 +16,12 @@
 /// jumps like it, repeated over the rest of the run (H to its end, one every DT + burst), keep
 /// the accumulated error within B:
 ///   T d + n tau(DT) + sqrt(V d^2 + n s(DT)^2) <= B,   n = H / (DT + burst),
-/// d = exp(-lambda (t0 - t_last)), and its tolerance is that jump's error s(DT) + tau(DT). Once
+/// d = exp(-lambda (t0 - t_last)), and its tolerance is that jump's error s(DT) + tau(DT). Where
+/// the slope's noise is the ensemble's walk (at U_s = 0.19: bench/walk_budget.py) a jump adds
+/// more than its slope's variance s(DT)^2: the slope's error is correlated with the walk already
+/// in the state it extrapolates from (twice DT q / R) and the jump stands in for the walk of DT a
+/// direct ensemble makes (less DT q / R), so each jump is charged s(DT)^2 + DT q / R, q / R the
+/// mean's walk per unit time (walk_rate()). Once
 /// the budget is spent the tolerance falls below what cpi.dt_min allows and the run goes on
 /// directly.
 ///
@@ -27,7 +32,7 @@
 /// b.credit(lambda, 1.0 / burst_length);  // every accepted burst: its resolved decay, or NaN
 /// const double tol = b.jump_tolerance(model, end_time, burst_length, dt_max);
 /// // ... jump, judge against tol, and when kept:
-/// b.commit(t_landed, statistical, truncation);
+/// b.commit(t_landed, statistical, truncation, dt * walk_rate(last_burst, window));
 /// \endcode
 
 #include <limits>
@@ -51,6 +56,11 @@ struct TrajectoryBudgetState {
     double last_rate = nan;
     double rate = 0.0;
 };
+
+/// The ensemble mean's walk per unit time, q / R, from a burst's least-squares slope over
+/// `window`: the slope of a walk over W has variance 1.2 q / (W R), so q / R = W se^2 / 1.2 (mean
+/// over the components). 0 for a window <= 0 or no components.
+double walk_rate(const SlopeNode& burst, double window);
 
 class TrajectoryBudget {
   public:
@@ -88,14 +98,17 @@ class TrajectoryBudget {
      * \brief The tolerance of the next jump, starting at model.t0, of a run that ends at
      *        `end_time` with bursts of `burst` after each jump and jumps of at most `dt_max`
      *        (see the file comment). 0 when the budget is spent.
-     * \pre ready(), burst > 0, dt_max > 0 finite, end_time > model.t0 finite.
+     *        Each jump of DT is charged DT walk beyond its slope's variance (walk_rate(); 0:
+     *        none).
+     * \pre ready(), burst > 0, dt_max > 0 finite, end_time > model.t0 finite, walk >= 0.
      */
-    double jump_tolerance(const JumpErrorModel& model, double end_time, double burst,
-                          double dt_max) const;
+    double jump_tolerance(const JumpErrorModel& model, double end_time, double burst, double dt_max,
+                          double walk = 0.0) const;
 
-    /// A jump kept that landed at t_landed with these parts of its error; the accumulated
-    /// error is first contracted at rate() from t_last to t_landed.
-    void commit(double t_landed, double statistical, double truncation);
+    /// A jump kept that landed at t_landed with these parts of its error and the variance
+    /// `walk` (DT walk_rate(), >= 0) it added beyond its slope's; the accumulated error is first
+    /// contracted at rate() from t_last to t_landed.
+    void commit(double t_landed, double statistical, double truncation, double walk = 0.0);
 
     const TrajectoryBudgetState& state() const { return state_; }
     void restore(const TrajectoryBudgetState& state) { state_ = state; }
