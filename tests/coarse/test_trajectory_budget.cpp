@@ -141,6 +141,18 @@ TEST_CASE("budgeted jumps end within the trajectory's budget",
 
 namespace {
 
+/// Adaptive CPI with cpi.accuracy = `accuracy` on the OU toys below: bursts of healing 1 and
+/// `window`, jumps of 2.5 to `dt_max` in steps of 0.1.
+MultistepSettings budgeted(double accuracy, double window, double dt_max) {
+    MultistepSettings s;
+    s.burst.healing = 1.0;
+    s.burst.window = window;
+    s.control = {.tolerance = 1.0, .dt_min = 2.5, .dt_max = dt_max};
+    s.dt_quantum = 0.1;
+    s.accuracy = accuracy;
+    return s;
+}
+
 struct BudgetRun {
     std::vector<double> accumulated;  ///< per seed and component: the sum of the jumps' errors
     std::vector<double> spent;        ///< per seed: the budget's account of it at the end
@@ -160,13 +172,7 @@ BudgetRun budget_run(double a, std::uint64_t seeds) {
     for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
         test::OuEnsembleStepper toy(k, 0.05, 8, 0.1, Eigen::VectorXd::Constant(dim, 3.0),
                                     300 + seed);
-        MultistepSettings s;
-        s.burst.healing = 1.0;
-        s.burst.window = 4.0;
-        s.control = {.tolerance = 1.0, .dt_min = 2.5, .dt_max = 80.0};
-        s.dt_quantum = 0.1;
-        s.accuracy = a;
-        MultistepProjectiveIntegrator integrator(s);
+        MultistepProjectiveIntegrator integrator(budgeted(a, 4.0, 80.0));
         integrator.set_end_time(300.0);
         Eigen::VectorXd sum = Eigen::VectorXd::Zero(dim);
         double spent = 0.0, walk = 0.0;
@@ -232,13 +238,7 @@ TEST_CASE("cpi.accuracy with cpi.jump_until plans the budget over the jumps befo
         const Eigen::Index dim = 19;
         test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(dim, 1e-4), 0.05, 8, 0.1,
                                     Eigen::VectorXd::Constant(dim, 3.0), 301);
-        MultistepSettings s;
-        s.burst.healing = 1.0;
-        s.burst.window = 4.0;
-        s.control = {.tolerance = 1.0, .dt_min = 2.5, .dt_max = 80.0};
-        s.dt_quantum = 0.1;
-        s.accuracy = 2.0;
-        MultistepProjectiveIntegrator integrator(s);
+        MultistepProjectiveIntegrator integrator(budgeted(2.0, 4.0, 80.0));
         integrator.set_end_time(end_time);
         integrator.set_jump_end(jump_end);
         while (toy.time() < 50.0) {
@@ -297,13 +297,7 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
     for (std::uint64_t seed = 1; seed <= 48; ++seed) {
         test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(dim, k), sigma, members, 0.1,
                                     Eigen::VectorXd::Constant(dim, x0), 700 + seed);
-        MultistepSettings s;
-        s.burst.healing = 1.0;
-        s.burst.window = 10.0;
-        s.control = {.tolerance = 1.0, .dt_min = 2.5, .dt_max = 12.0};
-        s.dt_quantum = 0.1;
-        s.accuracy = 50.0;
-        MultistepProjectiveIntegrator integrator(s);
+        MultistepProjectiveIntegrator integrator(budgeted(50.0, 10.0, 12.0));
         integrator.set_end_time(300.0);
         double spent = 0.0;
         while (300.0 - toy.time() >= 11.0 - 1e-9) {
