@@ -143,8 +143,7 @@ def var_r(directs, t):
     """The realizations' variance at the times t (mean over nodes and directs), on the directs' grid."""
     out = []
     for d in directs:
-        v = (d["icdf"].var(axis=1, ddof=1)).mean(axis=1)
-        out.append(np.interp(t, d["t"], v))
+        out.append(np.interp(t, d["t"], wp.realization_variance(d)))
     return np.mean(out, axis=0)
 
 

@@ -357,15 +357,19 @@ def rms(a, b, t, window):
     return math.sqrt(float(np.mean((a[sel] - b[sel]) ** 2))) if sel.any() else float("nan")
 
 
+def realization_variance(run):
+    """Per sample: the realizations' unbiased variance at a node, mean over the nodes."""
+    return run["icdf"].var(axis=1, ddof=1).mean(axis=1)
+
+
 def spread_floor(directs, window):
     """sqrt(2 var_r / R), var_r the realizations' variance at a node, mean over the directs, the
     nodes and their samples in WINDOW."""
     out = []
     for d in directs:
         sel = (d["t"] >= window[0]) & (d["t"] < window[1])
-        x = d["icdf"][sel]
-        if x.shape[0] and x.shape[1] > 1:
-            out.append(2.0 * float(np.mean(x.var(axis=1, ddof=1))) / x.shape[1])
+        if sel.any() and d["icdf"].shape[1] > 1:
+            out.append(2.0 * float(np.mean(realization_variance(d)[sel])) / d["icdf"].shape[1])
     return math.sqrt(float(np.mean(out))) if out else float("nan")
 
 
