@@ -352,8 +352,12 @@ def held_to(run, t):
     return out
 
 
-def rms(a, b, t, window):
+def rms(a, b, t, window, at=None):
+    """RMS of a - b over the nodes and the samples t in WINDOW where both are finite (and AT, a mask
+    over t, holds)."""
     sel = (t >= window[0]) & (t < window[1]) & np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+    if at is not None:
+        sel &= at
     return math.sqrt(float(np.mean((a[sel] - b[sel]) ** 2))) if sel.any() else float("nan")
 
 
@@ -362,15 +366,35 @@ def realization_variance(run):
     return run["icdf"].var(axis=1, ddof=1).mean(axis=1)
 
 
-def spread_floor(directs, window):
+def spread_floor(directs, window, times=None):
     """sqrt(2 var_r / R), var_r the realizations' variance at a node, mean over the directs, the
-    nodes and their samples in WINDOW."""
+    nodes and their samples in WINDOW (those at TIMES only, when given)."""
     out = []
     for d in directs:
         sel = (d["t"] >= window[0]) & (d["t"] < window[1])
+        if times is not None:
+            sel &= np.isin(np.round(d["t"], 6), np.round(times, 6))
         if sel.any() and d["icdf"].shape[1] > 1:
             out.append(2.0 * float(np.mean(realization_variance(d)[sel])) / d["icdf"].shape[1])
     return math.sqrt(float(np.mean(out))) if out else float("nan")
+
+
+def error_to(x, means, t, windows):
+    """e per window: the RMS of X (an ensemble mean at the times t, NaN where it has no sample)
+    minus each direct ensemble's mean (MEANS), averaged in square over the directs."""
+    return {w: math.sqrt(np.mean([rms(x, m, t, w) ** 2 for m in means])) for w in windows}
+
+
+def floors(directs, means, t, windows, at=None):
+    """The noise floors per window, at the samples t where AT (a mask over t) holds: the pairs'
+    (the mean over pairs of directs of the RMS between their means) and the spread's
+    (spread_floor). A CPI run samples only in its bursts and the floor grows with t, so its e is
+    divided by the floors at its own samples (AT = where it has one), as bench/walk_budget.py does."""
+    pairs = [(i, j) for i in range(len(means)) for j in range(i + 1, len(means))]
+    pair = {w: float(np.mean([rms(means[i], means[j], t, w, at) for i, j in pairs])) if pairs
+            else float("nan") for w in windows}
+    spread = {w: spread_floor(directs, w, None if at is None else t[at]) for w in windows}
+    return pair, spread
 
 
 def analyse_case(args, case):
@@ -405,12 +429,10 @@ def analyse_case(args, case):
     whole = (0.0, span + 1e-6)
     means = [held_to(d, t) for d in directs]
     pairs = [(i, j) for i in range(len(directs)) for j in range(i + 1, len(directs))]
-    floor = {w: float(np.mean([rms(means[i], means[j], t, w) for i, j in pairs])) if pairs else float("nan")
-             for w in quarters + [whole]}
     # The floor a model gives from the realizations' spread: two independent ensembles of R differ
     # by sqrt(2) standard errors of the mean, sqrt(2 var_r / R). A check beside the pairs' floor, and
     # the only one while a case has a single direct ensemble (rule: the stated floor is the pairs').
-    spread = {w: spread_floor(directs, w) for w in quarters + [whole]}
+    floor, spread = floors(directs, means, t, quarters + [whole])
 
     def state_at(run, when):
         """Each realization's median light height at the last sample at or before `when`."""
@@ -438,7 +460,9 @@ def analyse_case(args, case):
              f"floor (RMS between two direct ensembles' mean ICDF, mean over {len(pairs)} pair(s)): "
              f"{floor[whole]:.3f} d_p over the span, by quarter " + " / ".join(f"{floor[w]:.3f}" for w in quarters)
              + f" (from the realizations' spread, sqrt(2 var_r / R): {spread[whole]:.3f} d_p, by quarter "
-             + " / ".join(f"{spread[w]:.3f}" for w in quarters) + ").\n",
+             + " / ".join(f"{spread[w]:.3f}" for w in quarters) + "). Each CPI run's e is divided by "
+             "these floors taken at its own samples (it samples only in its bursts, and the floor grows "
+             "with t).\n",
              f"Direct realizations at rest for good by the end of their runs: {summary['direct_stopped']} of "
              f"{len(direct_stops)} (stop times "
              + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in direct_stops) + "). "
@@ -456,7 +480,8 @@ def analyse_case(args, case):
             continue
         run = runs[name]
         x = held_to(run, t)
-        e = {w: math.sqrt(np.mean([rms(x, m, t, w) ** 2 for m in means])) for w in quarters + [whole]}
+        e = error_to(x, means, t, quarters + [whole])
+        f_at, s_at = floors(directs, means, t, quarters + [whole], np.isfinite(x).all(axis=1))
         med = state_at(run, span)
         c_mean, c_se = float(med.mean()), float(med.std(ddof=1) / math.sqrt(len(med)))
         off = (c_mean - d_mean) / math.sqrt(d_se ** 2 + c_se ** 2)
@@ -481,17 +506,19 @@ def analyse_case(args, case):
                 * float(run["simulated_time"]) / float(run["wall_seconds"])) if whole_run else float("nan")
         ended = (f"end state at {float(run['t_all'][-1]):g}" if run["end_state"]
                  else f"{float(run['simulated_time']):g} (duration)")
-        summary["cpi"][name] = {"e_over_floor": e[whole] / floor[whole],
-                                "e_over_spread_floor": e[whole] / spread[whole], "e_over_floor_quarters":
-                                [e[w] / floor[w] for w in quarters], "median": c_mean, "median_se": c_se,
+        summary["cpi"][name] = {"e_over_floor": e[whole] / f_at[whole],
+                                "e_over_spread_floor": e[whole] / s_at[whole], "e_over_floor_quarters":
+                                [e[w] / f_at[w] for w in quarters],
+                                "e_over_floor_all_samples": e[whole] / floor[whole],
+                                "floor_at_samples": f_at[whole], "median": c_mean, "median_se": c_se,
                                 "off_se": off, "stops": [float(x) for x in cpi_stops],
                                 "stopped_demixing": [float(x) for x in cpi_quiet],
                                 "speedup_dem": speed,
                                 "speedup_to_end_state": to_end, "speedup_wall": wall, "end_status": run["end_status"],
                                 "dem_time_each": dem_each, "stops_expected_by_dem_time": expected,
                                 "p_no_stop_by_dem_time": p_none, "particle_steps_ratio": steps_ratio}
-        lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / floor[w]:.2f}" for w in quarters)
-                     + f" | {e[whole] / floor[whole]:.2f} ({e[whole] / spread[whole]:.2f}) | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
+        lines.append(f"| {name} | {ended} | " + " / ".join(f"{e[w] / f_at[w]:.2f}" for w in quarters)
+                     + f" | {e[whole] / f_at[whole]:.2f} ({e[whole] / s_at[whole]:.2f}) | {c_mean:.2f} +- {c_se:.2f} | {off:+.1f} | "
                      f"{int(np.isfinite(cpi_stops).sum())} of {len(cpi_stops)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
                      + f") | {int(np.isfinite(cpi_quiet).sum())} of {len(cpi_quiet)} ("
