@@ -2,8 +2,8 @@
 """One value of cpi.accuracy on beds whose noise differs (issue 34, item 1): adaptive CPI with
 cpi.accuracy = 1.5 (the jumps may add 1.5 ensemble standard errors to the trajectory, so the run
 should lie about sqrt(1 + 1.5^2 / 2) = 1.46x the noise floor from an independent direct ensemble)
-on the demo bed and the tall bed, against the direct ensembles the earlier studies made (same
-beds, own seeds). No per-bed tuning: the same key on every bed.
+on the demo bed, the tall bed and the paper's bed, against the direct ensembles the earlier
+studies made (same beds, own seeds). No per-bed tuning: the same key on every bed.
 
     /usr/bin/python3 bench/accuracy_study.py --efdem build/mpi_driver/efdem          # make and analyse
     /usr/bin/python3 bench/accuracy_study.py --analyse-only
@@ -16,7 +16,13 @@ the commands in those folders' analysis.md):
   tall bed, U_s 0.19, 400 units: bench/results/tall_study_r4/u0.19/direct_{a,b}.h5 (one pair: the
       floor is uncertain by ~2x)
   tall bed, U_s 0.41, 200 units: bench/results/tall_study_r4/u0.41/direct_{a,b}.h5 (one pair)
-Cost (AMD EPYC, 2 shared cores): demo 600 units ~15 min, tall 400 units ~40 min, tall 0.41 ~25 min.
+  paper's bed (12,500 spheres), U_s 0.41, 200 units, R = 2 (what fits 2 cores):
+      bench/results/paper_check_r2/u0.41/direct_{a,b}.h5 (one pair)
+The floor is taken at the CPI run's own samples (it samples only in its bursts; the floor changes
+with t), as e is. Rows of runs whose result file is not on this machine stay as an earlier
+analysis wrote them (marked).
+Cost (AMD EPYC, 2 shared cores): demo 600 units ~15 min, tall 400 units ~40 min, tall 0.41 ~25 min,
+paper's bed ~20 min.
 """
 import argparse
 import json
@@ -31,42 +37,77 @@ sys.path.insert(0, HERE)
 import slope_study as ss  # noqa: E402
 import study_runs as sr  # noqa: E402
 
+sys.path.insert(0, os.path.join(HERE, "..", "scripts"))
+import accuracy_metrics as am  # noqa: E402
+
 ACCURACY = 1.5
 RESULTS = os.path.join(HERE, "results")
-# name: scene, U_s, duration, healing, window, folder of the direct ensembles
+# name: scene, U_s, duration, healing, window, folder of the direct ensembles, realizations (on 2 ranks)
 CASES = {
-    "demo_acc1.5": ("demo_bed.cfg", 0.19, 600.0, 10, 10, "slope_study_r4_u0.19_t600"),
-    "tall_acc1.5": ("tall_bed.cfg", 0.19, 400.0, 10, 10, os.path.join("tall_study_r4", "u0.19")),
-    "tall41_acc1.5": ("tall_bed.cfg", 0.41, 200.0, 2, 20, os.path.join("tall_study_r4", "u0.41")),
+    "demo_acc1.5": ("demo_bed.cfg", 0.19, 600.0, 10, 10, "slope_study_r4_u0.19_t600", 4),
+    "tall_acc1.5": ("tall_bed.cfg", 0.19, 400.0, 10, 10, os.path.join("tall_study_r4", "u0.19"), 4),
+    "tall41_acc1.5": ("tall_bed.cfg", 0.41, 200.0, 2, 20, os.path.join("tall_study_r4", "u0.41"), 4),
+    # The paper's bed as bench/adaptive_study.py --bed paper ran it (bursts 2 + 20, R = 2).
+    "paper41_acc1.5": ("reference_bed.cfg", 0.41, 200.0, 2, 20, os.path.join("paper_check_r2", "u0.41"), 2),
 }
-ORDER = ("demo_acc1.5", "tall_acc1.5", "tall41_acc1.5")
+ORDER = ("demo_acc1.5", "tall_acc1.5", "tall41_acc1.5", "paper41_acc1.5")
 
 
 def overrides(case):
-    _, us, duration, healing, window, _ = CASES[case]
+    _, us, duration, healing, window, _, realizations = CASES[case]
     return {"gas_drag.superficial_velocity": us, "run.duration": duration, "cpi.warmup": 10,
-            "cpi.healing": healing, "cpi.window": window, "ensemble.realizations_per_rank": 2,
+            "cpi.healing": healing, "cpi.window": window, "ensemble.realizations_per_rank": realizations // 2,
             "seed": 404, "cpi.projection": "adaptive", "cpi.accuracy": ACCURACY}
+
+
+def floor_on(run, a, b):
+    """RMS between the direct ensembles A and B over the CPI RUN's samples (that both have)."""
+    keep_a, ya = am.align(a["t"], a["mean"], run["t"])
+    keep_b, yb = am.align(b["t"], b["mean"], run["t"])
+    both_a, both_b = keep_b[keep_a], keep_a[keep_b]  # within each kept set, the times the other has
+    d = ya[both_a] - yb[both_b]
+    return math.sqrt(float(np.mean(d * d))) if len(d) else float("nan")
+
+
+def earlier_rows(results):
+    """The table rows and summary an earlier analysis wrote, by run name."""
+    rows, summary = {}, {}
+    path = os.path.join(results, "analysis.md")
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                name = line.split("|")[1].strip().rstrip("*") if line.startswith("| ") else ""
+                if name in CASES:
+                    rows[name] = line.rstrip("\n")
+    if os.path.exists(os.path.join(results, "analysis.json")):
+        with open(os.path.join(results, "analysis.json")) as f:
+            summary = json.load(f)
+    return rows, summary
 
 
 def analyse(results):
     lines = ["# One cpi.accuracy on beds of different noise (issue 34)\n",
              "Made by `/usr/bin/python3 bench/accuracy_study.py --efdem build/mpi_driver/efdem`; adaptive CPI "
-             f"with cpi.accuracy = {ACCURACY}, R = 4, seed 404, against independent direct ensembles. Expected "
-             f"e / floor: sqrt(1 + a^2/2) = {math.sqrt(1 + ACCURACY ** 2 / 2):.2f} (docs/error_control.md §10).\n",
+             f"with cpi.accuracy = {ACCURACY}, R = 4 (the paper's bed: 2), seed 404, against independent direct "
+             f"ensembles. Expected e / floor: sqrt(1 + a^2/2) = {math.sqrt(1 + ACCURACY ** 2 / 2):.2f} "
+             "(docs/error_control.md §10). The floor at the CPI run's own samples; rows marked * are an earlier "
+             "analysis's (their run file is not on this machine), whose floor was over the directs' every sample.\n",
              "| run | bed, U_s, span | direct ensembles | floor [d_p] (pairs) | e [d_p] | e / floor | sigma [d_p] "
              "| budget [d_p] | spent [d_p] | tolerances per jump [d_p] | kept / rejected / direct | DEM-time speed-up |",
              "|---" * 12 + "|"]
-    summary = {}
+    rows, summary = earlier_rows(results)
     for name in ORDER:
         path = os.path.join(results, name + ".h5")
         if not sr.archived(path):
+            if name in rows:
+                row = rows[name]
+                lines.append(row if row.startswith(f"| {name}*") else row.replace(f"| {name} |", f"| {name}* |", 1))
             continue
-        scene, us, duration, _, _, folder = CASES[name]
+        scene, us, duration, _, _, folder, _ = CASES[name]
         directs = [ss.load(os.path.join(RESULTS, folder, d + ".h5")) for d in ("direct_a", "direct_b", "direct_c")
                    if os.path.exists(os.path.join(RESULTS, folder, d + ".h5"))]
         run = ss.load(path)
-        pairs = [ss.rms_on(directs[i], directs[j]) for i in range(len(directs)) for j in range(i + 1, len(directs))]
+        pairs = [floor_on(run, directs[i], directs[j]) for i in range(len(directs)) for j in range(i + 1, len(directs))]
         floor = float(np.mean(pairs)) if pairs else float("nan")
         e = math.sqrt(np.mean([ss.rms_on(run, d) ** 2 for d in directs])) if directs else float("nan")
         c = run["controller"]
