@@ -42,6 +42,18 @@ forward Euler): the window is read from the run's command (default 10).
     /usr/bin/python3 bench/walk_budget.py --directs bench/results/tall_study_r4/u0.19/direct_a.h5 \\
         bench/results/tall_study_r4/u0.19/direct_b.h5 --cpi bench/results/tall_study_r4/u0.19/adaptive_tol0.32.h5 ...
 
+The bound. The walk's increments dW(s) in the bursts are all a CPI run knows of the walk; with
+slopes linear in the bursts' data and unbiased for a constant drift, its state at t carries them
+as sum_s c(s) dW(s), with c(s) = 1 plus what the jumps made of them, and a constant drift f must
+come out as f t: integral c(s) ds = t over the DEM time t / S. By Cauchy-Schwarz the walk's
+variance, (q / R) integral c(s)^2 ds, is then at least (q / R) t^2 / (t / S) = S q t / R: S times
+a direct ensemble's, whatever the window, pooling or order. The bound is attained by the
+increment over whole bursts with jumps of one length (c constant). With phi = q t / var_r(t) the
+walk's share of the realizations' variance, in expectation
+
+    (e / floor)^2 >= 1 + (S - 1) phi / 2,   and at equal compute (CPI with R against direct with
+    R / S)   e_cpi / e_direct >= sqrt(phi + (1 - phi) / S).
+
 Directs and CPI runs are run archives (.h5) or bench/whole_process.py reductions (.json). Prints
 the fitted noise, each CPI run's predicted and measured e / spread floor, and for uniform schedules
 (bursts of b = healing + W, jumps of DT = (S - 1) b) the ratio the walk alone allows at speed-up S.
@@ -137,6 +149,17 @@ def jumps(run):
 def jump_variance(dt, q, window, r):
     """The variance one jump of DT adds to the ensemble mean beyond a direct ensemble's (above)."""
     return (1.2 * q * dt * dt / window + q * dt) / r
+
+
+def floor_bound(speedup, phi):
+    """The least e / floor in expectation of a CPI run at DEM-time speed-up SPEEDUP whose slopes
+    come from its own bursts, PHI the walk's share of the realizations' variance (the bound above)."""
+    return math.sqrt(1.0 + (speedup - 1.0) * phi / 2.0)
+
+
+def equal_compute_bound(speedup, phi):
+    """The least CPI error over a direct ensemble's of R / SPEEDUP realizations (the bound above)."""
+    return math.sqrt(phi + (1.0 - phi) / speedup)
 
 
 def var_r(directs, t):
@@ -236,6 +259,11 @@ def main():
         end, whole, equal, actual = uniform(directs, q, span, r, args.healing, args.window, s)
         print(f"  DT = {(s - 1) * (args.healing + args.window):g} (S = {actual:.2f} over the span): {end:.2f} at the end, "
               f"{whole:.2f} over the span; at equal compute {equal:.2f}")
+    phi = q * span / float(var_r(directs, np.array([span]))[0])
+    print(f"\nThe bound at t = {span:g} (the walk's share of the variance phi = {phi:.2f}): e / floor at the end >= "
+          + ", ".join(f"{floor_bound(s, phi):.2f} at {s:g}x" for s in (2.0, 3.0, 5.0, 10.0))
+          + "; at equal compute >= " + ", ".join(f"{equal_compute_bound(s, phi):.2f} at {s:g}x" for s in (2.0, 5.0))
+          + f" (-> {math.sqrt(phi):.2f})")
     if args.plot:
         plot(args, directs, q, span, r, points)
 

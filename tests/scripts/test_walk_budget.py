@@ -106,6 +106,55 @@ class Noise(unittest.TestCase):
         self.assertEqual(wb.jumps({"t_all": t}), [(70.0, 40.0)])
 
 
+def walk_through_cpi(rng, slope, healing, draws, q, burst=20.0, dt=80.0, cycles=4):
+    """The ensemble mean's walk (q per unit, from 0) through CYCLES bursts of BURST, each followed by
+    a jump of DT from SLOPE: 'increment' (the burst's own increment over its whole length), 'least
+    squares' (over the burst after HEALING) or 'pooled' (the mean of the last two bursts' least-squares
+    slopes). Returns the state at the end (t = cycles (burst + dt)) of DRAWS independent runs."""
+    n = int(round(burst / STEP))
+    t = STEP * np.arange(n + 1)
+    x, before = np.zeros(draws), None
+    for _ in range(cycles):
+        steps = rng.normal(0.0, math.sqrt(q * STEP), size=(draws, n))
+        traj = np.concatenate([x[:, None], x[:, None] + np.cumsum(steps, axis=1)], axis=1)
+        if slope == "increment":
+            s = (traj[:, -1] - traj[:, 0]) / burst
+        else:
+            fit = t >= healing - 1e-9
+            s = np.polyfit(t[fit], traj[:, fit].T, 1)[0]
+            if slope == "pooled":
+                s, before = (s if before is None else 0.5 * (s + before)), s
+        x = traj[:, -1] + dt * s
+    return x
+
+
+class Bound(unittest.TestCase):
+    def test_no_slope_from_the_bursts_carries_the_walk_below_s_times(self):
+        # Bursts of 20, jumps of 80: S = 5 over 400 units. The bound (walk_budget.py's docstring):
+        # the walk's variance at t is at least S q t, attained by the increment over whole bursts.
+        # 20,000 draws: a variance's relative sd is sqrt(2 / 20000) = 1 %; the bounds are 3 sd.
+        # Measured when written: increment 5.02, least squares over the whole burst 5.56, over
+        # 2 + 18 5.95, pooled over two bursts 6.47 (pooling a walk's slopes weighs the earlier
+        # burst's increments twice: further from uniform, so worse).
+        q, draws, speedup, t_end = 3e-4, 20000, 5.0, 400.0
+        tol = 3.0 * math.sqrt(2.0 / draws)
+        rng = np.random.default_rng(5)
+        ratio = {(slope, h): float(np.var(walk_through_cpi(rng, slope, h, draws, q))) / (q * t_end)
+                 for slope, h in (("increment", 0.0), ("least squares", 0.0), ("least squares", 2.0),
+                                  ("pooled", 2.0))}
+        for key, r in ratio.items():
+            self.assertGreater(r, speedup * (1.0 - tol), key)
+        self.assertLess(abs(ratio[("increment", 0.0)] / speedup - 1.0), tol)  # attained: the bound is tight
+        # Least squares over a whole burst of a walk: 1.2 q / W, its excess over the increment's
+        # 0.2 q DT^2 / W per jump (4 x 0.2 x 6400 / 20 = 256 q, i.e. 0.64 q t): 5.64.
+        self.assertLess(abs(ratio[("least squares", 0.0)] / (speedup + 0.64) - 1.0), tol)
+        # What the docs derive from it: at S = 5 and phi = 0.52 (the tall bed at t = 600), at
+        # least 1.43 floors and 0.78 of direct's error at equal compute.
+        self.assertAlmostEqual(wb.floor_bound(5.0, 0.52), math.sqrt(1.0 + 4.0 * 0.52 / 2.0), places=12)
+        self.assertAlmostEqual(round(wb.floor_bound(5.0, 0.52), 2), 1.43)
+        self.assertAlmostEqual(round(wb.equal_compute_bound(5.0, 0.52), 2), 0.78)
+
+
 class Input(unittest.TestCase):
     def test_bad_files_are_named(self):
         script = os.path.join(os.path.dirname(__file__), "..", "..", "bench", "walk_budget.py")
