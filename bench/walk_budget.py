@@ -36,8 +36,9 @@ and e / floor = sqrt(mean_t E[e^2] / mean_t of the floor^2 var_r (1 / R_cpi + 1 
 the CPI run's samples (what bench/whole_process.py compares), the floor taken from the
 realizations' spread (its "spread floor"). What the model leaves out (truncation, the lift's miss,
 any bias of the lifted beds) is what a run's measured ratio has beyond the predicted one. The
-model is for a slope from one burst's least squares over a fixed window (cpi.slope = burst,
-forward Euler): the window is read from the run's command (default 10).
+model is for a slope from one burst's least squares over a fixed window, or its increment there
+(cpi.slope = burst, forward Euler): the window and cpi.slope_fit are read from the run's command
+(default 10, least squares).
 
     /usr/bin/python3 bench/walk_budget.py --directs bench/results/tall_study_r4/u0.19/direct_a.h5 \\
         bench/results/tall_study_r4/u0.19/direct_b.h5 --cpi bench/results/tall_study_r4/u0.19/adaptive_tol0.32.h5 ...
@@ -146,9 +147,11 @@ def jumps(run):
     return [(float(t[k + 1] - step), float(gaps[k])) for k in np.nonzero(gaps > 0.5 * step)[0]]
 
 
-def jump_variance(dt, q, window, r):
-    """The variance one jump of DT adds to the ensemble mean beyond a direct ensemble's (above)."""
-    return (1.2 * q * dt * dt / window + q * dt) / r
+def jump_variance(dt, q, window, r, factor=1.2):
+    """The variance one jump of DT adds to the ensemble mean beyond a direct ensemble's (above);
+    FACTOR: the slope's variance over the window is factor q / (W R), 1.2 for least squares, 1 for
+    the increment (cpi.slope_fit = increment). The covariance term is the same for both."""
+    return (factor * q * dt * dt / window + q * dt) / r
 
 
 def floor_bound(speedup, phi):
@@ -174,7 +177,9 @@ def compare(directs, run, q):
     """(predicted, measured) e / spread floor of the CPI run RUN over its samples on the directs'
     grid from SETTLED on, the window its slopes were fitted over and its jumps."""
     r_cpi, r_dir = run["icdf"].shape[1], directs[0]["icdf"].shape[1]
-    window = key(run.get("command", run.get("study_command", "")), "cpi.window", 10.0)
+    command = run.get("command", run.get("study_command", ""))
+    window = key(command, "cpi.window", 10.0)
+    factor = 1.0 if "cpi.slope_fit=increment" in command else 1.2
     span = min(float(d["t"][-1]) for d in directs)
     grid = directs[0]["t"][(directs[0]["t"] <= span + 1e-6)]
     x = wp.held_to(dict(run, end_state=False), grid)
@@ -184,7 +189,8 @@ def compare(directs, run, q):
     measured_e2 = np.mean([np.mean((x[ok] - m) ** 2, axis=1) for m in means], axis=0)
     floor2 = var_r(directs, t) * (1.0 / r_cpi + 1.0 / r_dir)
     landed = jumps(run)
-    added = np.array([sum(jump_variance(dt, q, window, r_cpi) for land, dt in landed if land <= s + 1e-6) for s in t])
+    added = np.array([sum(jump_variance(dt, q, window, r_cpi, factor) for land, dt in landed if land <= s + 1e-6)
+                      for s in t])
     return (math.sqrt(float(np.mean(floor2 + added)) / float(np.mean(floor2))),
             math.sqrt(float(np.mean(measured_e2)) / float(np.mean(floor2))), window, len(landed))
 

@@ -97,6 +97,12 @@ TALL_SLOW = {
     # of this bed (R = 4, 400 units) expects 1.37 floors at 4.4x (docs/error_control.md §7)
     "ranks_accuracy_h2w18": {**{k: v for k, v in MOVING.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5,
                              "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18},
+    # ranks_h2w18 with the window's increment for its slope (cpi.slope_fit = increment): this bed's
+    # noise is a walk with no fast part (bench/walk_budget.py), where the increment has 1/1.2 of
+    # least squares' variance and what a jump of 80 adds beyond a direct ensemble falls to 0.86 of
+    # least squares' (docs/error_control.md §7)
+    "ranks_inc_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
+                        "cpi.window": 18, "cpi.slope_fit": "increment"},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}

@@ -34,6 +34,7 @@ std::map<std::string, std::string> parse_lines(const std::string& text) {
 constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.slope", "burst"},  // cpi.slope = pooled (issue 33)
     {"cpi.pool", "4"},       // read only with cpi.slope = pooled
+    {"cpi.slope_fit", "least_squares"},  // increment: the window's increment (issue 34)
     {"cpi.healing_auto", "false"},
     {"cpi.window_auto", "false"},
     {"cpi.window_max", nullptr},  // read only with cpi.window_auto

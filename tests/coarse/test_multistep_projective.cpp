@@ -755,3 +755,43 @@ TEST_CASE("a first burst that would leave less than one burst runs on to the end
     CHECK(toy.time() == Approx(14.0).margin(1e-9));
     CHECK(first.t_end == Approx(14.0).margin(1e-9));
 }
+
+TEST_CASE("with a walk, the increment slope carries the bursts' walk with uniform weights",
+          "[unit][coarse][multistep]") {
+    // 8 members walking (OU with k = 1e-6: q = sigma^2 per member over 420 units), 19
+    // components, 200 seeds; fixed DT = 80 after bursts of 20 with no healing: five bursts, four
+    // jumps, t = 420. The end state carries each burst's walk increments dW(s) with weight
+    // c(s) = 1 + DT g(s), g the slope's weight on them: the increment's g = 1/20, so
+    // Var = q/R (4 x 20 x 5^2 + 20) = 2020 q/R; least squares' g = 6 s (20 - s)/20^3, whose
+    // integral of c^2 is 564 per burst: 2276 q/R, 1.127 x the increment's (error_control.md §7).
+    // The same seeds drive both fits (the toy's draws do not depend on the lifts), so their ratio
+    // is sharp; each variance from 3,800 values is within 2.3 % (1 s.d.), the bounds 4 s.d.
+    const Eigen::Index dim = 19;
+    const int members = 8;
+    const double sigma = 0.05, k = 1e-6, x0 = 3.0;
+    const double q_mean = sigma * sigma / members;
+    auto end_variance = [&](SlopeFit fit) {
+        double sum = 0.0;
+        long values = 0;
+        for (std::uint64_t seed = 1; seed <= 200; ++seed) {
+            test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(dim, k), sigma, members, 0.1,
+                                        Eigen::VectorXd::Constant(dim, x0), 900 + seed);
+            MultistepSettings s = fixed_settings(1, 80.0);
+            s.burst.window = 20.0;
+            s.slope_fit = fit;
+            MultistepProjectiveIntegrator integrator(s);
+            for (int step = 0; step < 5; ++step) REQUIRE(integrator.step(toy).advanced());
+            REQUIRE(toy.time() == Approx(420.0));
+            const Eigen::VectorXd m = toy.mean();
+            const double exact = x0 * std::exp(-k * toy.time());
+            for (Eigen::Index i = 0; i < dim; ++i, ++values) sum += (m[i] - exact) * (m[i] - exact);
+        }
+        return sum / static_cast<double>(values) / q_mean;
+    };
+    const double increment = end_variance(SlopeFit::increment);
+    const double least_squares = end_variance(SlopeFit::least_squares);
+    INFO("increment " << increment << " q/R, least squares " << least_squares << " q/R");
+    CHECK(increment == Approx(2020.0).epsilon(0.09));
+    CHECK(least_squares == Approx(2276.0).epsilon(0.09));
+    CHECK(least_squares / increment == Approx(2276.0 / 2020.0).epsilon(0.03));
+}

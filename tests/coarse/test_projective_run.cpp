@@ -820,3 +820,26 @@ TEST_CASE("cpi.jump_until is read on the sampling grid, and refused where nothin
     CHECK_THAT(cpi_refusal("cpi.jump_until = 40.25\n"), Catch::Contains("cpi.jump_until"));
     CHECK_THAT(cpi_refusal("cpi.jump_until = -1\n"), Catch::Contains("cpi.jump_until"));
 }
+
+TEST_CASE("cpi.slope_fit: the window's increment with fixed or adaptive DT, refused where unread",
+          "[unit][coarse][run]") {
+    ParamTable fixed =
+        ParamTable::from_text("cpi.slope_fit = increment\ncpi.dt = 40\n", "scene.cfg", "/scenes");
+    const CpiSettings f = CpiSettings::from_params(fixed.root().scope("cpi"), 0.5);
+    CHECK(f.multistep.slope_fit == SlopeFit::increment);
+    // Fixed DT with the increment: the multistep integrator (the plain one fits least squares).
+    CHECK(f.make_integrator({})->name() == "projective_forward_euler_multistep");
+    ParamTable plain = ParamTable::from_text("cpi.dt = 40\n", "scene.cfg", "/scenes");
+    CHECK(CpiSettings::from_params(plain.root().scope("cpi"), 0.5).multistep.slope_fit ==
+          SlopeFit::least_squares);
+    CHECK_THAT(cpi_refusal("cpi.slope_fit = increments\n"),
+               Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.slope_fit") &&
+                   Catch::Contains("least_squares") && Catch::Contains("increment"));
+    CHECK_THAT(cpi_refusal("cpi.projection = periods\ncpi.slope_fit = increment\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.slope_fit") &&
+                   Catch::Contains("periods"));
+    CHECK_THAT(cpi_refusal("cpi.projection = adaptive\ncpi.tolerance = 0.1\ncpi.slope_fit = "
+                           "increment\ncpi.window_auto = true\n"),
+               Catch::Contains("scene.cfg:4") && Catch::Contains("cpi.window_auto") &&
+                   Catch::Contains("increment"));
+}

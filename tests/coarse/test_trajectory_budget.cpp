@@ -258,10 +258,14 @@ TEST_CASE("cpi.accuracy with cpi.jump_until plans the budget over the jumps befo
 
 TEST_CASE("a jump is charged the walk it carries and the walk it skips",
           "[unit][coarse][trajectory_budget]") {
-    // walk_rate: q / R = W se^2 / 1.2 (the least-squares slope of a walk over W).
+    // walk_rate: q / R = W se^2 / 1.2 (the least-squares slope of a walk over W), W se^2 for the
+    // increment.
     const SlopeNode node{0.0, Eigen::VectorXd::Zero(3), Eigen::Vector3d(0.01, 0.02, 0.02)};
-    CHECK(walk_rate(node, 12.0) == Approx(12.0 * (1e-4 + 4e-4 + 4e-4) / 3.0 / 1.2).epsilon(1e-14));
-    CHECK(walk_rate(node, 0.0) == 0.0);
+    CHECK(walk_rate(node, 12.0, SlopeFit::least_squares) ==
+          Approx(12.0 * (1e-4 + 4e-4 + 4e-4) / 3.0 / 1.2).epsilon(1e-14));
+    CHECK(walk_rate(node, 12.0, SlopeFit::increment) ==
+          Approx(12.0 * (1e-4 + 4e-4 + 4e-4) / 3.0).epsilon(1e-14));
+    CHECK(walk_rate(node, 0.0, SlopeFit::increment) == 0.0);
     // The plan: n = H / (DT + b) jumps of variance se^2 DT^2 + w DT reach B^2:
     // H se^2 DT^2 + (w H - B^2) DT - B^2 b = 0.
     TrajectoryBudget b(2.0);
@@ -288,7 +292,10 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
     // (spent^2: no truncation resolves, the toy's lift is exact). 912 values estimate the mean
     // square to ~5 %, about 8 % of the excess (1 s.d.); the bounds 0.7-1.3 are ~4 s.d. (0.89
     // when written). Without the walk term the account would be 1 / 1.69 of itself here (the
-    // ratio ~1.5, outside).
+    // ratio ~1.5, outside). The same with cpi.slope_fit = increment, whose slope has 1/1.2 of the
+    // variance and whose walk rate is therefore read as W se^2 (0.94 when written; with least
+    // squares' 1.2 the walk would be charged 1/1.2 of itself).
+    const SlopeFit fit = GENERATE(SlopeFit::least_squares, SlopeFit::increment);
     const Eigen::Index dim = 19;
     const double k = 1e-4, sigma = 0.05, x0 = 3.0;
     const int members = 8;
@@ -297,7 +304,9 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
     for (std::uint64_t seed = 1; seed <= 48; ++seed) {
         test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(dim, k), sigma, members, 0.1,
                                     Eigen::VectorXd::Constant(dim, x0), 700 + seed);
-        MultistepProjectiveIntegrator integrator(budgeted(50.0, 10.0, 12.0));
+        MultistepSettings settings = budgeted(50.0, 10.0, 12.0);
+        settings.slope_fit = fit;
+        MultistepProjectiveIntegrator integrator(settings);
         integrator.set_end_time(300.0);
         double spent = 0.0;
         while (300.0 - toy.time() >= 11.0 - 1e-9) {
@@ -316,7 +325,8 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
     }
     excess /= static_cast<double>(values);
     charged /= static_cast<double>(values);
-    INFO("jumps " << jumps << ", excess " << excess << ", charged " << charged);
+    INFO("fit " << static_cast<int>(fit) << ": jumps " << jumps << ", excess " << excess
+                << ", charged " << charged);
     CHECK(jumps > 48 * 10);
     CHECK(excess / charged > 0.7);
     CHECK(excess / charged < 1.3);

@@ -112,20 +112,31 @@ std::size_t first_sample_at_or_after(std::span<const double> t, double t_start) 
     return static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), threshold) - t.begin());
 }
 
+namespace {
+
+/// The window's first sample and count in `est`; false (with est.message) when it holds fewer
+/// than two samples. `what` names the estimator in the message.
+bool open_window(std::span<const double> t, [[maybe_unused]] std::size_t x_size, double t_start,
+                 const char* what, SlopeEstimate& est, std::size_t& first) {
+    EFDEM_EXPECTS(x_size == t.size());
+    EFDEM_EXPECTS(strictly_increasing(t));
+    first = first_sample_at_or_after(t, t_start);
+    est.n_samples = static_cast<Eigen::Index>(t.size() - first);
+    if (est.n_samples >= 2) return true;
+    est.message = fmt::format(
+        "{} slope needs at least 2 samples at t >= {:.6g}, the burst has {} "
+        "(lengthen the estimation window or sample more often)",
+        what, t_start, est.n_samples);
+    return false;
+}
+
+}  // namespace
+
 SlopeEstimate least_squares_slope(std::span<const double> t, std::span<const Eigen::VectorXd> x,
                                   double t_start) {
-    EFDEM_EXPECTS(x.size() == t.size());
-    EFDEM_EXPECTS(strictly_increasing(t));
-    const std::size_t first = first_sample_at_or_after(t, t_start);
     SlopeEstimate est;
-    est.n_samples = static_cast<Eigen::Index>(t.size() - first);
-    if (est.n_samples < 2) {
-        est.message = fmt::format(
-            "least-squares slope needs at least 2 samples at t >= {:.6g}, the burst has {} "
-            "(lengthen the estimation window or sample more often)",
-            t_start, est.n_samples);
-        return est;
-    }
+    std::size_t first = 0;
+    if (!open_window(t, x.size(), t_start, "least-squares", est, first)) return est;
     const auto tw = t.subspan(first);
     const auto xw = x.subspan(first);
     const Line<Eigen::VectorXd> line = least_squares_line(tw, xw);
@@ -135,6 +146,29 @@ SlopeEstimate least_squares_slope(std::span<const double> t, std::span<const Eig
     est.t_last = tw.back();
     est.ok = true;
     return est;
+}
+
+SlopeEstimate increment_slope(std::span<const double> t, std::span<const Eigen::VectorXd> x,
+                              double t_start) {
+    SlopeEstimate est;
+    std::size_t first = 0;
+    if (!open_window(t, x.size(), t_start, "increment", est, first)) return est;
+    est.t_first = t[first];
+    est.t_last = t.back();
+    est.slope = (x.back() - x[first]) / (est.t_last - est.t_first);
+    est.t_mean = 0.5 * (est.t_first + est.t_last);
+    est.ok = true;
+    return est;
+}
+
+SlopeEstimate window_slope(SlopeFit fit, std::span<const double> t,
+                           std::span<const Eigen::VectorXd> x, double t_start) {
+    return fit == SlopeFit::increment ? increment_slope(t, x, t_start)
+                                      : least_squares_slope(t, x, t_start);
+}
+
+double walk_slope_variance_factor(SlopeFit fit) {
+    return fit == SlopeFit::increment ? 1.0 : 1.2;
 }
 
 LineFit fit_line(std::span<const double> t, std::span<const double> y) {
@@ -185,6 +219,13 @@ Eigen::MatrixXd member_least_squares_slopes(std::span<const double> t,
                                             double t_start) {
     return slopes_per_member(t, members, [&](std::span<const Eigen::VectorXd> x) {
         return least_squares_slope(t, x, t_start);
+    });
+}
+
+Eigen::MatrixXd member_window_slopes(SlopeFit fit, std::span<const double> t,
+                                     std::span<const Eigen::MatrixXd> members, double t_start) {
+    return slopes_per_member(t, members, [&](std::span<const Eigen::VectorXd> x) {
+        return window_slope(fit, t, x, t_start);
     });
 }
 

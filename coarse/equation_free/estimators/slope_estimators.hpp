@@ -49,6 +49,32 @@ struct SlopeEstimate {
 SlopeEstimate least_squares_slope(std::span<const double> t, std::span<const Eigen::VectorXd> x,
                                   double t_start);
 
+/**
+ * \brief Increment slope over the samples with t_k >= t_start: s = (X_last - X_first) /
+ *        (t_last - t_first), per component, placed at the window's middle (t_mean).
+ *
+ * Exact for a linear X(t), and the best linear unbiased slope when the noise is a walk (a
+ * Brownian motion of diffusivity q: Var(s) = q / W for a window W, where least squares has
+ * 1.2 q / W); with independent noise sigma_X per sample it has Var(s) = 2 sigma_X^2 / W^2, worse
+ * than least squares for more than a few samples (docs/error_control.md §7). Not ok (with a
+ * message) when fewer than two samples lie in the window.
+ * \pre t strictly increasing; x.size() == t.size(); all x_k of one size.
+ */
+SlopeEstimate increment_slope(std::span<const double> t, std::span<const Eigen::VectorXd> x,
+                              double t_start);
+
+/// How a burst's window becomes a slope (cpi.slope_fit): least squares (the default) or the
+/// window's increment.
+enum class SlopeFit { least_squares, increment };
+
+/// least_squares_slope() or increment_slope(), as FIT says.
+SlopeEstimate window_slope(SlopeFit fit, std::span<const double> t,
+                           std::span<const Eigen::VectorXd> x, double t_start);
+
+/// Var(slope) W / q of a walk of diffusivity q over a window W: 1.2 for least squares (dense
+/// samples), 1 for the increment.
+double walk_slope_variance_factor(SlopeFit fit);
+
 /// Least-squares line y ~ mean_value + slope (t - mean_time) of a scalar series.
 struct LineFit {
     double slope = 0.0;
@@ -105,6 +131,11 @@ SlopeEstimate period_mean_slope(std::span<const double> t, std::span<const Eigen
 Eigen::MatrixXd member_least_squares_slopes(std::span<const double> t,
                                             std::span<const Eigen::MatrixXd> members,
                                             double t_start);
+
+/// Every member's own window_slope(fit, t, x, t_start), R x dim; empty as for
+/// member_least_squares_slopes().
+Eigen::MatrixXd member_window_slopes(SlopeFit fit, std::span<const double> t,
+                                     std::span<const Eigen::MatrixXd> members, double t_start);
 
 /// Every member's own period_mean_slope(t, x, period, t_end) (the same period T for all, each
 /// member's own period means), R x dim; empty as for member_least_squares_slopes() or when the

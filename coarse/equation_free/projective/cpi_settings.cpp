@@ -89,6 +89,15 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                  "pooled pools the bursts' slopes into one forward-Euler slope; it does not "
                  "combine with cpi.integrator = adams_bashforth2",
                  "burst with adams_bashforth2; pooled with cpi.integrator = euler");
+    m.slope_fit = cpi.get_or_choice("slope_fit", "least_squares", {"least_squares", "increment"}) ==
+                          "increment"
+                      ? SlopeFit::increment
+                      : SlopeFit::least_squares;
+    if (m.slope_fit == SlopeFit::increment && s.projection == Projection::periods)
+        cpi.fail("slope_fit",
+                 "increment is read with cpi.projection = fixed or adaptive; periods takes "
+                 "period means, which a wave does not bias",
+                 "least_squares with cpi.projection = periods");
     m.healing_auto = cpi.get_or<bool>("healing_auto", false);
     if (m.healing_auto && s.projection == Projection::periods)
         cpi.fail("healing_auto",
@@ -156,6 +165,12 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         m.window_max =
             cpi.get_or<double>("window_max", 4.0 * burst, Bounds::closed(m.window_min, 1e7));
         on_grid("window_max", m.window_max);
+        if (m.window_auto && m.slope_fit == SlopeFit::increment)
+            cpi.fail("window_auto",
+                     "chooses the window from how a least-squares slope's noise falls with it; "
+                     "cpi.slope_fit = increment is a different estimator",
+                     "false with cpi.slope_fit = increment (set cpi.window), or cpi.slope_fit = "
+                     "least_squares");
         if (m.window_auto && window > m.window_max)
             cpi.fail("window", fmt::format("is longer than cpi.window_max = {:g}", m.window_max),
                      "cpi.window <= cpi.window_max with cpi.window_auto");
@@ -225,7 +240,8 @@ double CpiSettings::window() const {
 std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook repair) const {
     if (projection == Projection::adaptive ||
         (projection == Projection::fixed &&
-         (steps == 2 || multistep.slope == SlopeSource::pooled || multistep.healing_auto ||
+         (steps == 2 || multistep.slope == SlopeSource::pooled ||
+          multistep.slope_fit == SlopeFit::increment || multistep.healing_auto ||
           multistep.lift_apart || std::isfinite(jump_until))))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
     if (projection == Projection::fixed)

@@ -20,22 +20,22 @@ namespace efdem::coarse {
 
 namespace {
 
-/// The ensemble's least-squares slope over the first n samples of a burst from t_a on, its
-/// members' own slopes over the same window (R x dim) and the standard error those give (both
-/// empty when the burst has no members or the slope failed).
+/// The ensemble's slope (fitted as `fit` says) over the first n samples of a burst from t_a on,
+/// its members' own slopes over the same window (R x dim) and the standard error those give
+/// (both empty when the burst has no members or the slope failed).
 struct WindowFit {
     SlopeEstimate slope;
     Eigen::MatrixXd member_slopes;
     Eigen::VectorXd se;
 };
 
-WindowFit fit_window(const BurstSamples& b, double t_a, std::size_t n) {
+WindowFit fit_window(SlopeFit fit, const BurstSamples& b, double t_a, std::size_t n) {
     const std::span<const double> t(b.t.data(), n);
     WindowFit f;
-    f.slope = least_squares_slope(t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
+    f.slope = window_slope(fit, t, std::span<const Eigen::VectorXd>(b.x.data(), n), t_a);
     if (f.slope.ok && b.members.size() == b.t.size()) {
-        f.member_slopes = member_least_squares_slopes(
-            t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
+        f.member_slopes = member_window_slopes(
+            fit, t, std::span<const Eigen::MatrixXd>(b.members.data(), n), t_a);
         f.se = slope_standard_error(f.member_slopes);
     }
     return f;
@@ -43,11 +43,11 @@ WindowFit fit_window(const BurstSamples& b, double t_a, std::size_t n) {
 
 /// The slope node of a burst's samples in [t_a, t_b). False when the window holds too few
 /// samples or no members.
-bool window_node(const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
+bool window_node(SlopeFit fit, const BurstSamples& b, double t_a, double t_b, SlopeNode& out) {
     const double eps = 1e-9 * std::max(1.0, std::abs(t_b));
     const auto n = static_cast<std::size_t>(std::lower_bound(b.t.begin(), b.t.end(), t_b - eps) -
                                             b.t.begin());  // samples before t_b
-    WindowFit f = fit_window(b, t_a, n);
+    WindowFit f = fit_window(fit, b, t_a, n);
     if (!f.slope.ok || f.se.size() != f.slope.slope.size()) return false;
     out = SlopeNode{f.slope.t_mean, std::move(f.slope.slope), std::move(f.se)};
     return true;
@@ -76,6 +76,7 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
     EFDEM_EXPECTS(settings.slope == SlopeSource::burst || settings.steps == 1);
     EFDEM_EXPECTS(!settings.healing_auto ||
                   (settings.healing_min >= 0.0 && settings.healing_min <= settings.burst.healing));
+    EFDEM_EXPECTS(!settings.window_auto || settings.slope_fit == SlopeFit::least_squares);
     EFDEM_EXPECTS(!settings.window_auto ||
                   (settings.adaptive && settings.window_min > 0.0 &&
                    settings.window_min <= settings.window_max && settings.dt_quantum > 0.0));
@@ -154,7 +155,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     rec.x_end = std::move(origin_x);
     if (!valid) return false;
     const double t_window = t_start + length - window();  // the last `window` of the burst
-    WindowFit fit = fit_window(rec.burst, t_window, rec.burst.t.size());
+    WindowFit fit = fit_window(settings_.slope_fit, rec.burst, t_window, rec.burst.t.size());
     const SlopeEstimate& slope = fit.slope;
     if (!slope.ok) {
         rec.status = StepStatus::invalid_burst;
@@ -269,7 +270,7 @@ void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
 
 double MultistepProjectiveIntegrator::budget_walk() const {
     // The last accepted burst's own slope (not a pool's: its se is the walk over one window).
-    return history_.empty() ? 0.0 : walk_rate(history_.back(), window());
+    return history_.empty() ? 0.0 : walk_rate(history_.back(), window(), settings_.slope_fit);
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
@@ -360,7 +361,7 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         const double w = settings_.burst.window;
         SlopeNode early;
         if (settings_.adaptive && settings_.burst.healing >= w * (1.0 - 1e-12) &&
-            window_node(rec.burst, m.t_end - 2.0 * w, m.t_end - w, early)) {
+            window_node(settings_.slope_fit, rec.burst, m.t_end - 2.0 * w, m.t_end - w, early)) {
             history_.push_back(std::move(early));
             curvature_only_front_ = true;
         }

@@ -77,6 +77,10 @@ struct MultistepSettings {
     /// errors are correlated).
     SlopeSource slope = SlopeSource::burst;
     std::size_t pool = 4;  ///< cpi.pool: bursts a pooled slope uses (>= 1)
+    /// cpi.slope_fit: how a burst's window becomes its slope and its members' slopes (least
+    /// squares, or the window's increment: the best for a noise that is a walk,
+    /// docs/error_control.md §7). Not with window_auto (its noise model is least squares').
+    SlopeFit slope_fit = SlopeFit::least_squares;
     /// cpi.healing_auto: every burst that follows a lift is tested for a post-lift transient
     /// (estimators/post_lift_transient.hpp); the bursts after it heal for burst.healing when
     /// one is measured and for healing_min when none is, the window filling the rest of the

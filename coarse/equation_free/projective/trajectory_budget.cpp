@@ -9,9 +9,10 @@
 
 namespace efdem::coarse {
 
-double walk_rate(const SlopeNode& burst, double window) {
+double walk_rate(const SlopeNode& burst, double window, SlopeFit fit) {
     if (window <= 0.0 || burst.se.size() == 0) return 0.0;
-    return window * burst.se.squaredNorm() / static_cast<double>(burst.se.size()) / 1.2;
+    return window * burst.se.squaredNorm() / static_cast<double>(burst.se.size()) /
+           walk_slope_variance_factor(fit);
 }
 
 TrajectoryBudget::TrajectoryBudget(double accuracy) : accuracy_(accuracy) {

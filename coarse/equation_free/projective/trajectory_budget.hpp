@@ -32,7 +32,7 @@
 /// b.credit(lambda, 1.0 / burst_length);  // every accepted burst: its resolved decay, or NaN
 /// const double tol = b.jump_tolerance(model, end_time, burst_length, dt_max);
 /// // ... jump, judge against tol, and when kept:
-/// b.commit(t_landed, statistical, truncation, dt * walk_rate(last_burst, window));
+/// b.commit(t_landed, statistical, truncation, dt * walk_rate(last_burst, window, fit));
 /// \endcode
 
 #include <limits>
@@ -40,6 +40,7 @@
 #include <Eigen/Core>
 
 #include "coarse/equation_free/coarse_stepper.hpp"
+#include "coarse/equation_free/estimators/slope_estimators.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
 
 namespace efdem::coarse {
@@ -57,10 +58,12 @@ struct TrajectoryBudgetState {
     double rate = 0.0;
 };
 
-/// The ensemble mean's walk per unit time, q / R, from a burst's least-squares slope over
-/// `window`: the slope of a walk over W has variance 1.2 q / (W R), so q / R = W se^2 / 1.2 (mean
-/// over the components). 0 for a window <= 0 or no components.
-double walk_rate(const SlopeNode& burst, double window);
+/// The ensemble mean's walk per unit time, q / R, from a burst's slope over `window` fitted as
+/// FIT says: the least-squares slope of a walk over W has variance 1.2 q / (W R), the increment
+/// q / (W R) (walk_slope_variance_factor()), so q / R = W se^2 / factor (mean over the
+/// components). The charge it makes, DT q / R per jump, is the same for both: either slope's
+/// covariance with the walk already in the state is q / R. 0 for a window <= 0 or no components.
+double walk_rate(const SlopeNode& burst, double window, SlopeFit fit);
 
 class TrajectoryBudget {
   public:
