@@ -231,8 +231,10 @@ def load_archive(path):
 
 
 def lift_records(f):
-    """Every kept jump of a CPI run file F (open): [t of the burst after it, DT, labels its lift
-    switched per lifted realization]; [] for a direct run."""
+    """Every kept jump of a CPI run file F (open): [its step's t_start, DT, labels its lift switched
+    per lifted realization]; [] for a direct run. t_start is when the step's burst began: the burst
+    after the jump for the multistep integrator (adaptive runs, and fixed-DT ones with any of its
+    keys), the burst before it for the plain fixed-DT forward Euler (docs/output.md /cpi/t_start)."""
     if "cpi/status" not in f or "cpi/lift_changed" not in f:
         return []
     c = f["cpi"]
