@@ -764,8 +764,10 @@ TEST_CASE("with a walk, the increment slope carries the bursts' walk with unifor
     // c(s) = 1 + DT g(s), g the slope's weight on them: the increment's g = 1/20, so
     // Var = q/R (4 x 20 x 5^2 + 20) = 2020 q/R; least squares' g = 6 s (20 - s)/20^3, whose
     // integral of c^2 is 564 per burst: 2276 q/R, 1.127 x the increment's (error_control.md §7).
+    // (Discretely, with samples from one interval after each lift: 2026 and 2276, ratio 1.123.)
     // The same seeds drive both fits (the toy's draws do not depend on the lifts), so their ratio
-    // is sharp; each variance from 3,800 values is within 2.3 % (1 s.d.), the bounds 4 s.d.
+    // is sharp (1 s.d. of the ratio about 1.1 %); each variance from 3,800 values is within
+    // 2.3 % (1 s.d.); the bounds are 4 s.d.
     const Eigen::Index dim = 19;
     const int members = 8;
     const double sigma = 0.05, k = 1e-6, x0 = 3.0;
@@ -793,5 +795,5 @@ TEST_CASE("with a walk, the increment slope carries the bursts' walk with unifor
     INFO("increment " << increment << " q/R, least squares " << least_squares << " q/R");
     CHECK(increment == Approx(2020.0).epsilon(0.09));
     CHECK(least_squares == Approx(2276.0).epsilon(0.09));
-    CHECK(least_squares / increment == Approx(2276.0 / 2020.0).epsilon(0.03));
+    CHECK(least_squares / increment == Approx(2276.0 / 2026.0).epsilon(0.045));
 }

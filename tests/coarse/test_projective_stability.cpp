@@ -120,6 +120,33 @@ TEST_CASE("slope gains match quadrature, and the lambda -> 0 limit is smooth", "
     CHECK(std::abs(slope_gain(pm, -500.0)) < 1e-300);
 }
 
+TEST_CASE("the increment's slope gain is the increment of e^(lambda t), smooth at lambda -> 0",
+          "[unit][coarse]") {
+    const CpiCycle inc{SlopeEstimator::increment, 20.0, 18.0, 80.0};
+    // Away from lambda W = -1 both forms are exact to round-off; across it continuous.
+    for (double lambda : {-0.5, -0.2, -0.01, 0.003, 0.05})
+        CHECK(slope_gain(inc, lambda) ==
+              Approx((std::exp(lambda * 20.0) - std::exp(lambda * 2.0)) / 18.0).epsilon(1e-12));
+    const double edge = -1.0 / 18.0;
+    CHECK(slope_gain(inc, edge * (1 - 1e-12)) ==
+          Approx(slope_gain(inc, edge * (1 + 1e-12))).epsilon(1e-10));
+    // lambda -> 0: S -> lambda e^(lambda (dt_b - W/2)) (expm1: no cancellation).
+    for (double lambda : {1e-8, -1e-8})
+        CHECK(slope_gain(inc, lambda) / (lambda * std::exp(lambda * 11.0)) ==
+              Approx(1.0).epsilon(1e-6));
+    CHECK(slope_gain(inc, 0.0) == 0.0);
+    CHECK(std::abs(slope_gain(inc, -500.0)) < 1e-300);
+    // The documented amplifications at 2 + 18, DT = 80: a fast mode the least-squares slope
+    // damps, the increment amplifies.
+    const CpiCycle ls{SlopeEstimator::least_squares, 20.0, 18.0, 80.0};
+    CHECK(std::abs(cpi_amplification(ls, -0.5)) == Approx(0.85).margin(0.01));
+    CHECK(std::abs(cpi_amplification(inc, -0.5)) == Approx(1.63).margin(0.01));
+    // Adams-Bashforth 2 reads the increment as it reads least squares (nodes at the middle).
+    CpiCycle ab2 = inc;
+    ab2.steps = 2;
+    CHECK(std::isfinite(ab2_cpi_amplification(ab2, -0.05)));
+}
+
 TEST_CASE("decay rate of a pure exponential transient is measured exactly", "[unit][coarse]") {
     // X(t) = c + v e^(lambda t) sampled every 0.1 over [10, 20]: the two half-window slopes are
     // shifted copies, s2/s1 = e^(5 lambda) exactly; 1e-10 covers round-off in the sums.

@@ -78,6 +78,10 @@ TEST_CASE("the increment slope is exact on a line, sits at the window's middle, 
     CHECK(est.t_mean == Approx(107.5));
     // One difference of values O(40) over 5: round-off 1e-13.
     CHECK((est.slope - b).cwiseAbs().maxCoeff() < 1e-12);
+    const SlopeEstimate two = increment_slope(t, x, 109.9);  // exactly two samples: a slope
+    REQUIRE(two.ok);
+    CHECK(two.n_samples == 2);
+    CHECK((two.slope - b).cwiseAbs().maxCoeff() < 1e-9);
     const SlopeEstimate none = increment_slope(t, x, 110.0);
     CHECK_FALSE(none.ok);
     CHECK_THAT(none.message, Catch::Contains("at least 2 samples"));
@@ -87,7 +91,7 @@ TEST_CASE("the increment slope is exact on a line, sits at the window's middle, 
 
 TEST_CASE("on a walk the increment slope has 1/1.2 of least squares' variance", "[unit][coarse]") {
     // 4,000 walks (q = 1 per unit) sampled every 0.1 over W = 20 (201 samples): Var(increment) =
-    // q / W = 0.05 exactly, Var(least squares) = 1.2 q / W (0.3 % less for 201 samples). Each
+    // q / W = 0.05 exactly, Var(least squares) = 1.2 q / W (0.5 % less for 201 samples). Each
     // variance from 4,000 draws is within 2.2 % (1 s.d.); the bounds are 4 s.d.
     efdem::RandomStream rng(11, 0, "test-walk-slopes");
     const auto t = sample_times(0.0, 0.1, 201);
@@ -326,16 +330,17 @@ TEST_CASE("members' increment slopes: each member's own, their mean the ensemble
     std::vector<Eigen::VectorXd> mean;
     for (double s : t) {
         Eigen::MatrixXd m(3, 2);
-        m << 1.0 + 0.1 * s, 2.0 - s, 0.3 * s * s, 5.0, -s, 0.2 * s;
+        m << 1.0 + 0.1 * s, 2.0 - s, 0.01 * s * s * s, 5.0, -s, 0.2 * s;
         members.push_back(m);
         mean.push_back(m.colwise().mean().transpose());
     }
     const Eigen::MatrixXd slopes = member_window_slopes(SlopeFit::increment, t, members, 4.0);
     REQUIRE(slopes.rows() == 3);
-    // Member 1's first component is 0.3 s^2: its increment over [4, 10] is 0.3 x 14 = 4.2.
+    // Member 1's first component is 0.01 s^3: its increment over [4, 10] is 0.01 x 936 / 6 =
+    // 1.56, where least squares gives 1.53 (a cubic tells the two fits apart).
     CHECK(slopes(0, 0) == Approx(0.1));
     CHECK(slopes(0, 1) == Approx(-1.0));
-    CHECK(slopes(1, 0) == Approx(4.2));
+    CHECK(slopes(1, 0) == Approx(1.56));
     CHECK(slopes(2, 1) == Approx(0.2));
     const Eigen::VectorXd ensemble = increment_slope(t, mean, 4.0).slope;
     CHECK((slopes.colwise().mean().transpose() - ensemble).cwiseAbs().maxCoeff() < 1e-12);

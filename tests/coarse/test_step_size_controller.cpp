@@ -215,6 +215,30 @@ TEST_CASE("plan: DT is halved until the measured transient is not amplified",
     CHECK_THAT(q.message, Catch::StartsWith("no DT >= cpi.dt_min is stable"));
 }
 
+TEST_CASE("plan: the stability check models the slope the run fits (cpi.slope_fit)",
+          "[unit][coarse][controller]") {
+    // Burst 2 + 18, DT = 80, lambda = -0.5: the least-squares slope damps the mode (G = 0.85),
+    // the increment's end points see it undamped (G = 1.63): halved for the increment only.
+    DecayRateEstimate decay;
+    decay.ok = true;
+    decay.rate = -0.5;
+    StepSizeSetup s = setup();
+    s.burst = 20.0;
+    s.window = 18.0;
+    s.control.dt_max = 80.0;
+    PlanInput in = input(model(1e-4));  // the tolerance allows 400: dt_max 80
+    in.decay = decay;
+    const DtPlan ls = StepSizeController(s).plan(in);
+    CHECK(ls.dt == 80.0);
+    CHECK(ls.limited_by != DtLimit::stability);
+    s.estimator = SlopeEstimator::increment;
+    const DtPlan inc = StepSizeController(s).plan(in);
+    CHECK(inc.dt < 80.0);
+    CHECK(inc.limited_by == DtLimit::stability);
+    REQUIRE(inc.stability.has_value());
+    CHECK(inc.stability->stable);
+}
+
 TEST_CASE("judge: accept within the tolerance, reject above it, and the redo rule",
           "[unit][coarse][controller]") {
     StepSizeController c(setup());

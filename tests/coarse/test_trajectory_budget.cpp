@@ -294,13 +294,18 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
     // when written). Without the walk term the account would be 1 / 1.69 of itself here (the
     // ratio ~1.5, outside). The same with cpi.slope_fit = increment, whose slope has 1/1.2 of the
     // variance and whose walk rate is therefore read as W se^2 (0.94 when written; with least
-    // squares' 1.2 the walk would be charged 1/1.2 of itself).
+    // squares' 1.2 the walk would be charged 1/1.2 of itself). That bound is wide; the walk
+    // each jump was charged, budget_walk^2 / DT, is checked directly against the toy's q / R =
+    // sigma^2 / 8: each jump's reading scatters by about 12 % (8 members' spread, 19
+    // components), so the mean over ~640 jumps by 0.5 %; the bound 5 % holds the discrete
+    // least-squares factor (101 samples: 1.19, not 1.2) and the OU's slight relaxation, and a
+    // factor of the wrong fit (17 % off) fails it.
     const SlopeFit fit = GENERATE(SlopeFit::least_squares, SlopeFit::increment);
     const Eigen::Index dim = 19;
     const double k = 1e-4, sigma = 0.05, x0 = 3.0;
     const int members = 8;
-    double excess = 0.0, charged = 0.0;
-    long values = 0, jumps = 0;
+    double excess = 0.0, charged = 0.0, walk = 0.0;
+    long values = 0, jumps = 0, walks = 0;
     for (std::uint64_t seed = 1; seed <= 48; ++seed) {
         test::OuEnsembleStepper toy(Eigen::VectorXd::Constant(dim, k), sigma, members, 0.1,
                                     Eigen::VectorXd::Constant(dim, x0), 700 + seed);
@@ -314,6 +319,10 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
             REQUIRE(r.advanced());
             if (std::isfinite(r.controller.budget_spent)) spent = r.controller.budget_spent;
             if (r.status == StepStatus::projected) ++jumps;
+            if (r.status == StepStatus::projected && std::isfinite(r.controller.budget_walk)) {
+                walk += r.controller.budget_walk * r.controller.budget_walk / r.dt;
+                ++walks;
+            }
         }
         const double t = toy.time();
         const double exact = x0 * std::exp(-k * t);
@@ -330,4 +339,7 @@ TEST_CASE("cpi.accuracy charges what the jumps add to the error beyond a direct 
     CHECK(jumps > 48 * 10);
     CHECK(excess / charged > 0.7);
     CHECK(excess / charged < 1.3);
+    REQUIRE(walks > 48 * 10);
+    CHECK(walk / static_cast<double>(walks) / (sigma * sigma / members) ==
+          Approx(1.0).epsilon(0.05));
 }

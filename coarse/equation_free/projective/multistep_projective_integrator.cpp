@@ -65,7 +65,10 @@ MultistepProjectiveIntegrator::MultistepProjectiveIntegrator(const MultistepSett
                                 .first_dt = settings.first_dt,
                                 .dt_quantum = settings.dt_quantum,
                                 .burst = settings.burst.healing + settings.burst.window,
-                                .window = settings.burst.window}),
+                                .window = settings.burst.window,
+                                .estimator = settings.slope_fit == SlopeFit::increment
+                                                 ? SlopeEstimator::increment
+                                                 : SlopeEstimator::least_squares}),
       pool_(std::max<std::size_t>(settings.pool, 1)),
       healing_(settings.burst.healing),
       window_(settings.burst.window) {
@@ -270,7 +273,11 @@ void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
 
 double MultistepProjectiveIntegrator::budget_walk() const {
     // The last accepted burst's own slope (not a pool's: its se is the walk over one window).
-    return history_.empty() ? 0.0 : walk_rate(history_.back(), window(), settings_.slope_fit);
+    // Its window is the one that burst had: it ended at t_end_ and its slope sits at the
+    // window's middle, tau, on the uniform sampling grid (with no healing the first sample is
+    // one interval after the lift; with cpi.healing_auto window() may since have changed).
+    if (history_.empty()) return 0.0;
+    return walk_rate(history_.back(), 2.0 * (t_end_ - history_.back().tau), settings_.slope_fit);
 }
 
 std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {

@@ -108,6 +108,13 @@ double slope_gain(const CpiCycle& cycle, double lambda) {
         const double tbar = cycle.burst - 0.5 * cycle.window;
         return 6.0 / cycle.window * weighted_h(lambda, tbar, cycle.window);
     }
+    if (cycle.estimator == SlopeEstimator::increment) {
+        EFDEM_EXPECTS(cycle.window <= cycle.burst);
+        const double w = cycle.window, x = lambda * w;
+        if (x > -1.0) return std::exp(lambda * cycle.burst) * (-std::expm1(-x)) / w;
+        // Both exponents <= 0: nothing overflows however fast the mode.
+        return (std::exp(lambda * cycle.burst) - std::exp(lambda * (cycle.burst - w))) / w;
+    }
     const double period = cycle.window;
     EFDEM_EXPECTS(2.0 * period <= cycle.burst);
     const double x = lambda * period;
@@ -130,7 +137,7 @@ double cpi_amplification(const CpiCycle& cycle, double lambda) {
 }
 
 double ab2_cpi_amplification(const CpiCycle& cycle, double lambda) {
-    EFDEM_EXPECTS(cycle.dt >= 0.0 && cycle.estimator == SlopeEstimator::least_squares);
+    EFDEM_EXPECTS(cycle.dt >= 0.0 && cycle.estimator != SlopeEstimator::period_mean);
     const double dt = cycle.dt, a = 0.5 * cycle.window, h = cycle.burst + dt;
     const double w1 = dt * (a + h + 0.5 * dt) / h, w0 = -dt * (a + 0.5 * dt) / h;
     const double s = slope_gain(cycle, lambda);

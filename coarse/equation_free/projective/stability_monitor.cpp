@@ -139,8 +139,7 @@ StabilityAssessment assess_stability(const DecayRateEstimate& decay, const CpiCy
         "measured transient lambda = {:.4g} per unit time: G(lambda) = {:.4g} for DT = {:.6g} "
         "(burst {:.6g}, {} {:.6g}; exact factor {:.4g}){}",
         a.rate, a.amplification, cycle.dt, cycle.burst,
-        cycle.estimator == SlopeEstimator::least_squares ? "window" : "period", cycle.window,
-        a.exact,
+        cycle.estimator == SlopeEstimator::period_mean ? "period" : "window", cycle.window, a.exact,
         a.stable ? ""
                  : ": |G| > 1, the projective step would amplify this mode (physics.md §10; "
                    "cure: longer healing or smaller DT)");

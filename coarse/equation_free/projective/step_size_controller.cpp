@@ -219,7 +219,7 @@ DtPlan StepSizeController::plan(const PlanInput& in) const {
     }
     // Never a jump the measured transient would be amplified by: shorten until stable.
     // The plan keeps the assessment of the DT taken (or of the last one refused).
-    CpiCycle cycle{SlopeEstimator::least_squares, burst, setup_.window, dt,
+    CpiCycle cycle{setup_.estimator, burst, setup_.window, dt,
                    static_cast<int>(model.nodes.size())};
     for (int i = 0; i < 20 && dt > 0.0; ++i) {
         cycle.dt = dt;

@@ -125,6 +125,9 @@ struct StepSizeSetup {
     double dt_quantum = 0.0;
     double burst = 20.0;   ///< healing + window: the burst that follows every jump (> 0)
     double window = 10.0;  ///< the slope's estimation window (the stability monitor's cycle)
+    /// How the slope is fitted over that window (the stability monitor's cycle): least squares
+    /// or the increment (cpi.slope_fit).
+    SlopeEstimator estimator = SlopeEstimator::least_squares;
 };
 
 /// What plan() looks at: the state after the last accepted burst.
