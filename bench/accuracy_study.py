@@ -62,11 +62,8 @@ def overrides(case):
 
 def floor_on(run, a, b):
     """RMS between the direct ensembles A and B over the CPI RUN's samples (that both have)."""
-    keep_a, ya = am.align(a["t"], a["mean"], run["t"])
-    keep_b, yb = am.align(b["t"], b["mean"], run["t"])
-    both_a, both_b = keep_b[keep_a], keep_a[keep_b]  # within each kept set, the times the other has
-    d = ya[both_a] - yb[both_b]
-    return math.sqrt(float(np.mean(d * d))) if len(d) else float("nan")
+    keep, ya = am.align(a["t"], a["mean"], run["t"])
+    return ss.rms_on({"t": run["t"][keep], "mean": ya}, b)
 
 
 def earlier_rows(results):

@@ -147,7 +147,12 @@ def jumps(run):
     return [(float(t[k + 1] - step), float(gaps[k])) for k in np.nonzero(gaps > 0.5 * step)[0]]
 
 
-def jump_variance(dt, q, window, r, factor=1.2):
+# Var(slope) W R / q of a walk over a window W, per cpi.slope_fit (dense samples): the
+# C++ walk_slope_variance_factor().
+SLOPE_VARIANCE = {"least_squares": 1.2, "increment": 1.0}
+
+
+def jump_variance(dt, q, window, r, factor=SLOPE_VARIANCE["least_squares"]):
     """The variance one jump of DT adds to the ensemble mean beyond a direct ensemble's (above);
     FACTOR: the slope's variance over the window is factor q / (W R), 1.2 for least squares, 1 for
     the increment (cpi.slope_fit = increment). The covariance term is the same for both."""
@@ -179,7 +184,8 @@ def compare(directs, run, q):
     r_cpi, r_dir = run["icdf"].shape[1], directs[0]["icdf"].shape[1]
     command = run.get("command", run.get("study_command", ""))
     window = key(command, "cpi.window", 10.0)
-    factor = 1.0 if "cpi.slope_fit=increment" in command else 1.2
+    fit = re.search(r"\bcpi\.slope_fit=(\S+)", command)
+    factor = SLOPE_VARIANCE[fit.group(1) if fit else "least_squares"]
     span = min(float(d["t"][-1]) for d in directs)
     grid = directs[0]["t"][(directs[0]["t"] <= span + 1e-6)]
     x = wp.held_to(dict(run, end_state=False), grid)
