@@ -103,6 +103,12 @@ TALL_SLOW = {
     # least squares' (docs/error_control.md §7)
     "ranks_inc_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
                         "cpi.window": 18, "cpi.slope_fit": "increment"},
+    # ranks_h2w18 whose jumps add the curvature pooled over the last four bursts' slopes
+    # (cpi.curvature = pooled): its jumps 3-6 were charged no truncation (each within its noise)
+    # while all undershot the accelerating demixing, 0.28 d_p in the median together, about one
+    # floor (docs/accuracy_vs_cost.md, the tall bed against two directs)
+    "ranks_curv_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
+                         "cpi.window": 18, "cpi.curvature": "pooled"},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}

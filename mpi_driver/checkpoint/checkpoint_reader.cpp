@@ -104,6 +104,8 @@ coarse::MultistepState read_integrator_state(const H5File& f, const std::filesys
     s.history = read_nodes("history");
     if (f.exists(g + "healing")) s.healing = real("healing");  // since cpi.healing_auto
     if (f.exists(g + "lift_reserve")) s.lift_reserve = real("lift_reserve");  // since issue 37
+    if (f.exists(g + "realizations"))                                         // since cpi.curvature
+        s.realizations = static_cast<int>(integer("realizations"));
     if (f.exists(g + "member_deviation")) {  // cpi.lift = own runs: R x m, row-major
         const std::vector<double> d = f.read_doubles(g + "member_deviation");
         if (x.empty() || d.size() % x.size() != 0)

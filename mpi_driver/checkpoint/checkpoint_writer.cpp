@@ -107,6 +107,7 @@ void write_integrator_state(H5File& f, const coarse::IntegratorState& state) {
     real("totals/truncation", t.truncation);
     real("healing", s.healing);
     real("lift_reserve", s.lift_reserve);
+    integer("realizations", s.realizations);
     if (s.member_deviation.size() > 0) {  // cpi.lift = own only; row-major R x m
         const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> d =
             s.member_deviation;

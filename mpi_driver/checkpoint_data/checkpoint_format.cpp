@@ -54,6 +54,8 @@ std::uint64_t hash_integrator(const coarse::IntegratorState& state, std::uint64_
     // Written before cpi.healing_auto / the pool: the checksum such a file was written with.
     if (!std::isnan(s.healing)) h = hash_value(s.healing, h);
     if (!std::isnan(s.lift_reserve)) h = hash_value(s.lift_reserve, h);
+    // Files written before it hold none (0) and keep their checksum.
+    if (s.realizations > 0) h = hash_value(static_cast<long>(s.realizations), h);
     // cpi.lift = own only (files of other runs keep the checksum they had before it).
     if (s.member_deviation.size() > 0) {
         h = hash_value(static_cast<long>(s.member_deviation.rows()), h);

@@ -30,7 +30,9 @@
 ///                           n x m, n: the slope pool; absent in files written before it);
 ///                           healing (the next burst's, cpi.healing_auto; absent before it);
 ///                           lift_reserve (the last lift's error in X, which the next jump
-///                           plans for; absent before it);
+///                           plans for; absent before it); realizations (the last
+///                           accepted burst's, cpi.curvature's significance test; absent
+///                           before it);
 ///                           window, window_fast_time2, window_measurements (cpi.window_auto
 ///                           runs only); member_deviation (R x m, cpi.lift = own runs only);
 ///                           budget/{variance, truncation, t_last, sigma, last_rate, rate}

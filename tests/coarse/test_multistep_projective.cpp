@@ -136,7 +136,7 @@ TEST_CASE("the divided difference's norm removes the slopes' noise", "[unit][coa
 
 TEST_CASE("largest_dt_within returns the DT whose error is the target",
           "[unit][coarse][multistep]") {
-    JumpErrorModel m{{node(0.0, Eigen::VectorXd::Constant(3, 1.0), 0.01)}, 5.0, 1e-3, 1.0, {}};
+    JumpErrorModel m{{node(0.0, Eigen::VectorXd::Constant(3, 1.0), 0.01)}, 5.0, 1e-3, 1.0, {}, {}};
     const double dt = largest_dt_within(m, 0.5, 1000.0);
     CHECK(jump_error(m, dt).total() == Approx(0.5).epsilon(1e-5));
     CHECK(jump_error(m, 2.0 * dt).total() > 0.5);

@@ -843,3 +843,34 @@ TEST_CASE("cpi.slope_fit: the window's increment with fixed or adaptive DT, refu
                Catch::Contains("scene.cfg:4") && Catch::Contains("cpi.window_auto") &&
                    Catch::Contains("increment"));
 }
+
+TEST_CASE(
+    "cpi.curvature: a pooled curvature with forward Euler and the bursts' own slopes, "
+    "refused where it cannot act",
+    "[unit][coarse][run]") {
+    ParamTable fixed =
+        ParamTable::from_text("cpi.curvature = pooled\ncpi.dt = 40\n", "scene.cfg", "/scenes");
+    const CpiSettings f = CpiSettings::from_params(fixed.root().scope("cpi"), 0.5);
+    CHECK(f.multistep.pooled_curvature);
+    // Fixed DT with a curvature: the multistep integrator (the plain one has no pool).
+    CHECK(f.make_integrator({})->name() == "projective_forward_euler_multistep");
+    ParamTable plain = ParamTable::from_text("cpi.dt = 40\n", "scene.cfg", "/scenes");
+    CHECK_FALSE(
+        CpiSettings::from_params(plain.root().scope("cpi"), 0.5).multistep.pooled_curvature);
+    CHECK_THAT(cpi_refusal("cpi.curvature = fitted\n"),
+               Catch::Contains("scene.cfg:1") && Catch::Contains("cpi.curvature") &&
+                   Catch::Contains("none") && Catch::Contains("pooled"));
+    CHECK_THAT(cpi_refusal("cpi.projection = periods\ncpi.curvature = pooled\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.curvature") &&
+                   Catch::Contains("periods"));
+    CHECK_THAT(cpi_refusal("cpi.integrator = adams_bashforth2\ncpi.curvature = pooled\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.curvature") &&
+                   Catch::Contains("adams_bashforth2"));
+    CHECK_THAT(cpi_refusal("cpi.slope = pooled\ncpi.curvature = pooled\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.curvature") &&
+                   Catch::Contains("cpi.slope = pooled"));
+    // Two slopes are Adams-Bashforth 2's line, not a pool.
+    CHECK_THAT(cpi_refusal("cpi.curvature = pooled\ncpi.pool = 2\n"),
+               Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.pool") &&
+                   Catch::Contains("at least 3"));
+}

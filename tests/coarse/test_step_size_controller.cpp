@@ -34,7 +34,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// One node at tau = t0 = 100 with standard error `se` in 5 components, curvature `d`.
 JumpErrorModel model(double se, double d = 0.0) {
     SlopeNode n{100.0, Eigen::VectorXd::Constant(5, 0.3), Eigen::VectorXd::Constant(5, se)};
-    return {{n}, 100.0, d, 1.0, {}};
+    return {{n}, 100.0, d, 1.0, {}, {}};
 }
 
 /// tolerance 0.05, safety 0.8 (target 0.04), dt_min 5, dt_max 160, growth 2, burst 20 = 10 + 10.

@@ -28,6 +28,7 @@ JumpErrorModel euler(double se, double t0, Eigen::Index dim = 4) {
             t0,
             std::numeric_limits<double>::quiet_NaN(),
             1.0,
+            {},
             {}};
 }
 

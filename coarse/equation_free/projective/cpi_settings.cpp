@@ -98,6 +98,31 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
                  "increment is read with cpi.projection = fixed or adaptive; periods takes "
                  "period means, which a wave does not bias",
                  "least_squares with cpi.projection = periods");
+    m.pooled_curvature = cpi.get_or_choice("curvature", "none", {"none", "pooled"}) == "pooled";
+    if (m.pooled_curvature) {
+        if (s.projection == Projection::periods)
+            cpi.fail("curvature",
+                     "pooled is read with cpi.projection = fixed or adaptive; periods projects "
+                     "period means",
+                     "none with cpi.projection = periods");
+        if (s.steps == 2)
+            cpi.fail("curvature",
+                     "pooled adds a curvature to forward Euler; cpi.integrator = adams_bashforth2 "
+                     "takes its own from the last two slopes",
+                     "none with adams_bashforth2; pooled with cpi.integrator = euler");
+        if (m.slope == SlopeSource::pooled)
+            cpi.fail("curvature",
+                     "pooled adds a curvature to the last burst's slope; cpi.slope = pooled "
+                     "averages the slopes of the bursts the curvature is fitted to",
+                     "none with cpi.slope = pooled; pooled with cpi.slope = burst");
+        if (m.pool < MultistepSettings::curvature_min_bursts)
+            cpi.fail("pool",
+                     fmt::format("is {}: cpi.curvature = pooled fits a curvature to the slopes of "
+                                 "the last cpi.pool bursts",
+                                 m.pool),
+                     fmt::format("at least {} (two slopes are Adams-Bashforth 2's line)",
+                                 MultistepSettings::curvature_min_bursts));
+    }
     m.healing_auto = cpi.get_or<bool>("healing_auto", false);
     if (m.healing_auto && s.projection == Projection::periods)
         cpi.fail("healing_auto",
@@ -241,8 +266,8 @@ std::unique_ptr<ProjectiveIntegrator> CpiSettings::make_integrator(RepairHook re
     if (projection == Projection::adaptive ||
         (projection == Projection::fixed &&
          (steps == 2 || multistep.slope == SlopeSource::pooled ||
-          multistep.slope_fit == SlopeFit::increment || multistep.healing_auto ||
-          multistep.lift_apart || std::isfinite(jump_until))))
+          multistep.slope_fit == SlopeFit::increment || multistep.pooled_curvature ||
+          multistep.healing_auto || multistep.lift_apart || std::isfinite(jump_until))))
         return std::make_unique<MultistepProjectiveIntegrator>(multistep, std::move(repair));
     if (projection == Projection::fixed)
         return std::make_unique<ProjectiveForwardEuler>(fixed, std::move(repair));

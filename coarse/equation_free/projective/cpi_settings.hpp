@@ -32,10 +32,14 @@
 /// | cpi.slope         | `burst` (the last burst's slope) or `pooled` (the weighted     | burst   |
 /// |                   | mean of the last cpi.pool bursts', estimators/slope_pool.hpp; |         |
 /// |                   | euler, fixed or adaptive)                                     |         |
-/// | cpi.pool          | pooled: the last bursts one slope pools (1..64)               | 4       |
+/// | cpi.pool          | the last bursts a pooled slope or curvature uses (1..64)      | 4       |
 /// | cpi.slope_fit     | `least_squares` over the window, or the window's `increment`  | least_  |
 /// |                   | (the best where the noise is a walk, error_control.md §7;     | squares |
 /// |                   | fixed or adaptive, not with cpi.window_auto)                  |         |
+/// | cpi.curvature     | `none` (forward Euler) or `pooled`: each jump also adds the   | none    |
+/// |                   | curvature fitted to the last cpi.pool (>= 3) bursts' slopes,  |         |
+/// |                   | where resolved (estimators/pooled_curvature.hpp; euler, fixed |         |
+/// |                   | or adaptive, cpi.slope = burst)                               |         |
 /// | cpi.healing_auto  | heal for cpi.healing only while bursts after a lift show a    | false   |
 /// |                   | transient, else for a tenth of the burst (post_lift_transient) |         |
 /// | cpi.window_auto   | adaptive: the window of the next bursts from how the slope's  | false   |

@@ -66,6 +66,24 @@ double omega_integral(std::span<const SlopeNode> nodes, double t0, double dt) {
     }));
 }
 
+namespace {
+/// The divided difference's weight on node k: 1 / prod_{j != k} (tau_k - tau_j).
+double divided_difference_weight(std::span<const SlopeNode> nodes, std::size_t k) {
+    double denom = 1.0;
+    for (std::size_t j = 0; j < nodes.size(); ++j)
+        if (j != k) denom *= nodes[k].tau - nodes[j].tau;
+    EFDEM_EXPECTS(denom != 0.0);
+    return 1.0 / denom;
+}
+
+/// sqrt(max(0, mean(value^2) - mean(noise_variance))).
+void set_debiased_norm(DividedDifference& d) {
+    const auto m = d.value.size();
+    const double excess = d.value.squaredNorm() - d.noise_variance.sum();
+    d.norm = m > 0 ? std::sqrt(std::max(0.0, excess / static_cast<double>(m))) : 0.0;
+}
+}  // namespace
+
 DividedDifference slope_divided_difference(std::span<const SlopeNode> nodes) {
     EFDEM_EXPECTS(nodes.size() >= 2);
     const Eigen::Index m = nodes[0].slope.size();
@@ -73,16 +91,27 @@ DividedDifference slope_divided_difference(std::span<const SlopeNode> nodes) {
     d.value = Eigen::VectorXd::Zero(m);
     d.noise_variance = Eigen::VectorXd::Zero(m);
     for (std::size_t k = 0; k < nodes.size(); ++k) {
-        double denom = 1.0;
-        for (std::size_t j = 0; j < nodes.size(); ++j)
-            if (j != k) denom *= nodes[k].tau - nodes[j].tau;
-        EFDEM_EXPECTS(denom != 0.0 && nodes[k].slope.size() == m && nodes[k].se.size() == m);
-        const double c = 1.0 / denom;
+        EFDEM_EXPECTS(nodes[k].slope.size() == m && nodes[k].se.size() == m);
+        const double c = divided_difference_weight(nodes, k);
         d.value += c * nodes[k].slope;
         d.noise_variance += (c * c) * nodes[k].se.cwiseAbs2();
     }
-    const double excess = d.value.squaredNorm() - d.noise_variance.sum();
-    d.norm = m > 0 ? std::sqrt(std::max(0.0, excess / static_cast<double>(m))) : 0.0;
+    set_debiased_norm(d);
+    return d;
+}
+
+DividedDifference curvature_left(std::span<const SlopeNode> nodes, const PooledCurvature& b) {
+    DividedDifference d = slope_divided_difference(nodes);
+    EFDEM_EXPECTS(b.value.size() == d.value.size());
+    Eigen::VectorXd cov = Eigen::VectorXd::Zero(d.value.size());  // Cov(d, b)
+    for (std::size_t k = 0; k < nodes.size(); ++k)
+        for (std::size_t j = 0; j < b.tau.size(); ++j)
+            if (b.tau[j] == nodes[k].tau)
+                cov += divided_difference_weight(nodes, k) *
+                       b.cov_slopes.row(static_cast<Eigen::Index>(j)).transpose();
+    d.value -= b.value;
+    d.noise_variance = (d.noise_variance + b.variance - 2.0 * cov).cwiseMax(0.0);
+    set_debiased_norm(d);
     return d;
 }
 

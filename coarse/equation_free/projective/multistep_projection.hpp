@@ -28,6 +28,7 @@
 
 #include <Eigen/Core>
 
+#include "coarse/equation_free/estimators/pooled_curvature.hpp"
 #include "coarse/equation_free/estimators/slope_node.hpp"
 
 namespace efdem::coarse {
@@ -62,6 +63,12 @@ struct DividedDifference {
 
 /// \pre nodes.size() >= 2, distinct taus, slopes and se of one size.
 DividedDifference slope_divided_difference(std::span<const SlopeNode> nodes);
+
+/// What a pooled curvature b (cpi.curvature = pooled) leaves of the divided difference of
+/// `nodes`' slopes: d - b per component, its noise variance Var(d) + Var(b) - 2 Cov(d, b) (the
+/// nodes b was fitted to, matched by tau, share their noise with it) and its debiased norm.
+/// \pre as slope_divided_difference; b of the nodes' size.
+DividedDifference curvature_left(std::span<const SlopeNode> nodes, const PooledCurvature& b);
 
 /// RMS over the components.
 double rms(const Eigen::VectorXd& v);

@@ -167,6 +167,8 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
     }
     out.node.slope = slope.slope;
     out.node.se = std::move(fit.se);
+    out.realizations =
+        rec.burst.members.empty() ? 0 : static_cast<int>(rec.burst.members.front().rows());
     if (out.node.se.size() != slope.slope.size()) {
         if (settings_.adaptive) {
             rec.status = StepStatus::invalid_burst;
@@ -235,6 +237,7 @@ void MultistepProjectiveIntegrator::accept_burst(const Measured& m, ControllerRe
     hold_kind_ = m.hold_kind;
     hold_ = m.hold;
     member_deviation_ = m.member_deviation;
+    realizations_ = m.realizations;
     // cpi.accuracy: the ensemble's noise from a burst whose members the lift did not gather
     // onto one ICDF (the first, before any lift; every one when the lift keeps them apart).
     if (budget_ && std::isfinite(m.sigma) && (!budget_->ready() || settings_.spread_survives_lift))
@@ -259,7 +262,7 @@ void MultistepProjectiveIntegrator::set_jump_tolerance(const JumpBasis& basis,
         jump_end());
     double tol = 0.0;
     if (horizon > t_end_)
-        tol = budget_->jump_tolerance(basis.model(t_end_, prior_curvature()), horizon,
+        tol = budget_->jump_tolerance(basis.model(t_end_, prior_curvature(basis)), horizon,
                                       burst_length(), settings_.control.dt_max, budget_walk());
     // Spent (or no noise at all): a tolerance no jump of cpi.dt_min meets, so bursts run
     // directly.
@@ -286,12 +289,13 @@ std::vector<SlopeNode> MultistepProjectiveIntegrator::method_nodes() const {
     return {history_.end() - static_cast<std::ptrdiff_t>(q), history_.end()};
 }
 
-double MultistepProjectiveIntegrator::prior_curvature() const {
+double MultistepProjectiveIntegrator::prior_curvature(const JumpBasis& basis) const {
     const std::size_t q = method_nodes().size();
     if (history_.size() < q + 1) return std::numeric_limits<double>::quiet_NaN();
     const std::vector<SlopeNode> nodes(history_.end() - static_cast<std::ptrdiff_t>(q + 1),
                                        history_.end());
-    return slope_divided_difference(nodes).norm;
+    return basis.correction.empty() ? slope_divided_difference(nodes).norm
+                                    : curvature_left(nodes, basis.correction).norm;
 }
 
 double MultistepProjectiveIntegrator::burst_length_from(const CoarseStepper& stepper) const {
@@ -304,12 +308,49 @@ MultistepProjectiveIntegrator::JumpBasis MultistepProjectiveIntegrator::jump_bas
     // last burst's slope.
     if (settings_.slope != SlopeSource::pooled || pool_.size() == 0) {
         b.nodes = method_nodes();
+        if (settings_.pooled_curvature) add_curvature_correction(b);
         return b;
     }
     b.pooled = pool_.estimate(pool_.size());  // the last cpi.pool bursts (fewer at the start)
     b.nodes = {b.pooled.node};
     b.committed = b.pooled.committed;
     return b;
+}
+
+void MultistepProjectiveIntegrator::add_curvature_correction(JumpBasis& b) const {
+    if (pool_.size() < MultistepSettings::curvature_min_bursts) {
+        b.correction_note =
+            fmt::format("no curvature added: {} burst(s) measured, a pooled curvature needs {}",
+                        pool_.size(), MultistepSettings::curvature_min_bursts);
+        return;
+    }
+    std::vector<SlopeNode> nodes;
+    for (const PooledBurst& p : pool_.bursts()) nodes.push_back(p.node);
+    PooledCurvature curvature = pooled_curvature(nodes);
+    // A curvature within its noise would add its noise and no expected gain: only one the
+    // bursts resolve is added (as a posteriori curvature counts only when resolved).
+    const MeanSignificance sig = significance(curvature.value, curvature.variance, realizations_);
+    if (!sig.measured) {
+        b.correction_note = fmt::format(
+            "no curvature added: the last burst's realizations ({}) give no noise to test it "
+            "against (a run resumed from a checkpoint written before cpi.curvature: the next burst "
+            "counts them)",
+            realizations_);
+        return;
+    }
+    if (!sig.resolved) {
+        b.correction_note = fmt::format(
+            "no curvature added: the curvature pooled over {} bursts is within its noise (S = "
+            "{:.3g} <= {:.3g})",
+            nodes.size(), sig.statistic, sig.threshold);
+        return;
+    }
+    b.correction_note = fmt::format(
+        "the jump adds the curvature pooled over {} bursts (S = {:.3g} > {:.3g}, RMS "
+        "{:.3g} +- {:.3g})",
+        nodes.size(), sig.statistic, sig.threshold, rms(curvature.value),
+        std::sqrt(curvature.variance.mean()));
+    b.correction = std::move(curvature);
 }
 
 void MultistepProjectiveIntegrator::record_statistical(ControllerRecord& c, const JumpBasis& basis,
@@ -329,7 +370,7 @@ void MultistepProjectiveIntegrator::record_statistical(ControllerRecord& c, cons
 
 double MultistepProjectiveIntegrator::plan_dt(ProjectiveStepRecord& rec,
                                               const JumpBasis& basis) const {
-    const DtPlan p = controller_.plan({.model = basis.model(t_end_, prior_curvature()),
+    const DtPlan p = controller_.plan({.model = basis.model(t_end_, prior_curvature(basis)),
                                        .decay = decay_,
                                        .hold = hold_kind_,
                                        .hold_message = hold_,
@@ -417,9 +458,19 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     ++totals_.attempts;
 
     const std::vector<double> w = projection_weights(nodes, t_end_, rec.dt);
-    c.predicted_truncation = jump_error(basis.model(t_end_, prior_curvature()), rec.dt).truncation;
+    c.predicted_truncation =
+        jump_error(basis.model(t_end_, prior_curvature(basis)), rec.dt).truncation;
     record_statistical(c, basis, rec.dt);
     Eigen::VectorXd x = x_end_ + projected_increment(nodes, w);
+    if (!basis.correction.empty()) {
+        // Forward Euler's truncation is b omega to leading order (multistep_projection.hpp).
+        const Eigen::VectorXd added =
+            omega_integral(nodes, t_end_, rec.dt) * basis.correction.value;
+        x += added;
+        append_message(
+            rec, fmt::format("{}: {:.3g} (RMS) added to X", basis.correction_note, rms(added)));
+    } else if (!basis.correction_note.empty())
+        append_message(rec, basis.correction_note);
     if (!repair_projection(rec, x, repair_)) {
         controller_.jump_failed(rec.dt);  // the next attempt jumps less far
         return rec;
@@ -481,7 +532,8 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
 
     std::vector<SlopeNode> judged = nodes;
     judged.push_back(m.node);
-    const DividedDifference d = slope_divided_difference(judged);
+    const DividedDifference d = basis.correction.empty() ? slope_divided_difference(judged)
+                                                         : curvature_left(judged, basis.correction);
     const double omega = omega_integral(nodes, t_end_, rec.dt);
     // A curvature within its own noise is no evidence of truncation error: its debiased norm is
     // still positive half the time by chance, and it would reject jumps the tolerance was spent
@@ -609,6 +661,7 @@ IntegratorState MultistepProjectiveIntegrator::save_state() const {
     s.pool.assign(pool_.bursts().begin(), pool_.bursts().end());
     s.healing = healing_;
     s.lift_reserve = lift_reserve_;
+    s.realizations = realizations_;
     s.member_deviation = member_deviation_;
     if (budget_) s.budget = budget_->state();
     if (settings_.window_auto) {
@@ -625,6 +678,7 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     pool_.restore({});
     healing_ = settings_.burst.healing;
     lift_reserve_ = 0.0;
+    realizations_ = 0;
     window_ = settings_.burst.window;
     fast_time2_ = std::numeric_limits<double>::quiet_NaN();
     noise_measurements_ = 0;
@@ -656,6 +710,7 @@ void MultistepProjectiveIntegrator::restore_state(const IntegratorState& state) 
     healing_ = std::isnan(s.healing) ? settings_.burst.healing : s.healing;
     // Checkpoints before the lift reserve: none (the next lift measures it).
     lift_reserve_ = std::isnan(s.lift_reserve) ? 0.0 : s.lift_reserve;
+    realizations_ = s.realizations;
     // Checkpoints of runs without cpi.window_auto (or before it) have no window: the configured.
     if (settings_.window_auto && !std::isnan(s.window)) {
         window_ = s.window;

@@ -98,6 +98,17 @@ struct MultistepSettings {
     /// as truncation error only when it is resolved above its own noise (mean_significance.hpp);
     /// true ("counted", what runs before it did): its debiased norm always counts.
     bool count_noisy_curvature = false;
+    /// cpi.curvature = pooled (forward Euler, the burst's own slope): every jump also adds
+    /// omega b, the curvature b fitted to the slopes of the last `pool` accepted bursts (at
+    /// least 3; estimators/pooled_curvature.hpp), when b is resolved above its noise
+    /// (mean_significance.hpp); its noise is charged with the statistical part and the
+    /// truncation part is what b leaves of the curvature measured after the jump. An
+    /// accelerating trajectory's forward-Euler jumps each undershoot within their own noise,
+    /// and all by the same sign (docs/error_control.md §3, "A curvature pooled over the bursts").
+    /// false ("none"): forward Euler.
+    bool pooled_curvature = false;
+    /// The fewest bursts a pooled curvature is fitted to (two are Adams-Bashforth 2's line).
+    static constexpr std::size_t curvature_min_bursts = 3;
     /// cpi.lift_error = counted (default): a kept jump's error includes the lift's own error in X
     /// (CoarseStepper::lift_error()), and the next DT plans for the last one (lift reserve);
     /// ignored: neither (a lift still fails when its error alone exceeds the tolerance).
@@ -168,6 +179,7 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
         /// The ensemble's standard error over the window (TrajectoryBudget::standard_error,
         /// RMS over its samples); NaN without members.
         double sigma = std::numeric_limits<double>::quiet_NaN();
+        int realizations = 0;  ///< members of the burst's observable (0: none)
     };
     /// `length` <= 0: one burst (healing + window); longer: the healing grows.
     bool measure_burst(CoarseStepper& stepper, ProjectiveStepRecord& rec, Measured& out,
@@ -194,18 +206,27 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     double drift_rate() const;
     /// The method's nodes (q_eff of them) and the error model of the next jump.
     std::vector<SlopeNode> method_nodes() const;
-    double prior_curvature() const;
     /// What the next jump projects from: the method's nodes (cpi.slope = burst), or one pooled
     /// node with the covariance of its noise with the state's (pooled).
     struct JumpBasis {
         std::vector<SlopeNode> nodes;
         Eigen::VectorXd committed;  ///< empty: no burst reused
         PooledSlope pooled;         ///< the estimate it was made from (pooled.bursts() = m)
+        /// cpi.curvature = pooled: the curvature the jump adds (empty: none, also when it is
+        /// within its noise), and what was decided (for the step's message).
+        PooledCurvature correction;
+        std::string correction_note;
         JumpErrorModel model(double t0, double curvature) const {
-            return {nodes, t0, curvature, 1.0, committed};
+            return {nodes, t0, curvature, 1.0, committed, correction};
         }
     };
     JumpBasis jump_basis() const;
+    /// cpi.curvature = pooled: the curvature of the pool's bursts into `b` when resolved, and
+    /// the note saying what was decided.
+    void add_curvature_correction(JumpBasis& b) const;
+    /// The curvature the next jump's plan counts as truncation: NaN before q + 1 slopes; with a
+    /// curvature correction in `basis`, what it leaves of the last two slopes' (curvature_left).
+    double prior_curvature(const JumpBasis& basis) const;
     /// Asks the controller for the next DT and writes its plan into `rec`; returns DT.
     double plan_dt(ProjectiveStepRecord& rec, const JumpBasis& basis) const;
     /// cpi.accuracy: the next jump's tolerance from the trajectory's budget (into the
@@ -236,6 +257,8 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     double healing_;  ///< the healing of the next burst (cpi.healing_auto: from the evidence)
     /// The last lift's error in X: the part of the next jump's tolerance planned for the lift.
     double lift_reserve_ = 0.0;
+    /// The realizations of the last accepted burst (the significance test's degrees of freedom).
+    int realizations_ = 0;
     double window_;  ///< cpi.window_auto: the window of the next burst
     /// cpi.window_auto: running mean of the bursts' fast-noise constant c (window_noise.hpp)
     /// over the last window_evidence measurements, and how many there were.

@@ -46,7 +46,7 @@ bool MultistepState::operator==(const MultistepState& o) const {
            t.statistical == u.statistical && t.truncation == u.truncation &&
            same_or_nan(healing, o.healing) && same_or_nan(lift_reserve, o.lift_reserve) &&
            same_or_nan(window, o.window) && same_or_nan(window_fast_time2, o.window_fast_time2) &&
-           window_measurements == o.window_measurements &&
+           window_measurements == o.window_measurements && realizations == o.realizations &&
            same(member_deviation, o.member_deviation) &&
            same_or_nan(budget.variance, o.budget.variance) &&
            same_or_nan(budget.truncation, o.budget.truncation) &&

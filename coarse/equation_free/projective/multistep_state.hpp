@@ -65,6 +65,10 @@ struct MultistepState {
     /// cpi.accuracy: the trajectory's error budget (trajectory_budget.hpp); sigma NaN in
     /// checkpoints of runs without it (or written before it).
     TrajectoryBudgetState budget;
+    /// The realizations of the last accepted burst (cpi.curvature = pooled: the significance
+    /// test's degrees of freedom); 0 in checkpoints written before it: unknown until the next
+    /// burst, so the first jump after such a restart adds no curvature.
+    int realizations = 0;
 
     /// Field by field, values compared with == (NaN never equal, as in a vector of doubles).
     bool operator==(const MultistepState& other) const;

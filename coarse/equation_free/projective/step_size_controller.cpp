@@ -25,6 +25,20 @@ double reserved(const StepSizeSettings& s, double lift) {
 Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt) {
     EFDEM_EXPECTS(dt >= 0.0 && !model.nodes.empty());
     const std::vector<double> w = projection_weights(model.nodes, model.t0, dt);
+    if (!model.correction.empty()) {
+        const PooledCurvature& b = model.correction;
+        EFDEM_EXPECTS(model.nodes.size() == 1 && model.committed.size() == 0 &&
+                      b.value.size() == model.nodes.front().se.size());
+        const double omega = omega_integral(model.nodes, model.t0, dt);
+        const Eigen::ArrayXd se = model.nodes.front().se.array();
+        // The covariance term is positive (the last slope is the fit's newest): no cancellation
+        // below zero.
+        return (w[0] * w[0] * se.square() + omega * omega * b.variance.array() +
+                2.0 * w[0] * omega * b.cov_last().array())
+            .max(0.0)
+            .sqrt()
+            .matrix();
+    }
     if (model.committed.size() == 0) return statistical_error(model.nodes, w);
     EFDEM_EXPECTS(model.nodes.size() == 1 &&
                   model.committed.size() == model.nodes.front().se.size());

@@ -24,6 +24,7 @@
 
 #include <Eigen/Core>
 
+#include "coarse/equation_free/estimators/pooled_curvature.hpp"
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/stability_monitor.hpp"
 
@@ -43,6 +44,11 @@ struct JumpErrorModel {
     /// with the noise earlier jumps put into the state; the statistical part is then the
     /// growth of the accumulated error, sqrt(DT^2 se^2 + 2 DT c). Empty: no reuse (c = 0).
     Eigen::VectorXd committed;
+    /// cpi.curvature = pooled (forward Euler, one node, no pooled slope): the curvature b the
+    /// jump adds, omega b with omega = integral_{t0}^{t0+DT} (t - tau) dt; its noise joins the
+    /// statistical part, sqrt(DT^2 se^2 + omega^2 Var(b) + 2 DT omega Cov(b, s)), and
+    /// `curvature` is then what b leaves (pooled_curvature.hpp). Empty: no correction.
+    PooledCurvature correction;
 };
 
 /// The two parts of a jump's error (RMS over components).
@@ -61,7 +67,8 @@ struct JumpError {
 std::string error_parts(double statistical, double truncation, double lift);
 
 /// Per component, the statistical part of a jump of `dt` under `model` (before se_scale):
-/// sqrt(sum_k W_k^2 se_k^2), or for a pooled slope the charged sqrt(DT^2 se^2 + 2 DT c).
+/// sqrt(sum_k W_k^2 se_k^2), or for a pooled slope the charged sqrt(DT^2 se^2 + 2 DT c), with
+/// a curvature correction sqrt(DT^2 se^2 + omega^2 Var(b) + 2 DT omega Cov(b, s)).
 /// \pre dt >= 0, model.nodes non-empty.
 Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt);
 
