@@ -83,6 +83,17 @@ std::vector<SlopeNode> linear_slopes(double a, double c, const std::vector<doubl
     return nodes;
 }
 
+/// ranks_h2w18's schedule with a fixed DT: bursts of 2 + 18, DT = 80.
+MultistepSettings bed_schedule(bool pooled_curvature) {
+    MultistepSettings s;
+    s.burst.healing = 2.0;
+    s.burst.window = 18.0;
+    s.adaptive = false;
+    s.dt = 80.0;
+    s.pooled_curvature = pooled_curvature;
+    return s;
+}
+
 }  // namespace
 
 TEST_CASE("a pooled curvature is exact where the slope changes linearly",
@@ -177,13 +188,7 @@ TEST_CASE("jumps that add the pooled curvature do not undershoot an accelerating
         Sums s;
         for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
             QuadraticWalkStepper toy(dim, members, a, c, sigma, 0.5, seed);
-            MultistepSettings settings;
-            settings.burst.healing = 2.0;
-            settings.burst.window = 18.0;
-            settings.adaptive = false;
-            settings.dt = dt;
-            settings.pooled_curvature = pooled;
-            MultistepProjectiveIntegrator integrator(settings);
+            MultistepProjectiveIntegrator integrator(bed_schedule(pooled));
             int jump = 0;
             while (jump < jumps) {
                 const ProjectiveStepRecord r = integrator.step(toy);
@@ -223,12 +228,7 @@ TEST_CASE("a run that adds the pooled curvature resumes from its saved state bit
     // Saved after five steps (four bursts in the pool: the next jump adds b). The saved state
     // holds the pool's slopes and the realizations the significance test counts; a state
     // without the latter (a checkpoint written before it) adds no curvature on its first jump.
-    MultistepSettings s;
-    s.burst.healing = 2.0;
-    s.burst.window = 18.0;
-    s.adaptive = false;
-    s.dt = 80.0;
-    s.pooled_curvature = true;
+    const MultistepSettings s = bed_schedule(true);
     QuadraticWalkStepper toy(19, 8, 0.005, 1.5e-5, std::sqrt(2.9e-4), 0.5, 3);
     MultistepProjectiveIntegrator a(s);
     for (int i = 0; i < 5; ++i) REQUIRE(a.step(toy).advanced());
