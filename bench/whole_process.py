@@ -109,6 +109,13 @@ TALL_SLOW = {
     # floor (docs/accuracy_vs_cost.md, the tall bed against two directs)
     "ranks_curv_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
                          "cpi.window": 18, "cpi.curvature": "pooled"},
+    # The bursts after ranks_h2w18's and ranks_curv_h2w18's lifts moved the middle of the light ICDF
+    # at 0.4-0.8 of the directs' pace over the same 15 units, less as the lifts grew (800-2,000
+    # labels): the lift, not truncation, sets the late lag. At U_s = 0.41 keep_clusters (lights
+    # added where lights are, lone ones taken first) kept the lifted beds' pace
+    "ranks_keep_h2w18": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters",
+                         "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
+                         "cpi.window": 18},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}
