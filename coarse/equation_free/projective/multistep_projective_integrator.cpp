@@ -332,9 +332,9 @@ void MultistepProjectiveIntegrator::add_curvature_correction(JumpBasis& b) const
     const MeanSignificance sig = significance(curvature.value, curvature.variance, realizations_);
     if (!sig.measured) {
         b.correction_note = fmt::format(
-            "no curvature added: the last burst's realizations ({}) give no noise to test it "
-            "against (a run resumed from a checkpoint written before cpi.curvature: the next burst "
-            "counts them)",
+            "no curvature added: {} realization(s) in the last burst, too few to test it against "
+            "their noise (0 after a restart from a checkpoint written before cpi.curvature, until "
+            "the next burst)",
             realizations_);
         return;
     }
