@@ -162,6 +162,12 @@ RunSettings RunSettings::from_params(const Params& root, const dem::DemScene& sc
                  "= own moves each realization by its own slope's jump, which cpi.projection = "
                  "periods does not measure",
                  "mean or members with cpi.projection = periods; own with fixed or adaptive");
+    if (lift == "own" && s.cpi.multistep.pooled_curvature)
+        cpi.fail("lift",
+                 "= own moves each realization by its own slope's deviation, assumed to persist "
+                 "from burst to burst, and cpi.curvature = pooled adds the ensemble's curvature "
+                 "only, fitted on the assumption that the bursts' slope errors are independent",
+                 "mean or members with cpi.curvature = pooled; own with cpi.curvature = none");
     // cpi.hand_off = steady: the CPI run's end state goes to the steady solver. Read in both
     // modes like the other cpi keys (its steady.* keys then too); a direct run does not use it.
     s.hand_off = cpi.get_or_choice("hand_off", "none", {"none", "steady"}) == "steady";

@@ -46,15 +46,22 @@ set -e
 [ $rc -eq 2 ] && grep -q "cpi.lift" "$work/refused.log" && [ ! -e "$work/refused/efdem.h5" ] \
   || { cat "$work/refused.log"; echo "FAIL: cpi.lift = members with the compact observable: exit $rc, expected 2"; exit 1; }
 echo "PASS: cpi.lift = members with the compact observable is refused (exit 2, the key named)"
-set +e
-timeout 120 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi cpi.lift=own \
-  cpi.projection=periods output.directory="$work/refused_own" > "$work/refused_own.log" 2>&1
-rc=$?
-set -e
-[ $rc -eq 2 ] && grep -q "cpi.lift" "$work/refused_own.log" && grep -q "periods" "$work/refused_own.log" \
-  && [ ! -e "$work/refused_own/efdem.h5" ] \
-  || { cat "$work/refused_own.log"; echo "FAIL: cpi.lift = own with cpi.projection = periods: exit $rc, expected 2"; exit 1; }
-echo "PASS: cpi.lift = own with cpi.projection = periods is refused (exit 2, the key named)"
+# cpi.lift = own with what cannot carry each realization's own slope: periods (no member slopes)
+# and cpi.curvature = pooled (the ensemble's curvature only). WORD: in the message besides cpi.lift.
+for refusal in "periods periods cpi.projection=periods" \
+               "curvature cpi.curvature cpi.curvature=pooled cpi.projection=adaptive cpi.tolerance=1"; do
+  read -r name word overrides <<< "$refusal"
+  set +e
+  # shellcheck disable=SC2086
+  timeout 120 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi cpi.lift=own \
+    $overrides output.directory="$work/refused_$name" > "$work/refused_$name.log" 2>&1
+  rc=$?
+  set -e
+  [ $rc -eq 2 ] && grep -q "cpi.lift" "$work/refused_$name.log" && grep -q "$word" "$work/refused_$name.log" \
+    && [ ! -e "$work/refused_$name/efdem.h5" ] \
+    || { cat "$work/refused_$name.log"; echo "FAIL: cpi.lift = own with $overrides: exit $rc, expected 2"; exit 1; }
+  echo "PASS: cpi.lift = own with $overrides is refused (exit 2, the key named)"
+done
 # cpi.relabel = moving: the same interval counts, so the first lift (from the same state as the
 # mean run's) changes the same number of labels per realization; which particles differs.
 timeout 300 "$mpiexec" -n 2 "${launcher[@]}" "$efdem" "$here/tiny_scene.cfg" mode=cpi run.duration=12 \

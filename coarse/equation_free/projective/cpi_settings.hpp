@@ -39,7 +39,7 @@
 /// | cpi.curvature     | `none` (forward Euler) or `pooled`: each jump also adds the   | none    |
 /// |                   | curvature fitted to the last cpi.pool (>= 3) bursts' slopes,  |         |
 /// |                   | where resolved (estimators/pooled_curvature.hpp; euler, fixed |         |
-/// |                   | or adaptive, cpi.slope = burst)                               |         |
+/// |                   | or adaptive, cpi.slope = burst, not cpi.lift = own)           |         |
 /// | cpi.healing_auto  | heal for cpi.healing only while bursts after a lift show a    | false   |
 /// |                   | transient, else for a tenth of the burst (post_lift_transient) |         |
 /// | cpi.window_auto   | adaptive: the window of the next bursts from how the slope's  | false   |

@@ -179,6 +179,7 @@ bool MultistepProjectiveIntegrator::measure_burst(CoarseStepper& stepper, Projec
         }
         out.node.se =
             Eigen::VectorXd::Zero(slope.slope.size());  // fixed DT: estimates without noise
+        out.realizations = 0;  // nothing to test a pooled curvature against
     }
     out.node.tau = slope.t_mean;
     if (settings_.window_auto) out.noise = window_noise(rec.burst.t, rec.burst.members, t_window);
