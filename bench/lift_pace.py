@@ -7,6 +7,8 @@ Reads the reductions bench/whole_process.py keeps in git (<case>/<run>.json: the
 ICDF on a 5-unit grid), so it runs without the runs' files:
 
     /usr/bin/python3 bench/lift_pace.py bench/results/whole_process/tall_u0.19_r8
+    /usr/bin/python3 bench/lift_pace.py bench/results/whole_process/tall_u0.19_r4 \
+        --directs bench/results/whole_process/tall_u0.19_r8   # R = 4 runs, the R = 8 directs
 
 For every CPI run of the case (a .json with lifts), each burst after a lift: the mean over the nodes
 p = 0.25-0.75 of the ensemble mean's rise from the burst's first to its last grid sample, the same
@@ -50,11 +52,18 @@ def rise(t, x, a, b):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("case", help="a case folder of bench/results/whole_process")
+    ap.add_argument("--directs", help="take the direct ensembles from this case folder instead "
+                    "(an R = 4 case's are the halves of its R = 8 case's)")
     args = ap.parse_args()
     directs, cpis = [], []
-    for path in sorted(glob.glob(os.path.join(args.case, "*.json"))):
-        t, x, d = load(path)
-        (cpis if d.get("lifts") else directs).append((os.path.basename(path)[:-5], t, x))
+    for folder in {args.case, args.directs or args.case}:
+        for path in sorted(glob.glob(os.path.join(folder, "*.json"))):
+            t, x, d = load(path)
+            if d.get("lifts"):
+                if folder == args.case:
+                    cpis.append((os.path.basename(path)[:-5], t, x))
+            elif folder == (args.directs or args.case):
+                directs.append((os.path.basename(path)[:-5], t, x))
     if len(directs) < 2:
         raise SystemExit(f"{args.case}: {len(directs)} direct ensemble(s); the comparison needs two or more")
     td = directs[0][1]
