@@ -462,11 +462,12 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     c.predicted_truncation =
         jump_error(basis.model(t_end_, prior_curvature(basis)), rec.dt).truncation;
     record_statistical(c, basis, rec.dt);
+    // The method's truncation is D omega to leading order (multistep_projection.hpp): what a
+    // pooled curvature adds, and what the burst after the jump judges.
+    const double omega = omega_integral(nodes, t_end_, rec.dt);
     Eigen::VectorXd x = x_end_ + projected_increment(nodes, w);
     if (!basis.correction.empty()) {
-        // Forward Euler's truncation is b omega to leading order (multistep_projection.hpp).
-        const Eigen::VectorXd added =
-            omega_integral(nodes, t_end_, rec.dt) * basis.correction.value;
+        const Eigen::VectorXd added = omega * basis.correction.value;
         x += added;
         append_message(
             rec, fmt::format("{}: {:.3g} (RMS) added to X", basis.correction_note, rms(added)));
@@ -535,7 +536,6 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     judged.push_back(m.node);
     const DividedDifference d = basis.correction.empty() ? slope_divided_difference(judged)
                                                          : curvature_left(judged, basis.correction);
-    const double omega = omega_integral(nodes, t_end_, rec.dt);
     // A curvature within its own noise is no evidence of truncation error: its debiased norm is
     // still positive half the time by chance, and it would reject jumps the tolerance was spent
     // on with the statistical part (the prior curvature of such a plan is already 0).

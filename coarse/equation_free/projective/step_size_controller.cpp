@@ -31,11 +31,10 @@ Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt) {
                       b.value.size() == model.nodes.front().se.size());
         const double omega = omega_integral(model.nodes, model.t0, dt);
         const Eigen::ArrayXd se = model.nodes.front().se.array();
-        // The covariance term is positive (the last slope is the fit's newest): no cancellation
-        // below zero.
+        // Every term is >= 0: the covariance with the last slope is positive (it is the fit's
+        // newest, after the mean tau).
         return (w[0] * w[0] * se.square() + omega * omega * b.variance.array() +
                 2.0 * w[0] * omega * b.cov_last().array())
-            .max(0.0)
             .sqrt()
             .matrix();
     }
