@@ -80,6 +80,11 @@ SLOW = {
 # the per-jump tolerances are twice the demo bed's and the accuracy key (one value for every bed,
 # issue 34 item 1) runs beside them. U_s = 0.41: rank coordinates (the lift a segregated bed can
 # meet, 1.8-2.4x the floor at the demo bed's steady state) and bursts 2 + 20 (the waves' window).
+# The tall bed's slow-demixing schedule (docs/accuracy_vs_cost.md, issue 33 and "R = 8 over 600
+# units"): rank coordinates, healing 2 + window 18, a per-jump tolerance twice the demo bed's.
+H2W18 = {"cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18}
+# ... with the members lifted apart and lights relabelled where lights are (keep_clusters)
+KEEP_H2W18 = {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters", **H2W18}
 TALL_SLOW = {
     "members_moving": {**MOVING, "cpi.tolerance": 0.32},
     "ranks_moving": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks"},
@@ -90,8 +95,7 @@ TALL_SLOW = {
     # the two levers the demo bed measured at U_s = 0.19 (docs/accuracy_vs_cost.md, issue 33 and
     # "R = 8 over 600 units"): healing 2 + window 18 (the same burst, the slope's error 0.74x: no
     # post-lift transient found there) and rank coordinates (longer jumps, fewer rejections)
-    "ranks_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
-                    "cpi.window": 18},
+    "ranks_h2w18": {**MOVING, **H2W18},
     # the same with the whole trajectory's accuracy instead of a per-jump tolerance (issue 34 item
     # 1): a = 1.5 allows sqrt(1 + a^2 / 2) = 1.46 floors, where bench/walk_budget.py's noise model
     # of this bed (R = 4, 400 units) expects 1.37 floors at 4.4x (docs/error_control.md §7)
@@ -101,26 +105,20 @@ TALL_SLOW = {
     # noise is a walk with no fast part (bench/walk_budget.py), where the increment has 1/1.2 of
     # least squares' variance and what a jump of 80 adds beyond a direct ensemble falls to 0.86 of
     # least squares' (docs/error_control.md §7)
-    "ranks_inc_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
-                        "cpi.window": 18, "cpi.slope_fit": "increment"},
+    "ranks_inc_h2w18": {**MOVING, **H2W18, "cpi.slope_fit": "increment"},
     # ranks_h2w18 whose jumps add the curvature pooled over the last four bursts' slopes
     # (cpi.curvature = pooled): its jumps 3-6 were charged no truncation (each within its noise)
     # while all undershot the accelerating demixing, 0.28 d_p in the median together, about one
     # floor (docs/accuracy_vs_cost.md, the tall bed against two directs)
-    "ranks_curv_h2w18": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
-                         "cpi.window": 18, "cpi.curvature": "pooled"},
+    "ranks_curv_h2w18": {**MOVING, **H2W18, "cpi.curvature": "pooled"},
     # The bursts after ranks_h2w18's and ranks_curv_h2w18's lifts moved the middle of the light ICDF
     # at 0.4-0.8 of the directs' pace over the same 15 units, less as the lifts grew (800-2,000
     # labels): the lift, not truncation, sets the late lag. At U_s = 0.41 keep_clusters (lights
     # added where lights are, lone ones taken first) kept the lifted beds' pace
-    "ranks_keep_h2w18": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters",
-                         "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
-                         "cpi.window": 18},
+    "ranks_keep_h2w18": {**KEEP_H2W18},
     # the same with another seed: at R = 4 it came within 1.27 floors at 3.03x, its end state
     # -0.1 s.e. off (2026-12-07); one draw does not set a default
-    "ranks_keep_h2w18_s505": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters",
-                              "cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2,
-                              "cpi.window": 18, "seed": 505},
+    "ranks_keep_h2w18_s505": {**KEEP_H2W18, "seed": 505},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}
