@@ -119,6 +119,10 @@ TALL_SLOW = {
     # the same with another seed: at R = 4 it came within 1.27 floors at 3.03x, its end state
     # -0.1 s.e. off (2026-12-07); one draw does not set a default
     "ranks_keep_h2w18_s505": {**KEEP_H2W18, "seed": 505},
+    # ranks_keep_h2w18 with the whole trajectory's accuracy instead of the per-jump tolerance (one
+    # value for every bed, issue 34 item 1): with the lifts no longer slowing the beds, whether
+    # a = 1.5 (1.46 floors stated) finds the jumps the hand-set 0.32 d_p did
+    "ranks_keep_acc_h2w18": {**{k: v for k, v in KEEP_H2W18.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}
