@@ -122,6 +122,11 @@ TALL_SLOW = {
     # ranks_keep_h2w18 with the whole trajectory's accuracy instead of the per-jump tolerance (one
     # value for every bed, issue 34 item 1): with the lifts no longer slowing the beds, whether
     # a = 1.5 (1.46 floors stated) finds the jumps the hand-set 0.32 d_p did
+    # ranks_keep_h2w18 with the bursts' pooled curvature added to every jump: with relabel = moving
+    # the lifted beds' pace hid what the curvature adds (ranks_curv_h2w18); keep_clusters keeps
+    # the pace, and its error still grew late (1.52 floors in the last quarter), where the replay
+    # of the jumps on the directs' mean put forward Euler's undershoot at about one floor
+    "ranks_keep_curv_h2w18": {**KEEP_H2W18, "cpi.curvature": "pooled"},
     "ranks_keep_acc_h2w18": {**{k: v for k, v in KEEP_H2W18.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
