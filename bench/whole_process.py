@@ -127,6 +127,10 @@ TALL_SLOW = {
     # the pace, and its error still grew late (1.52 floors in the last quarter), where the replay
     # of the jumps on the directs' mean put forward Euler's undershoot at about one floor
     "ranks_keep_curv_h2w18": {**KEEP_H2W18, "cpi.curvature": "pooled"},
+    # ranks_keep_h2w18 with the window's increment for its slope (ranks_inc_h2w18's lever, never
+    # run on a bed): the slope nearest the bound of docs/error_control.md §7, 1/1.2 of least
+    # squares' variance on a walk, once the lift no longer slows the beds
+    "ranks_keep_inc_h2w18": {**KEEP_H2W18, "cpi.slope_fit": "increment"},
     "ranks_keep_acc_h2w18": {**{k: v for k, v in KEEP_H2W18.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5},
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
