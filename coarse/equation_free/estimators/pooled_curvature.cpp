@@ -25,11 +25,21 @@ PooledCurvature pooled_curvature(std::span<const SlopeNode> nodes) {
         const SlopeNode& node = nodes[static_cast<std::size_t>(k)];
         const double c = (node.tau - tau_mean) / stt;
         const Eigen::VectorXd se2 = node.se.cwiseAbs2();
+        out.weights.push_back(c);
         out.value += c * node.slope;
         out.variance += (c * c) * se2;
         out.cov_slopes.row(k) = (c * se2).transpose();
     }
     return out;
+}
+
+Eigen::VectorXd committed_covariance(const PooledCurvature& b,
+                                     std::span<const double> commitments) {
+    EFDEM_EXPECTS(commitments.size() == b.bursts());
+    Eigen::VectorXd kappa = Eigen::VectorXd::Zero(b.cov_slopes.cols());
+    for (std::size_t k = 0; k < commitments.size(); ++k)
+        kappa += commitments[k] * b.cov_slopes.row(static_cast<Eigen::Index>(k)).transpose();
+    return kappa;
 }
 
 }  // namespace efdem::coarse

@@ -73,6 +73,12 @@ void SlopePool::commit(const PooledSlope& e, double dt) {
     for (double w : e.weights) (it++)->commitment += dt * w;
 }
 
+void SlopePool::add_commitments(std::span<const double> added) {
+    EFDEM_EXPECTS(added.size() <= bursts_.size());
+    auto it = bursts_.end() - static_cast<std::ptrdiff_t>(added.size());
+    for (double a : added) (it++)->commitment += a;
+}
+
 void SlopePool::restore(std::deque<PooledBurst> bursts) {
     EFDEM_EXPECTS(bursts.size() <= capacity_);
     bursts_ = std::move(bursts);

@@ -34,6 +34,7 @@
 
 #include <cstddef>
 #include <deque>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -85,6 +86,10 @@ class SlopePool {
     /// A jump of `dt` from `e` was kept: every burst it used gets a_k += dt w_k.
     /// \pre e was made by estimate() of this pool, with no add() since.
     void commit(const PooledSlope& e, double dt);
+    /// A kept jump also put `added[k]` of the last added.size() bursts' noise into the state
+    /// (a pooled curvature's omega c_k, pooled_curvature.hpp): a_k += added[k], oldest first.
+    /// \pre added.size() <= size().
+    void add_commitments(std::span<const double> added);
 
     std::size_t size() const { return bursts_.size(); }
     std::size_t capacity() const { return capacity_; }

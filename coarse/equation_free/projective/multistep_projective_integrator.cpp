@@ -326,7 +326,11 @@ void MultistepProjectiveIntegrator::add_curvature_correction(JumpBasis& b) const
         return;
     }
     std::vector<SlopeNode> nodes;
-    for (const PooledBurst& p : pool_.bursts()) nodes.push_back(p.node);
+    std::vector<double> commitments;
+    for (const PooledBurst& p : pool_.bursts()) {
+        nodes.push_back(p.node);
+        commitments.push_back(p.commitment);
+    }
     PooledCurvature curvature = pooled_curvature(nodes);
     // A curvature within its noise would add its noise and no expected gain: only one the
     // bursts resolve is added (as a posteriori curvature counts only when resolved).
@@ -351,6 +355,7 @@ void MultistepProjectiveIntegrator::add_curvature_correction(JumpBasis& b) const
         "{:.3g} +- {:.3g})",
         nodes.size(), sig.statistic, sig.threshold, rms(curvature.value),
         std::sqrt(curvature.variance.mean()));
+    curvature.committed = committed_covariance(curvature, commitments);
     b.correction = std::move(curvature);
 }
 
@@ -567,6 +572,11 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
             pool_.commit(basis.pooled, rec.dt);
         } else if (settings_.steps == 1 && pool_.size() > 0) {
             pool_.commit(pool_.estimate(1), rec.dt);
+        }
+        if (!basis.correction.empty()) {  // and omega c_k of every burst its curvature used
+            std::vector<double> added;
+            for (double ck : basis.correction.weights) added.push_back(omega * ck);
+            pool_.add_commitments(added);
         }
         if (budget_ && budget_->ready()) {
             // The lift's error is charged as a bias, like the truncation part: it need not

@@ -31,12 +31,13 @@ Eigen::VectorXd statistical_error(const JumpErrorModel& model, double dt) {
                       b.value.size() == model.nodes.front().se.size());
         const double omega = omega_integral(model.nodes, model.t0, dt);
         const Eigen::ArrayXd se = model.nodes.front().se.array();
-        // Every term is >= 0: the covariance with the last slope is positive (it is the fit's
-        // newest, after the mean tau).
-        return (w[0] * w[0] * se.square() + omega * omega * b.variance.array() +
-                2.0 * w[0] * omega * b.cov_last().array())
-            .sqrt()
-            .matrix();
+        // The growth of the accumulated error's variance (pooled_curvature.hpp): the jump's own
+        // variance plus 2 omega kappa, kappa <= 0 where the older bursts' noise is already in
+        // the state (the sum is >= 0 up to round-off: a variance after minus one before).
+        Eigen::ArrayXd v = w[0] * w[0] * se.square() + omega * omega * b.variance.array() +
+                           2.0 * w[0] * omega * b.cov_last().array();
+        if (b.committed.size()) v += 2.0 * omega * b.committed.array();
+        return v.max(0.0).sqrt().matrix();
     }
     if (model.committed.size() == 0) return statistical_error(model.nodes, w);
     EFDEM_EXPECTS(model.nodes.size() == 1 &&
