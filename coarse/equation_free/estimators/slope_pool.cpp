@@ -69,14 +69,13 @@ Eigen::VectorXd charged_error(const Eigen::VectorXd& se, const Eigen::VectorXd& 
 
 void SlopePool::commit(const PooledSlope& e, double dt) {
     EFDEM_EXPECTS(dt >= 0.0 && e.bursts() >= 1 && e.bursts() <= bursts_.size());
-    auto it = bursts_.end() - static_cast<std::ptrdiff_t>(e.bursts());
-    for (double w : e.weights) (it++)->commitment += dt * w;
+    add_commitments(e.weights, dt);
 }
 
-void SlopePool::add_commitments(std::span<const double> added) {
-    EFDEM_EXPECTS(added.size() <= bursts_.size());
-    auto it = bursts_.end() - static_cast<std::ptrdiff_t>(added.size());
-    for (double a : added) (it++)->commitment += a;
+void SlopePool::add_commitments(std::span<const double> weights, double scale) {
+    EFDEM_EXPECTS(weights.size() <= bursts_.size());
+    auto it = bursts_.end() - static_cast<std::ptrdiff_t>(weights.size());
+    for (double w : weights) (it++)->commitment += scale * w;
 }
 
 void SlopePool::restore(std::deque<PooledBurst> bursts) {

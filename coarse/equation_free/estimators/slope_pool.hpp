@@ -86,10 +86,10 @@ class SlopePool {
     /// A jump of `dt` from `e` was kept: every burst it used gets a_k += dt w_k.
     /// \pre e was made by estimate() of this pool, with no add() since.
     void commit(const PooledSlope& e, double dt);
-    /// A kept jump also put `added[k]` of the last added.size() bursts' noise into the state
-    /// (a pooled curvature's omega c_k, pooled_curvature.hpp): a_k += added[k], oldest first.
-    /// \pre added.size() <= size().
-    void add_commitments(std::span<const double> added);
+    /// A kept jump put `scale` x `weights[k]` of the last weights.size() bursts' noise into the
+    /// state: a_k += scale w_k, oldest first (commit; a pooled curvature's omega c_k,
+    /// pooled_curvature.hpp). \pre weights.size() <= size().
+    void add_commitments(std::span<const double> weights, double scale);
 
     std::size_t size() const { return bursts_.size(); }
     std::size_t capacity() const { return capacity_; }

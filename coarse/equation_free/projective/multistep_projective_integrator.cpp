@@ -573,11 +573,8 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
         } else if (settings_.steps == 1 && pool_.size() > 0) {
             pool_.commit(pool_.estimate(1), rec.dt);
         }
-        if (!basis.correction.empty()) {  // and omega c_k of every burst its curvature used
-            std::vector<double> added;
-            for (double ck : basis.correction.weights) added.push_back(omega * ck);
-            pool_.add_commitments(added);
-        }
+        if (!basis.correction.empty())  // and omega c_k of every burst its curvature used
+            pool_.add_commitments(basis.correction.weights, omega);
         if (budget_ && budget_->ready()) {
             // The lift's error is charged as a bias, like the truncation part: it need not
             // average out over the jumps (a relaxation that moves heights one way).
