@@ -85,6 +85,13 @@ SLOW = {
 H2W18 = {"cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18}
 # ... with the members lifted apart and lights relabelled where lights are (keep_clusters)
 KEEP_H2W18 = {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters", **H2W18}
+
+
+def with_accuracy(keys, a):
+    """KEYS with the whole trajectory's accuracy a (cpi.accuracy) instead of a per-jump tolerance."""
+    return {**{k: v for k, v in keys.items() if k != "cpi.tolerance"}, "cpi.accuracy": a}
+
+
 TALL_SLOW = {
     "members_moving": {**MOVING, "cpi.tolerance": 0.32},
     "ranks_moving": {**MOVING, "cpi.tolerance": 0.32, "cpi.observable": "ranks"},
@@ -99,8 +106,7 @@ TALL_SLOW = {
     # the same with the whole trajectory's accuracy instead of a per-jump tolerance (issue 34 item
     # 1): a = 1.5 allows sqrt(1 + a^2 / 2) = 1.46 floors, where bench/walk_budget.py's noise model
     # of this bed (R = 4, 400 units) expects 1.37 floors at 4.4x (docs/error_control.md §7)
-    "ranks_accuracy_h2w18": {**{k: v for k, v in MOVING.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5,
-                             "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18},
+    "ranks_accuracy_h2w18": with_accuracy({**MOVING, **H2W18}, 1.5),
     # ranks_h2w18 with the window's increment for its slope (cpi.slope_fit = increment): this bed's
     # noise is a walk with no fast part (bench/walk_budget.py), where the increment has 1/1.2 of
     # least squares' variance and what a jump of 80 adds beyond a direct ensemble falls to 0.86 of
@@ -119,9 +125,6 @@ TALL_SLOW = {
     # the same with another seed: at R = 4 it came within 1.27 floors at 3.03x, its end state
     # -0.1 s.e. off (2026-12-07); one draw does not set a default
     "ranks_keep_h2w18_s505": {**KEEP_H2W18, "seed": 505},
-    # ranks_keep_h2w18 with the whole trajectory's accuracy instead of the per-jump tolerance (one
-    # value for every bed, issue 34 item 1): with the lifts no longer slowing the beds, whether
-    # a = 1.5 (1.46 floors stated) finds the jumps the hand-set 0.32 d_p did
     # ranks_keep_h2w18 with the bursts' pooled curvature added to every jump: with relabel = moving
     # the lifted beds' pace hid what the curvature adds (ranks_curv_h2w18); keep_clusters keeps
     # the pace, and its error still grew late (1.52 floors in the last quarter), where the replay
@@ -131,7 +134,10 @@ TALL_SLOW = {
     # run on a bed): the slope nearest the bound of docs/error_control.md §7, 1/1.2 of least
     # squares' variance on a walk, once the lift no longer slows the beds
     "ranks_keep_inc_h2w18": {**KEEP_H2W18, "cpi.slope_fit": "increment"},
-    "ranks_keep_acc_h2w18": {**{k: v for k, v in KEEP_H2W18.items() if k != "cpi.tolerance"}, "cpi.accuracy": 1.5},
+    # ranks_keep_h2w18 with the whole trajectory's accuracy instead of the per-jump tolerance (one
+    # value for every bed, issue 34 item 1): with the lifts no longer slowing the beds, whether
+    # a = 1.5 (1.46 floors stated) finds the jumps the hand-set 0.32 d_p did
+    "ranks_keep_acc_h2w18": with_accuracy(KEEP_H2W18, 1.5),
 }
 WAVES = {"cpi.projection": "adaptive", "cpi.healing": 2, "cpi.window": 20, "cpi.finish": "steady",
          "cpi.observable": "ranks"}
