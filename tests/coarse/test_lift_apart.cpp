@@ -13,6 +13,7 @@
 
 #include "coarse/equation_free/coarse_stepper.hpp"
 #include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
+#include "tests/coarse/fixed_schedule.hpp"
 
 using namespace efdem::coarse;
 
@@ -72,11 +73,7 @@ class RelaxingMembers final : public CoarseStepper {
 /// Euler is stable and accurate for every member.
 /// `recorded`: the jumps whose record says how far they moved the members apart.
 double end_mean(bool apart, bool members_alike, RelaxingMembers& toy, double t_end, int& recorded) {
-    MultistepSettings s;
-    s.burst.healing = 1.0;
-    s.burst.window = 4.0;
-    s.adaptive = false;
-    s.dt = 10.0;
+    MultistepSettings s = efdem::test::fixed_schedule(1.0, 4.0, 10.0);
     s.lift_apart = apart;
     MultistepProjectiveIntegrator integrator(s);
     integrator.set_end_time(t_end);

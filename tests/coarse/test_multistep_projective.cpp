@@ -21,6 +21,7 @@
 #include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
 #include "coarse/equation_free/projective/projective_stability.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
+#include "tests/coarse/fixed_schedule.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem;
@@ -62,12 +63,8 @@ MultistepSettings adaptive_settings(double healing, double window, StepSizeSetti
 }
 
 MultistepSettings fixed_settings(int steps, double dt) {
-    MultistepSettings s;
-    s.burst.healing = 0.0;
-    s.burst.window = 0.2;
+    MultistepSettings s = test::fixed_schedule(0.0, 0.2, dt);
     s.steps = steps;
-    s.adaptive = false;
-    s.dt = dt;
     return s;
 }
 
@@ -174,12 +171,8 @@ TEST_CASE("the Adams-Bashforth 2 amplification factor is what the integrator doe
         Eigen::MatrixXd p(1, 1);
         p(0, 0) = std::exp(lambda * h);
         test::LinearToyStepper toy(p, h, Eigen::VectorXd::Constant(1, 1.0));
-        MultistepSettings s;
-        s.burst.healing = 10.0;
-        s.burst.window = 10.0;
+        MultistepSettings s = test::fixed_schedule(10.0, 10.0, 20.0);
         s.steps = 2;
-        s.adaptive = false;
-        s.dt = 20.0;
         MultistepProjectiveIntegrator ab2(s);
         std::vector<double> x;
         for (int n = 0; n < 40; ++n) {

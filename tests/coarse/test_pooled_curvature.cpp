@@ -19,6 +19,7 @@
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
 #include "coarse/equation_free/projective/step_size_controller.hpp"
+#include "tests/coarse/fixed_schedule.hpp"
 
 using namespace efdem;
 using namespace efdem::coarse;
@@ -87,11 +88,7 @@ std::vector<SlopeNode> linear_slopes(double a, double c, const std::vector<doubl
 
 /// ranks_h2w18's schedule with a fixed DT: bursts of 2 + 18, DT = 80.
 MultistepSettings bed_schedule(bool pooled_curvature) {
-    MultistepSettings s;
-    s.burst.healing = 2.0;
-    s.burst.window = 18.0;
-    s.adaptive = false;
-    s.dt = 80.0;
+    MultistepSettings s = test::fixed_schedule(2.0, 18.0, 80.0);
     s.pooled_curvature = pooled_curvature;
     return s;
 }

@@ -16,6 +16,7 @@
 #include "coarse/equation_free/estimators/slope_pool.hpp"
 #include "coarse/equation_free/projective/multistep_projection.hpp"
 #include "coarse/equation_free/projective/multistep_projective_integrator.hpp"
+#include "tests/coarse/fixed_schedule.hpp"
 #include "tests/coarse/toy_steppers.hpp"
 
 using namespace efdem;
@@ -175,11 +176,7 @@ PooledRun pooled_run(SlopeSource source, std::uint64_t seeds) {
     for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
         test::OuEnsembleStepper toy(k, 0.05, 8, 0.1, Eigen::VectorXd::Constant(dim, 3.0),
                                     100 + seed);
-        MultistepSettings s;
-        s.burst.healing = 1.0;
-        s.burst.window = 4.0;
-        s.adaptive = false;
-        s.dt = 12.0;
+        MultistepSettings s = test::fixed_schedule(1.0, 4.0, 12.0);
         s.slope = source;
         s.pool = 4;
         MultistepProjectiveIntegrator integrator(s);
