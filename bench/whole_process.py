@@ -74,6 +74,11 @@ SLOW = {
     # the same with another seed, and with the jumps ended later (the bias against T)
     "moving_until250_s505": {**MOVING, "cpi.jump_until": 250, "seed": 505},
     "moving_until400": {**MOVING, "cpi.jump_until": 400},
+    # the tall bed's recipe (examples/tall_bed/scene_u019.cfg: rank coordinates, members lifted
+    # apart, lights relabelled where lights are, bursts 2 + 18) at the demo bed's tolerance: whether
+    # the lift that kept the tall bed's pace also lets this bed's realizations stop as direct ones do
+    "ranks_keep_h2w18": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters",
+                         "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18},
 }
 # The tall bed (3,120 spheres, the paper's height at a quarter of its area; bench/scenes/tall_bed.cfg):
 # its floor is about three times the demo bed's in d_p (docs/accuracy_vs_cost.md, "The tall bed"), so
