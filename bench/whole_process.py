@@ -644,6 +644,24 @@ def frozen(section):
         return FROZEN in f.read(2000)
 
 
+def remade(folder, names):
+    """What a frozen section's closing line says of each run re-made since (NAMES, reductions in
+    FOLDER): a direct run by name; a CPI run with its median light height at its last sample
+    (mean +- standard error over its realizations), how many came to rest, its DEM-time speed-up."""
+    out = []
+    for name in names:
+        run = load(folder, name)
+        if run is None or name.startswith("direct"):
+            out.append(name)
+            continue
+        median = run["icdf"][-1, :, MEDIAN]
+        se = float(np.std(median, ddof=1) / np.sqrt(len(median))) if len(median) > 1 else float("nan")
+        rest = int(np.sum(np.isfinite(run["stops"])))
+        out.append(f"{name} (median at t = {run['t'][-1]:g}: {np.mean(median):.2f} +- {se:.2f} d_p, "
+                   f"{rest} of {len(median)} at rest, {run['simulated_time'] / run['dem_time']:.2f}x in DEM time)")
+    return out
+
+
 def keep_frozen(section, names):
     """SECTION as it was, with one closing line naming the runs re-made so far (NAMES)."""
     with open(section) as f:
@@ -673,10 +691,12 @@ def analyse(args):
     for case in CASES:
         section = os.path.join(args.results, case, "analysis.md")
         s, lines = analyse_case(args, case)
-        if s and sum(n.startswith("direct") for n in s["runs"]) < len(DIRECT) and frozen(section):
+        folder = os.path.join(args.results, case)
+        made = [n for n in runs_of(case) if os.path.exists(os.path.join(folder, n + ".json"))]
+        if made and frozen(section) and (s is None or sum(n.startswith("direct") for n in s["runs"]) < len(DIRECT)):
             # A section made from archives that are gone (FROZEN) stands until the case's directs
             # are all made again; what is made so far is named under it.
-            keep_frozen(section, s["runs"])
+            keep_frozen(section, remade(folder, made))
             s = None
         if s:
             summary[case] = s
