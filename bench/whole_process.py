@@ -53,6 +53,11 @@ ADAPTIVE = {"cpi.projection": "adaptive", "cpi.tolerance": 0.16, "cpi.healing": 
             "cpi.finish": "steady"}
 # members, relabelling where the beds move: the lift of most runs below
 MOVING = {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "moving"}
+# The tall bed's slow-demixing schedule (docs/accuracy_vs_cost.md, issue 33 and "R = 8 over 600
+# units"): rank coordinates, healing 2 + window 18, a per-jump tolerance twice the demo bed's.
+H2W18 = {"cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18}
+# ... with the members lifted apart and lights relabelled where lights are (keep_clusters)
+KEEP_H2W18 = {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters", **H2W18}
 SLOW = {
     "members_hold": {**ADAPTIVE, "cpi.lift": "members"},  # each realization kept apart
     "mean_hold": {**ADAPTIVE, "cpi.lift": "mean"},  # the paper's lift, those at rest held
@@ -77,19 +82,13 @@ SLOW = {
     # the tall bed's recipe (examples/tall_bed/scene_u019.cfg: rank coordinates, members lifted
     # apart, lights relabelled where lights are, bursts 2 + 18) at the demo bed's tolerance: whether
     # the lift that kept the tall bed's pace also lets this bed's realizations stop as direct ones do
-    "ranks_keep_h2w18": {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters",
-                         "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18},
+    "ranks_keep_h2w18": {**KEEP_H2W18, "cpi.tolerance": 0.16},
 }
 # The tall bed (3,120 spheres, the paper's height at a quarter of its area; bench/scenes/tall_bed.cfg):
 # its floor is about three times the demo bed's in d_p (docs/accuracy_vs_cost.md, "The tall bed"), so
 # the per-jump tolerances are twice the demo bed's and the accuracy key (one value for every bed,
 # issue 34 item 1) runs beside them. U_s = 0.41: rank coordinates (the lift a segregated bed can
 # meet, 1.8-2.4x the floor at the demo bed's steady state) and bursts 2 + 20 (the waves' window).
-# The tall bed's slow-demixing schedule (docs/accuracy_vs_cost.md, issue 33 and "R = 8 over 600
-# units"): rank coordinates, healing 2 + window 18, a per-jump tolerance twice the demo bed's.
-H2W18 = {"cpi.tolerance": 0.32, "cpi.observable": "ranks", "cpi.healing": 2, "cpi.window": 18}
-# ... with the members lifted apart and lights relabelled where lights are (keep_clusters)
-KEEP_H2W18 = {**ADAPTIVE, "cpi.lift": "members", "cpi.relabel": "keep_clusters", **H2W18}
 
 
 def with_accuracy(keys, a):
