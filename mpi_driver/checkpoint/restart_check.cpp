@@ -33,7 +33,7 @@ std::map<std::string, std::string> parse_lines(const std::string& text) {
 // clang-format off
 constexpr std::pair<const char*, const char*> kAddedKeys[] = {
     {"cpi.slope", "burst"},  // cpi.slope = pooled (issue 33)
-    {"cpi.pool", "4"},       // read with cpi.slope = pooled or cpi.curvature = pooled
+    {"cpi.pool", "4"},  // read with cpi.slope, cpi.curvature or cpi.noisy_curvature = pooled
     {"cpi.slope_fit", "least_squares"},  // increment: the window's increment (issue 34)
     {"cpi.curvature", "none"},  // pooled: the bursts' curvature added to each jump (issue 34)
     {"cpi.healing_auto", "false"},

@@ -261,6 +261,89 @@ TEST_CASE("a curvature within its noise rejects no jump", "[unit][coarse][multis
     CHECK(static_cast<double>(rejected) <= 0.05 * static_cast<double>(attempts));
 }
 
+namespace {
+
+struct TruncationJudged {
+    double judged = 0.0, expected = 0.0;  ///< summed over the kept jumps
+    long attempts = 0, rejected = 0;
+    std::vector<double> ratio;  ///< each kept jump's true error over the one charged
+    long over = 0;              ///< kept jumps whose true error exceeds 1.5 x the tolerance
+};
+
+/// Adaptive forward Euler on 4 OU members around a decaying mean (rates k, noise sigma) to
+/// t = 400 with cpi.noisy_curvature = `mode`: the truncation the kept jumps were charged, and
+/// forward Euler's own to leading order, |k^2 (.) X_end| omega, omega = DT (DT / 2 + window / 2)
+/// (the slope at the window's middle, no healing left after it).
+TruncationJudged judge_truncation(MultistepSettings::NoisyCurvature mode, const Eigen::VectorXd& k,
+                                  double sigma, double x0) {
+    TruncationJudged out;
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        test::OuEnsembleStepper toy(k, sigma, 4, 0.1, Eigen::VectorXd::Constant(19, x0), seed);
+        MultistepSettings s;
+        s.burst.healing = 2.0;
+        s.burst.window = 4.0;
+        s.control = {.tolerance = 0.05, .dt_min = 2.0, .dt_max = 40.0};
+        s.noisy_curvature = mode;
+        MultistepProjectiveIntegrator integrator(s);
+        for (const ProjectiveStepRecord& r : run_to(integrator, toy, 400.0)) {
+            out.attempts += r.status == StepStatus::projected || r.status == StepStatus::rejected;
+            out.rejected += r.status == StepStatus::rejected;
+            if (r.status != StepStatus::projected) continue;
+            const double omega = r.dt * (0.5 * r.dt + 0.5 * s.burst.window);
+            out.judged += r.controller.truncation;
+            out.expected += rms((k.array().square() * r.x_end.array()).matrix()) * omega;
+            const Eigen::VectorXd exact = ((-k.array() * r.dt).exp() * r.x_end.array()).matrix();
+            out.ratio.push_back(rms(r.x_projected - exact) / r.controller.error());
+            out.over += rms(r.x_projected - exact) > 1.5 * s.control.tolerance;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("cpi.noisy_curvature = pooled charges a truncation each jump's noise hides",
+          "[unit][coarse][multistep]") {
+    using Mode = MultistepSettings::NoisyCurvature;
+    SECTION("a decaying mean: the pooled curvature charges forward Euler's truncation") {
+        // Rates 0.004-0.008 and sigma 0.02 with 4 members: most jumps' own divided difference
+        // lies within its noise, so `ignored` charged 0.11 (seeds 1-6; 0.14 with seeds 7-12) of
+        // the truncation forward Euler makes, all of it one sign. The line through the pool's 4
+        // slopes and the one after the jump charged 0.84 (0.94); `counted`, each jump's own
+        // debiased norm, 3.5 (3.6): clipped at 0, a noisy norm is biased up. The sums run over
+        // about 190 kept jumps, so the seeds move them by about 0.1: bands of 0.6-1.5 and
+        // below 0.4 and above 2.
+        Eigen::VectorXd k(19);
+        for (int i = 0; i < 19; ++i) k[i] = 0.004 + 0.004 * i / 18.0;
+        const TruncationJudged ignored = judge_truncation(Mode::ignored, k, 0.02, 3.0);
+        const TruncationJudged pooled = judge_truncation(Mode::pooled, k, 0.02, 3.0);
+        const TruncationJudged counted = judge_truncation(Mode::counted, k, 0.02, 3.0);
+        INFO("charged / forward Euler's truncation: ignored "
+             << ignored.judged / ignored.expected << ", pooled " << pooled.judged / pooled.expected
+             << ", counted " << counted.judged / counted.expected);
+        REQUIRE(pooled.ratio.size() >= 100);
+        CHECK(ignored.judged < 0.4 * ignored.expected);
+        CHECK(pooled.judged > 0.6 * pooled.expected);
+        CHECK(pooled.judged < 1.5 * pooled.expected);
+        CHECK(counted.judged > 2.0 * counted.expected);
+        // Charged as well as measured: no kept jump's true error above 1.5 x the tolerance.
+        CHECK(pooled.over == 0);
+    }
+    SECTION("a random walk: no curvature charged, no jump rejected for one") {
+        // As "a curvature within its noise rejects no jump": the pooled line's noise is a
+        // fraction of one jump's, its debiased norm mostly 0 (0.0006 per jump of the tolerance
+        // 0.05 on average with these seeds). At most 1 in 20 attempts rejected, and on average
+        // less than a twentieth of the tolerance charged.
+        const TruncationJudged pooled =
+            judge_truncation(Mode::pooled, Eigen::VectorXd::Constant(19, 1e-4), 0.05, 0.0);
+        INFO(pooled.rejected << " of " << pooled.attempts << " rejected, " << pooled.judged
+                             << " charged in all");
+        REQUIRE(pooled.attempts >= 60);
+        CHECK(static_cast<double>(pooled.rejected) <= 0.05 * static_cast<double>(pooled.attempts));
+        CHECK(pooled.judged < 0.05 * 0.05 * static_cast<double>(pooled.ratio.size()));
+    }
+}
+
 TEST_CASE("a jump whose error exceeds the tolerance is rejected and redone",
           "[unit][coarse][multistep]") {
     // A fast mode (k = 0.3) with no noise, a first jump allowed up to 40: its curvature makes

@@ -874,3 +874,34 @@ TEST_CASE(
                Catch::Contains("scene.cfg:2") && Catch::Contains("cpi.pool") &&
                    Catch::Contains("at least 3"));
 }
+
+TEST_CASE(
+    "cpi.noisy_curvature = pooled: forward Euler with the bursts' own slopes and no added "
+    "curvature, refused elsewhere",
+    "[unit][coarse][run]") {
+    const std::string adaptive = "cpi.projection = adaptive\ncpi.tolerance = 0.1\n";
+    using Mode = MultistepSettings::NoisyCurvature;
+    const auto mode = [](const std::string& text) {
+        ParamTable t = ParamTable::from_text(text, "scene.cfg", "/scenes");
+        return CpiSettings::from_params(t.root().scope("cpi"), 0.5).multistep.noisy_curvature;
+    };
+    CHECK(mode(adaptive) == Mode::ignored);
+    CHECK(mode(adaptive + "cpi.noisy_curvature = counted\n") == Mode::counted);
+    CHECK(mode(adaptive + "cpi.noisy_curvature = pooled\n") == Mode::pooled);
+    CHECK_THAT(cpi_refusal(adaptive + "cpi.noisy_curvature = fitted\n"),
+               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.noisy_curvature") &&
+                   Catch::Contains("pooled"));
+    CHECK_THAT(cpi_refusal(adaptive + "cpi.integrator = adams_bashforth2\n"
+                                      "cpi.noisy_curvature = pooled\n"),
+               Catch::Contains("scene.cfg:4") && Catch::Contains("cpi.noisy_curvature") &&
+                   Catch::Contains("adams_bashforth2"));
+    CHECK_THAT(cpi_refusal(adaptive + "cpi.curvature = pooled\ncpi.noisy_curvature = pooled\n"),
+               Catch::Contains("scene.cfg:4") && Catch::Contains("cpi.noisy_curvature") &&
+                   Catch::Contains("cpi.curvature = pooled"));
+    CHECK_THAT(cpi_refusal(adaptive + "cpi.slope = pooled\ncpi.noisy_curvature = pooled\n"),
+               Catch::Contains("scene.cfg:4") && Catch::Contains("cpi.noisy_curvature") &&
+                   Catch::Contains("cpi.slope = pooled"));
+    CHECK_THAT(cpi_refusal(adaptive + "cpi.pool = 1\ncpi.noisy_curvature = pooled\n"),
+               Catch::Contains("scene.cfg:3") && Catch::Contains("cpi.pool") &&
+                   Catch::Contains("at least 2"));
+}

@@ -179,8 +179,35 @@ CpiSettings CpiSettings::from_params(const Params& cpi, double sample_interval, 
         c.growth = cpi.get_or<double>("growth", 2.0, Bounds::open_closed(1.0, 100.0));
         // The window from evidence (window_noise.hpp): at least 4 samples (2 per half, what
         // the measurement needs), at most cpi.window_max.
-        m.count_noisy_curvature =
-            cpi.get_or_choice("noisy_curvature", "ignored", {"ignored", "counted"}) == "counted";
+        const std::string noisy =
+            cpi.get_or_choice("noisy_curvature", "ignored", {"ignored", "counted", "pooled"});
+        m.noisy_curvature = noisy == "counted"  ? MultistepSettings::NoisyCurvature::counted
+                            : noisy == "pooled" ? MultistepSettings::NoisyCurvature::pooled
+                                                : MultistepSettings::NoisyCurvature::ignored;
+        if (m.noisy_curvature == MultistepSettings::NoisyCurvature::pooled) {
+            if (m.steps != 1)
+                cpi.fail("noisy_curvature",
+                         "pooled fits the curvature forward Euler's truncation comes from; "
+                         "cpi.integrator = adams_bashforth2's comes from the next derivative",
+                         "ignored or counted with cpi.integrator = adams_bashforth2");
+            if (m.pooled_curvature)
+                cpi.fail("noisy_curvature",
+                         "pooled charges the curvature fitted to the pooled bursts, which "
+                         "cpi.curvature = pooled already adds to every jump",
+                         "ignored or counted with cpi.curvature = pooled");
+            if (m.slope == SlopeSource::pooled)
+                cpi.fail("noisy_curvature",
+                         "pooled fits a curvature to the slopes cpi.slope = pooled averages",
+                         "ignored or counted with cpi.slope = pooled");
+            if (m.pool < 2)
+                cpi.fail(
+                    "pool",
+                    fmt::format("is {}: cpi.noisy_curvature = pooled fits a curvature to the "
+                                "slopes of the last cpi.pool bursts and the one after the jump",
+                                m.pool),
+                    "at least 2 (one burst and the one after the jump are the jump's own "
+                    "divided difference)");
+        }
         // The lift's own error in X is part of the jump's (docs/error_control.md §4); ignored:
         // as before it was (studies that compare with runs made then).
         m.count_lift_error =

@@ -46,7 +46,8 @@
 /// |                   | noise falls with the window (estimators/window_noise.hpp)     |         |
 /// | cpi.window_max    | adaptive: the longest window cpi.window_auto may choose       | 4 burst |
 /// | cpi.noisy_curvature | adaptive: a posteriori curvature within its noise `ignored` | ignored |
-/// |                   | or `counted` as truncation error (runs before it: counted)    |         |
+/// |                   | or `counted` as truncation error (runs before it: counted), or |         |
+/// |                   | `pooled`: the curvature fitted to the pool's slopes instead   |         |
 /// | cpi.finish        | `duration` (run to run.duration); `at_rest`: end where every  | duration|
 /// |                   | realization is at rest; `steady`: there, or where the pooled  |         |
 /// |                   | slope is noise (DriftTest, projective_run.hpp)                |         |

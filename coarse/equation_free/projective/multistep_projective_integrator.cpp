@@ -359,6 +359,20 @@ void MultistepProjectiveIntegrator::add_curvature_correction(JumpBasis& b) const
     b.correction = std::move(curvature);
 }
 
+double MultistepProjectiveIntegrator::pooled_noisy_curvature(const SlopeNode& after) const {
+    // The pool's bursts end with the jump's own slope; with the burst after the jump a line
+    // through at least three slopes (two are the jump's own divided difference).
+    if (pool_.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    std::vector<SlopeNode> nodes;
+    for (const PooledBurst& p : pool_.bursts()) nodes.push_back(p.node);
+    nodes.push_back(after);
+    const PooledCurvature b = pooled_curvature(nodes);
+    // The RMS of the part that is not noise, as the divided difference's norm (unbiased for
+    // |b|^2 when the slopes' errors are independent).
+    const double excess = b.value.squaredNorm() - b.variance.sum();
+    return std::sqrt(std::max(0.0, excess / static_cast<double>(b.value.size())));
+}
+
 void MultistepProjectiveIntegrator::record_statistical(ControllerRecord& c, const JumpBasis& basis,
                                                        double dt) const {
     // The curvature plays no part in the statistical error.
@@ -545,16 +559,29 @@ ProjectiveStepRecord MultistepProjectiveIntegrator::step(CoarseStepper& stepper)
     // still positive half the time by chance, and it would reject jumps the tolerance was spent
     // on with the statistical part (the prior curvature of such a plan is already 0).
     double curvature = d.norm;
-    if (settings_.adaptive && !settings_.count_noisy_curvature && curvature > 0.0) {
+    if (settings_.adaptive &&
+        settings_.noisy_curvature != MultistepSettings::NoisyCurvature::counted &&
+        curvature > 0.0) {
         const int realizations =
             rec.burst.members.empty() ? 0 : static_cast<int>(rec.burst.members.front().rows());
         const MeanSignificance sig = significance(d.value, d.noise_variance, realizations);
         if (sig.measured && !sig.resolved) {
-            append_message(
-                rec, fmt::format("the curvature after the jump is within its noise (S = {:.3g} "
-                                 "<= {:.3g}): truncation error judged 0, not {:.3g}",
-                                 sig.statistic, sig.threshold, curvature * omega));
-            curvature = 0.0;
+            const std::string within = fmt::format(
+                "the curvature after the jump is within its noise (S = {:.3g} <= "
+                "{:.3g}): truncation error judged ",
+                sig.statistic, sig.threshold);
+            const double pooled =
+                settings_.noisy_curvature == MultistepSettings::NoisyCurvature::pooled
+                    ? pooled_noisy_curvature(m.node)
+                    : std::numeric_limits<double>::quiet_NaN();
+            if (std::isfinite(pooled))
+                append_message(
+                    rec, fmt::format("{}{:.3g} from the curvature pooled over {} "
+                                     "bursts, not {:.3g}",
+                                     within, pooled * omega, pool_.size() + 1, curvature * omega));
+            else
+                append_message(rec, fmt::format("{}0, not {:.3g}", within, curvature * omega));
+            curvature = std::isfinite(pooled) ? pooled : 0.0;
         }
     }
     c.truncation = curvature * omega;

@@ -94,10 +94,16 @@ struct MultistepSettings {
     /// phase signal shows a wave (two periods in the burst), whole periods of it, at least two.
     /// The burst is healing + that window.
     bool window_auto = false;
-    /// cpi.noisy_curvature (adaptive): false ("ignored"), a jump's a posteriori curvature counts
-    /// as truncation error only when it is resolved above its own noise (mean_significance.hpp);
-    /// true ("counted", what runs before it did): its debiased norm always counts.
-    bool count_noisy_curvature = false;
+    /// cpi.noisy_curvature (adaptive): how a jump's a posteriori curvature counts as truncation
+    /// error when it lies within its own noise (mean_significance.hpp). ignored: not at all
+    /// (judged 0); counted (what runs before the key did): its debiased norm; pooled (forward
+    /// Euler without cpi.curvature = pooled): the debiased norm of the curvature fitted to the
+    /// slopes of the pooled bursts and the burst after the jump (pooled_curvature.hpp), a
+    /// baseline several jumps long whose noise is a fraction of the one jump's, so that an
+    /// accelerating path's truncation, each jump's within its own noise, is still charged.
+    /// A curvature resolved above its noise counts in every mode.
+    enum class NoisyCurvature { ignored, counted, pooled };
+    NoisyCurvature noisy_curvature = NoisyCurvature::ignored;
     /// cpi.curvature = pooled (forward Euler, the burst's own slope): every jump also adds
     /// omega b, the curvature b fitted to the slopes of the last `pool` accepted bursts (at
     /// least 3; estimators/pooled_curvature.hpp), when b is resolved above its noise
@@ -224,6 +230,9 @@ class MultistepProjectiveIntegrator final : public ProjectiveIntegrator {
     /// cpi.curvature = pooled: the curvature of the pool's bursts into `b` when resolved, and
     /// the note saying what was decided.
     void add_curvature_correction(JumpBasis& b) const;
+    /// cpi.noisy_curvature = pooled: the debiased RMS of the curvature fitted to the pool's
+    /// slopes and `after`'s (the burst after the jump); NaN while the pool holds fewer than 2.
+    double pooled_noisy_curvature(const SlopeNode& after) const;
     /// The curvature the next jump's plan counts as truncation: NaN before q + 1 slopes; with a
     /// curvature correction in `basis`, what it leaves of the last two slopes' (curvature_left).
     double prior_curvature(const JumpBasis& basis) const;
