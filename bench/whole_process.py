@@ -254,7 +254,8 @@ def make_runs(efdem, scene, runs, results, work, only=None, label=""):
         archive = os.path.join(results, name + ".h5")
         if sr.ensure(os.path.abspath(efdem), 2, scene, work, name, mode, overrides, archive,
                      label=f"{label}/{name}"):
-            write_reduction(archive, os.path.join(results, name + ".json"))
+            write_reduction(archive, os.path.join(results, name + ".json"),
+                            os.path.join(work, name, name + ".log"))
 
 
 # What the analysis reads of a run, kept in git beside the analysis (<case>/<run>.json): a study
@@ -266,17 +267,29 @@ def make_runs(efdem, scene, runs, results, work, only=None, label=""):
 # errors and floors are RMS over these samples: every 10th of a 0.5-unit sampling, which over a
 # quarter of a 600-unit span leaves 30 samples of a trajectory that moves on a scale of tens of units.
 GRID = 5.0
-KEPT_ATTRIBUTES = ("end_status", "simulated_time", "dem_time", "particle_steps", "wall_seconds", "git_commit",
-                   "study_command")
+KEPT_ATTRIBUTES = ("end_status", "simulated_time", "dem_time", "particle_steps", "wall_seconds",
+                   "resumed_wall_seconds", "git_commit", "study_command")
 
 
-def load_archive(path):
+def load_archive(path, log=None):
     with h5py.File(path, "r") as f:
         d = {k: sr.text(v) if isinstance(v, (bytes, str)) else v for k, v in f.attrs.items()}
         d["t"], d["icdf"] = f["samples/time"][:], f["samples/icdf"][:]
         d["rest"] = f["samples/at_rest"][:] if "samples/at_rest" in f else None
         d["lifts"] = lift_records(f)
+    # Before efdem kept a restarted run's earlier wall time (resumed_wall_seconds), wall_seconds
+    # was the last process's alone: a run its LOG shows restarted has an unknown wall time.
+    if "resumed_wall_seconds" not in d and log and os.path.exists(log):
+        with open(log, errors="replace") as f:
+            if any("restarted from" in line for line in f):
+                d["resumed_wall_seconds"] = float("nan")
     return d
+
+
+def wall_known(run):
+    """Whether RUN's wall_seconds is its whole run loop's (not a restart's last process alone)."""
+    resumed = run.get("resumed_wall_seconds", 0.0)
+    return resumed is not None and math.isfinite(float(resumed))
 
 
 def lift_records(f):
@@ -300,6 +313,8 @@ def reduce_run(full):
     on_grid = np.abs(t / GRID - np.round(t / GRID)) < 1e-6
     out = {k: (float(full[k]) if k not in ("end_status", "git_commit", "study_command") else full[k])
            for k in KEPT_ATTRIBUTES if k in full}
+    if "resumed_wall_seconds" in out and not math.isfinite(out["resumed_wall_seconds"]):
+        out["resumed_wall_seconds"] = None  # unknown (JSON has no NaN)
     def finite(xs):  # a realization still moving at the end: null (JSON has no NaN)
         return [float(x) if np.isfinite(x) else None for x in xs]
 
@@ -320,10 +335,10 @@ def from_reduction(d):
     return run
 
 
-def write_reduction(archive, dest):
+def write_reduction(archive, dest, log=None):
     tmp = dest + ".part"
     with open(tmp, "w") as f:
-        json.dump(reduce_run(load_archive(archive)), f, separators=(",", ":"), allow_nan=False)
+        json.dump(reduce_run(load_archive(archive, log)), f, separators=(",", ":"), allow_nan=False)
         f.write("\n")
     os.replace(tmp, dest)
 
@@ -559,8 +574,10 @@ def analyse_case(args, case):
         steps_ratio = (np.mean([float(d["particle_steps"]) for d in directs]) / float(run["particle_steps"])
                        if whole_run_steps(directs, run, duration) else float("nan"))
         whole_run = span >= duration - 1e-6
+        # Not where a restart left only its last process's wall time (wall_known).
+        walled = whole_run and wall_known(run) and all(wall_known(d) for d in directs)
         wall = (np.mean([float(d["wall_seconds"]) / float(d["simulated_time"]) for d in directs])
-                * float(run["simulated_time"]) / float(run["wall_seconds"])) if whole_run else float("nan")
+                * float(run["simulated_time"]) / float(run["wall_seconds"])) if walled else float("nan")
         ended = (f"end state at {float(run['t_all'][-1]):g}" if run["end_state"]
                  else f"{float(run['simulated_time']):g} (duration)")
         summary["cpi"][name] = {"e_over_floor": e[whole] / f_at[whole],
@@ -580,7 +597,7 @@ def analyse_case(args, case):
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_stops)
                      + f") | {int(np.isfinite(cpi_quiet).sum())} of {len(cpi_quiet)} ("
                      + ", ".join("moving" if not np.isfinite(x) else f"{x:g}" for x in cpi_quiet)
-                     + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if whole_run else "-")
+                     + f") | {speed:.2f} | {to_end:.2f} | " + (f"{wall:.2f}" if walled else "-")
                      + f" | {dem_each:g} | {expected:.1f} ({p_none:.2g}) | {steps_ratio:.2f} |")
     lines.append("")
     lines.append(noise_model_line(directs, {n: runs[n] for n in cpi if n in runs}))
