@@ -214,6 +214,12 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
         h.driver.fell_back = integers[3] != 0;
         // Before format 3 checkpoints were only written after the warm-up.
         h.driver.warmed_up = h.format_version < 3 || integers[4] != 0;
+        if (f.exists("/driver/wall_seconds")) {  // written since efdem keeps it
+            const auto wall = f.read_doubles("/driver/wall_seconds");
+            if (wall.size() != 1 || !(wall[0] >= 0))
+                refuse(path, "has a malformed /driver/wall_seconds");
+            h.stepper.wall_seconds = wall[0];
+        }
         if (f.exists("/driver/warmup_done")) {  // written since the warm-up has safe points
             const auto done = f.read_doubles("/driver/warmup_done");
             if (done.size() != 1 || !(done[0] >= 0))

@@ -431,6 +431,10 @@ void CheckpointWriter::write_header(H5File& f, long sequence, const CheckpointHe
                                              h.driver.without_progress, h.driver.fell_back ? 1 : 0,
                                              h.driver.warmed_up ? 1 : 0};
     f.write("/driver/integers", std::span<const std::int64_t>(integers), {integers.size()});
+    if (std::isfinite(s.wall_seconds)) {  // absent: unknown (read as NaN)
+        const std::vector<double> wall{s.wall_seconds};
+        f.write("/driver/wall_seconds", std::span<const double>(wall), {1});
+    }
     const std::vector<double> warmup_done{h.driver.warmup_done};
     f.write("/driver/warmup_done", std::span<const double>(warmup_done), {1});
     if (!h.driver.drift.empty())

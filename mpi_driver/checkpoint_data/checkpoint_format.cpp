@@ -125,6 +125,8 @@ std::uint64_t CheckpointHeader::checksum() const {
         h = hash_value(static_cast<std::uint64_t>(driver.drift.size()), h);
         for (double v : driver.drift) h = hash_value(v, h);
     }
+    // Likewise the run loop's wall time (absent where unknown, and before efdem kept it).
+    if (std::isfinite(s.wall_seconds)) h = hash_value(s.wall_seconds, h);
     if (format_version >= 3) {
         h = hash_value(driver.warmed_up ? 1L : 0L, h);
         h = fnv1a_array(s.active, h);

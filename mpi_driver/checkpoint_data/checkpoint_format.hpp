@@ -80,6 +80,10 @@ struct StepperState {
     /// Per realization: 1 in the ensemble, 0 dropped after a failure (empty: all in; format 3).
     std::vector<std::int64_t> active;
     long failures = 0;  ///< realization failures survived so far (ensemble.on_failure)
+    /// The run loop's wall time up to this state, summed over every process the run went
+    /// through (the root's). NaN: unknown (a steady solve's state, or a checkpoint written before
+    /// efdem kept it: /driver/wall_seconds absent).
+    double wall_seconds = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The run loop's state: coarse::ProjectiveRunState (t_origin, coarse_steps, without_progress,

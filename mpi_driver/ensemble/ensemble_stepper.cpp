@@ -1,6 +1,7 @@
 #include "mpi_driver/ensemble/ensemble_stepper.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <mpi.h>
@@ -503,6 +504,8 @@ StepperState EnsembleStepper::saved_state() const {
     s.samples_taken = samples_taken_;
     s.micro_time = micro_time_;
     s.particle_steps = particle_steps_;
+    s.wall_seconds = progress_ ? wall_before_ + progress_->elapsed_seconds()
+                               : std::numeric_limits<double>::quiet_NaN();
     sampler_.save(s);
     lifting_.save(s);
     failures_.save(s);

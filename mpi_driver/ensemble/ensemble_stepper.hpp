@@ -149,6 +149,11 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     /// on a restart (every rank; the lifting streams and warm starts matter on the root only).
     StepperState saved_state() const;
     void restore_state(const StepperState& state);
+    /// Root, a restarted run: the run loop's wall time of the processes before this one, up to
+    /// the checkpoint it resumed (StepperState::wall_seconds; NaN: unknown). saved_state() adds
+    /// this process's (from the progress clock; NaN without one, as in a steady solve).
+    void resume_wall(double seconds) { wall_before_ = seconds; }
+    double wall_before() const { return wall_before_; }
     long samples_taken() const { return samples_taken_; }
     /// Root: the first sample from which every realization in the ensemble has been at rest
     /// (Realization::at_rest), up to the last; NaN when one moves (or none is left).
@@ -305,6 +310,7 @@ class EnsembleStepper final : public coarse::CoarseStepper {
     StepperSettings settings_;
     SampleSink* sink_;
     Progress* progress_;
+    double wall_before_ = 0.0;  ///< resume_wall()
     EnsembleSampler sampler_;
     EnsembleLifting lifting_;
     EnsembleSnapshots snapshots_;

@@ -151,11 +151,12 @@ void CsvRecorder::coarse_step(const coarse::ProjectiveStepRecord& r, const LiftR
 void CsvRecorder::finish(const RunSummary& s) {
     write_meta(
         fmt::format(",\n  \"simulated_time\": {},\n  \"dem_time\": {},\n  \"wall_seconds\": {},\n"
+                    "  \"resumed_wall_seconds\": {},\n"
                     "  \"settling_wall_seconds\": {},\n  \"total_wall_seconds\": {},\n"
                     "  \"particle_steps\": {}",
                     json(s.simulated_time), json(s.dem_time), json(s.wall_seconds),
-                    json(s.settling_wall_seconds), json(s.total_wall_seconds),
-                    json(s.particle_steps)),
+                    json(s.resumed_wall_seconds), json(s.settling_wall_seconds),
+                    json(s.total_wall_seconds), json(s.particle_steps)),
         s.end_status);
 }
 

@@ -646,6 +646,7 @@ void Hdf5Recorder::finish(const RunSummary& s) {
     file_.attribute("/", "simulated_time", s.simulated_time);
     file_.attribute("/", "dem_time", s.dem_time);
     file_.attribute("/", "wall_seconds", s.wall_seconds);
+    file_.attribute("/", "resumed_wall_seconds", s.resumed_wall_seconds);
     file_.attribute("/", "settling_wall_seconds", s.settling_wall_seconds);
     file_.attribute("/", "total_wall_seconds", s.total_wall_seconds);
     file_.attribute("/", "particle_steps", s.particle_steps);

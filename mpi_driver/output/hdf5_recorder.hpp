@@ -9,7 +9,8 @@
 /// so that netCDF-4 readers (xarray) open each group; the layout in prose: docs/output.md. The
 /// file's attributes: format_version, efdem_version, git_hash, build, date, mode, ranks,
 /// realizations, realizations_per_rank, seed, observed_species, scene_file, overrides; at the end:
-/// end_status, simulated_time, dem_time, wall_seconds (the run loop only),
+/// end_status, simulated_time, dem_time, wall_seconds (the run loop only; a restarted run's with
+/// the processes it resumed through), resumed_wall_seconds (their part),
 /// settling_wall_seconds (building and settling the beds), total_wall_seconds (start-up to
 /// end, settling included), particle_steps, coarse_steps, restrict_seconds, lift_seconds.
 

@@ -24,7 +24,12 @@ namespace efdem::mpi_driver {
 struct RunSummary {
     double simulated_time = 0;  ///< time covered by the ensemble
     double dem_time = 0;        ///< time actually simulated by the DEM (per realization)
-    double wall_seconds = 0;    ///< wall time of the run loop (direct or cpi), not of the set-up
+    /// Wall time of the run loop (direct or cpi), not of the set-up; a restarted run's counts
+    /// the processes it resumed through up to their checkpoints (resumed_wall_seconds).
+    double wall_seconds = 0;
+    /// Of wall_seconds, the part of the processes before this one (0: not a restart; NaN:
+    /// unknown, a checkpoint written before efdem kept it: wall_seconds is then this process's).
+    double resumed_wall_seconds = 0;
     /// Root wall time from building the realizations to every rank having built its own: the
     /// settling of the beds, nearly all of it (also on a restart, which builds them again).
     double settling_wall_seconds = 0;

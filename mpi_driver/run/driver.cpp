@@ -147,7 +147,11 @@ void hand_off(EnsembleStepper& stepper, const RunSettings& s, RunRecorder* recor
 
 void fill_totals(RunSummary& sum, const EnsembleStepper& stepper, const Progress& progress) {
     sum.dem_time = stepper.micro_time();
-    sum.wall_seconds = progress.elapsed_seconds();
+    // A restarted run's wall time counts the processes before it too (as its DEM time and
+    // particle-steps do); where theirs is unknown, this process's alone.
+    const double before = stepper.wall_before();
+    sum.resumed_wall_seconds = before;
+    sum.wall_seconds = progress.elapsed_seconds() + (std::isfinite(before) ? before : 0.0);
     sum.particle_steps = stepper.particle_steps();
     sum.restrict_seconds = stepper.overhead().restrict_seconds;
 }

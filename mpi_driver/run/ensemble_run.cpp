@@ -161,6 +161,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
     RunControl control;
     if (resume) {
         stepper.restore_state(restart->header.stepper);
+        stepper.resume_wall(restart->header.stepper.wall_seconds);
         control.resume = restart->header.driver;
         // The rate and the time left count this process's work only.
         if (mpi.is_root()) progress.resume(stepper.time(), stepper.particle_steps());
@@ -197,9 +198,7 @@ int run_ensemble(const MpiSession& mpi, const ParamTable& table, const RunSettin
         RunSummary failed;
         failed.end_status = "failed: " + why;
         failed.simulated_time = stepper.time() - t0;
-        failed.dem_time = stepper.micro_time();
-        failed.particle_steps = stepper.particle_steps();
-        failed.wall_seconds = progress.elapsed_seconds();
+        fill_totals(failed, stepper, progress);
         wall.fill(failed);
         try {
             recorders->finish(failed);

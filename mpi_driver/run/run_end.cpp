@@ -1,5 +1,6 @@
 #include "mpi_driver/run/run_end.hpp"
 
+#include <cmath>
 #include <string>
 
 #include <fmt/format.h>
@@ -14,13 +15,22 @@ namespace efdem::mpi_driver {
 
 int report_end(const RunSummary& summary, const RunSettings& s, const ParamTable& table,
                int ranks) {
+    // A restarted run's loop counts the processes before it (their wall is not in this one's).
+    const double resumed = summary.resumed_wall_seconds;
+    const std::string loop =
+        resumed == 0.0 ? fmt::format("{} the run", format_duration(summary.wall_seconds))
+        : std::isfinite(resumed)
+            ? fmt::format("{} the run here; {} with the processes it resumed from",
+                          format_duration(summary.wall_seconds - resumed),
+                          format_duration(summary.wall_seconds))
+            : fmt::format("{} the run here; the processes it resumed from unknown",
+                          format_duration(summary.wall_seconds));
     log::info(
-        "{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall ({} settling the beds, {} "
-        "the run), "
-        "{:.3e} particle-steps",
+        "{}: simulated {:.6g} time units ({:.6g} by the DEM) in {} wall ({} settling the beds, "
+        "{}), {:.3e} particle-steps",
         summary.end_status, summary.simulated_time, summary.dem_time,
         format_duration(summary.total_wall_seconds), format_duration(summary.settling_wall_seconds),
-        format_duration(summary.wall_seconds), summary.particle_steps);
+        loop, summary.particle_steps);
     if (summary.stop_signal == 0) return summary.unconverged ? kExitRuntimeFailure : kExitOk;
     const std::string signal = signal_name(summary.stop_signal);
     if (summary.solve_interrupted) {

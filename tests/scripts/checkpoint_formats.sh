@@ -173,5 +173,14 @@ if not (0 < k < len(b) and filled[:k].all() and np.array_equal(a[k:], b[k:])):
     sys.exit(f"FAIL: {sys.argv[2]}: /samples/at_rest is not -1 up to the restart and the uninterrupted run's after it")
 print(f"PASS: the records the old run did not make are filled up to the restart ({k} of {len(b)} samples)")
 EOF
+  # The stored checkpoints came before /driver/wall_seconds: the restarted run's wall time is
+  # its own process's and says the earlier one is unknown; the one written now carries it.
+  /usr/bin/python3 -c "
+import h5py, math, sys
+a = h5py.File(sys.argv[1], 'r').attrs
+resumed = float(a['resumed_wall_seconds'])
+assert (math.isnan(resumed) if sys.argv[2] != '4' else 0 < resumed < a['wall_seconds']), (resumed, a['wall_seconds'])" \
+    "$work/$kind-f$version.h5" "$version" \
+    || { echo "FAIL: $kind-f$version's resumed wall time is not what its checkpoint says"; exit 1; }
   echo "PASS: $kind run restarted from a format-$version checkpoint ($(basename "$file")) equals the uninterrupted run"
 done

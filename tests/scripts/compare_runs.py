@@ -13,7 +13,7 @@ import sys
 import h5py
 import numpy as np
 
-SKIP_ATTRS = {"ranks", "realizations_per_rank", "date", "run_id", "wall_seconds", "settling_wall_seconds", "total_wall_seconds",
+SKIP_ATTRS = {"ranks", "realizations_per_rank", "date", "run_id", "wall_seconds", "resumed_wall_seconds", "settling_wall_seconds", "total_wall_seconds",
               "restrict_seconds", "lift_seconds",
               "overrides", "git_hash", "build"}
 

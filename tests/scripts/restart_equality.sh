@@ -11,6 +11,7 @@
 # start it again from the beginning at every requeue), also inside the drift loop of a warm-up
 # until steady, whose checkpoint holds the samples its next drift test reads ("warmsteady").
 # Compared: the run HDF5 file (compare_runs.py) and the CSV files (byte for byte: the wall time is in the sidecar, not compared).
+# A restarted run's wall_seconds counts the run it resumed (resumed_wall_seconds, from the checkpoint).
 #   restart_equality.sh EFDEM_BINARY MPIEXEC [MPIEXEC_PREFLAGS...]
 set -euo pipefail
 efdem=$1; mpiexec=$2; shift 2
@@ -91,6 +92,20 @@ assert f['/driver/warmup_tail/expansion'].shape == (len(t), 4)" "$ckpt" \
       echo "FAIL: the restart $mode-np$np settled its beds again"; exit 1
     fi
     same_output $mode-ref $mode-np$np
+    # The restarted run's loop wall time counts the process it resumed from, up to the checkpoint
+    # (as its DEM time does); the uninterrupted run resumed from none.
+    /usr/bin/python3 -c "
+import h5py, json, math, sys
+ck = float(h5py.File(sys.argv[1], 'r')['/driver/wall_seconds'][0])
+a, ref = h5py.File(sys.argv[2], 'r').attrs, h5py.File(sys.argv[3], 'r').attrs
+assert ref['resumed_wall_seconds'] == 0.0, ref['resumed_wall_seconds']
+assert ck > 0 and a['resumed_wall_seconds'] == ck, (a['resumed_wall_seconds'], ck)
+assert a['wall_seconds'] > ck, (a['wall_seconds'], ck)
+meta = json.load(open(sys.argv[4]))  # the sidecar writes 10 significant digits
+assert math.isclose(meta['resumed_wall_seconds'], ck, rel_tol=1e-9), meta
+assert math.isclose(meta['wall_seconds'], a['wall_seconds'], rel_tol=1e-9), meta" \
+      "$ckpt" "$work/$mode-np$np.h5" "$work/$mode-ref.h5" "$work/$mode-np${np}_csv_meta.json" \
+      || { echo "FAIL: $mode-np$np's wall time does not count the run it resumed"; exit 1; }
     echo "PASS: $mode restarted from $(basename "$ckpt") (2 ranks x 2) on $np ranks x $k equals the uninterrupted run"
   done
 done
