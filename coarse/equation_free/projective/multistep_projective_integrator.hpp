@@ -97,8 +97,9 @@ struct MultistepSettings {
     /// cpi.noisy_curvature (adaptive): how a jump's a posteriori curvature counts as truncation
     /// error when it lies within its own noise (mean_significance.hpp). ignored: not at all
     /// (judged 0); counted (what runs before the key did): its debiased norm; pooled (forward
-    /// Euler without cpi.curvature = pooled): the debiased norm of the curvature fitted to the
-    /// slopes of the pooled bursts and the burst after the jump (pooled_curvature.hpp), a
+    /// Euler without cpi.curvature = pooled), where that norm is positive: the debiased norm of
+    /// the curvature fitted to the slopes of the pooled bursts and the burst after the jump
+    /// (pooled_curvature.hpp; a norm that debiases to 0 is charged 0 in every mode), a
     /// baseline several jumps long whose noise is a fraction of the one jump's, so that an
     /// accelerating path's truncation, each jump's within its own noise, is still charged.
     /// A curvature resolved above its noise counts in every mode.
