@@ -76,13 +76,16 @@ double divided_difference_weight(std::span<const SlopeNode> nodes, std::size_t k
     return 1.0 / denom;
 }
 
-/// sqrt(max(0, mean(value^2) - mean(noise_variance))).
 void set_debiased_norm(DividedDifference& d) {
-    const auto m = d.value.size();
-    const double excess = d.value.squaredNorm() - d.noise_variance.sum();
-    d.norm = m > 0 ? std::sqrt(std::max(0.0, excess / static_cast<double>(m))) : 0.0;
+    d.norm = debiased_rms(d.value, d.noise_variance);
 }
 }  // namespace
+
+double debiased_rms(const Eigen::VectorXd& value, const Eigen::VectorXd& noise_variance) {
+    const auto m = value.size();
+    const double excess = value.squaredNorm() - noise_variance.sum();
+    return m > 0 ? std::sqrt(std::max(0.0, excess / static_cast<double>(m))) : 0.0;
+}
 
 DividedDifference slope_divided_difference(std::span<const SlopeNode> nodes) {
     EFDEM_EXPECTS(nodes.size() >= 2);

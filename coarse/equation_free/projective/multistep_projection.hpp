@@ -73,4 +73,9 @@ DividedDifference curvature_left(std::span<const SlopeNode> nodes, const PooledC
 /// RMS over the components.
 double rms(const Eigen::VectorXd& v);
 
+/// sqrt(max(0, mean(value^2) - mean(noise_variance))): the RMS of the part of an estimate that
+/// is not noise (unbiased for |value|^2 when its components' errors are independent); 0 for no
+/// component. DividedDifference::norm, and cpi.noisy_curvature = pooled's charge.
+double debiased_rms(const Eigen::VectorXd& value, const Eigen::VectorXd& noise_variance);
+
 }  // namespace efdem::coarse

@@ -367,10 +367,7 @@ double MultistepProjectiveIntegrator::pooled_noisy_curvature(const SlopeNode& af
     for (const PooledBurst& p : pool_.bursts()) nodes.push_back(p.node);
     nodes.push_back(after);
     const PooledCurvature b = pooled_curvature(nodes);
-    // The RMS of the part that is not noise, as the divided difference's norm (unbiased for
-    // |b|^2 when the slopes' errors are independent).
-    const double excess = b.value.squaredNorm() - b.variance.sum();
-    return std::sqrt(std::max(0.0, excess / static_cast<double>(b.value.size())));
+    return debiased_rms(b.value, b.variance);  // as the divided difference's norm
 }
 
 void MultistepProjectiveIntegrator::record_statistical(ControllerRecord& c, const JumpBasis& basis,
